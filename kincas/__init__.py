@@ -1,0 +1,23 @@
+"""kincas: kinematics of planar closed-chain mechanisms, solved as a whole with CasADi.
+
+Declare a mechanism (ground points, links, slides, inputs), then solve poses or sweeps:
+positions by Newton with the exact Jacobian, velocities and accelerations from the same
+Jacobians, sensitivities to every named parameter. Angles are radians in Python.
+
+>>> import numpy as np, kincas
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+...            kincas.Link.bar("rocker", "D", "C", 3)],
+...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+>>> pose = kincas.solve(m, {"crank.angle": np.pi / 2}, report=["C.x", "rocker.omega"])
+>>> pose.status, round(pose["C.x"], 6)
+('ok', 3.111346)
+"""
+from .errors import KincasError, ModelError, SceneError
+from .model import Input, Link, Mechanism, Param, Slide
+from .results import Pose, Sweep
+from .solve import compile, solve, sweep
+
+__all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "solve", "sweep", "compile",
+           "Pose", "Sweep", "KincasError", "ModelError", "SceneError"]
+__version__ = "0.1.0"

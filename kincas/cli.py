@@ -1,0 +1,100 @@
+"""The command line: `kincas solve SCENE.toml [--json]`.
+
+Exit status: 0 when every pose was solved, 3 when some were not, 2 when the scene itself is
+wrong (with one message on standard error naming the section and the field, no traceback).
+
+>>> main(["--version"])
+kincas 0.1.0
+0
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+from . import __version__
+from .errors import KincasError
+
+EXIT_OK, EXIT_SCENE, EXIT_UNSOLVED = 0, 2, 3
+
+
+def _parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="kincas", description="Kinematics of planar closed-chain mechanisms.")
+    ap.add_argument("--version", action="store_true", help="print the version and exit")
+    sub = ap.add_subparsers(dest="command")
+    s = sub.add_parser("solve", help="solve a scene: positions, velocities, accelerations over its inputs")
+    s.add_argument("scene", help="the scene file (TOML)")
+    s.add_argument("--json", action="store_true", help="print the documented JSON object")
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit status."""
+    ap = _parser()
+    args = ap.parse_args(argv)
+    if args.version:
+        print(f"kincas {__version__}")
+        return EXIT_OK
+    if args.command is None:
+        ap.print_help()
+        return EXIT_SCENE
+    try:
+        return _solve(args)
+    except BrokenPipeError:  # `kincas solve ... | head`: the reader left, nothing is wrong
+        sys.stderr.close()
+        return EXIT_OK
+    except KincasError as e:
+        print(f"kincas: error in {getattr(args, 'scene', 'scene')}:\n{e}", file=sys.stderr)
+        return EXIT_SCENE
+
+
+def _solve(args) -> int:
+    from .scene import load
+    sc = load(args.scene)
+    sw = sc.run()
+    inputs, values = sc.user_inputs(sw), sc.user_values(sw)
+    if args.json:
+        doc = {"title": sc.study.title, "units": sc.study.units,
+               "inputs": {k: _list(v) for k, v in inputs.items()},
+               "status": sw.status, "flags": sw.flags,
+               "values": {k: _list(v) for k, v in values.items()}}
+        json.dump(doc, sys.stdout, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        _table(sc, sw, inputs, values)
+    return EXIT_OK if all(s == "ok" for s in sw.status) else EXIT_UNSOLVED
+
+
+def _list(v) -> list:
+    return [float(x) if math.isfinite(x) else None for x in v]
+
+
+def _unit(sc, name: str) -> str:
+    from .symbolic import is_angular, parse_quantity
+    u = sc.study.units
+    L, A, T = u.get("length", ""), u.get("angle", "deg"), u.get("time", "s")
+    kind, obj, attr = parse_quantity(name)
+    if kind == "sens":
+        return f"{_unit(sc, obj) or '1'} per {attr}"
+    if name in sc.mechanism.param_values:
+        return ""
+    base = A if is_angular(name) or attr == "angle" else L
+    order = {"vx": 1, "vy": 1, "omega": 1, "v": 1, "ax": 2, "ay": 2, "alpha": 2, "a": 2}.get(attr, 0)
+    return base + ("" if order == 0 else f"/{T}" if order == 1 else f"/{T}^2")
+
+
+def _table(sc, sw, inputs, values):
+    print(sc.study.title or "kincas")
+    cols = list(inputs) + list(values)
+    heads = [c if not _unit(sc, c) else f"{c} [{_unit(sc, c)}]" for c in cols]
+    width = [max(12, len(h)) for h in heads]
+    print("  ".join(h.rjust(w) for h, w in zip(heads, width)) + "  status")
+    data = [inputs[c] for c in inputs] + [values[c] for c in values]
+    for i in range(len(sw)):
+        cells = [("-" if not math.isfinite(d[i]) else f"{d[i]:.6g}").rjust(w) for d, w in zip(data, width)]
+        flag = f" ({sw.flags[i]})" if sw.flags[i] else ""
+        print("  ".join(cells) + f"  {sw.status[i]}{flag}")
+    bad = sum(s != "ok" for s in sw.status)
+    print(f"{len(sw)} poses, {len(sw) - bad} solved" + (f", {bad} not solved" if bad else ""))

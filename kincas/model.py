@@ -1,0 +1,407 @@
+"""Declarations of a planar mechanism as immutable plain data (no casadi here).
+
+A mechanism is ground points, links (rigid bodies carrying named points), slides (a point
+kept on a line of a body) and inputs (what drives it). A point name shared by two bodies is
+a revolute joint. Numbers may be given as a parameter's name, so that sensitivities and
+optimisation can refer to them. Angles are radians in Python.
+
+>>> m = Mechanism(
+...     parameters={"crank": 1.0},
+...     ground={"A": (0, 0), "D": (4, 0)},
+...     links=[Link.bar("crank", "A", "B", "crank"), Link.bar("coupler", "B", "C", 3.5),
+...            Link.bar("rocker", "D", "C", 3.0)],
+...     inputs=[Input.angle("crank")],
+...     guess={"C": (3.5, 2.5)})
+>>> m.mobility
+1
+>>> m.with_parameters(crank=1.5).parameter("crank")
+1.5
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field, replace
+from typing import Iterable, Mapping, Union
+
+from .errors import ModelError
+
+# --- numbers that may name a parameter ---
+
+
+@dataclass(frozen=True)
+class Param:
+    """A reference to a named parameter, times a fixed factor (degrees -> radians, say)."""
+
+    name: str
+    scale: float = 1.0
+
+
+Num = Union[float, int, str, Param]
+GROUND = "ground"
+_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
+
+
+def as_param(v: Num) -> Param | None:
+    """The parameter a number refers to, or None for a plain number."""
+    if isinstance(v, Param):
+        return v
+    if isinstance(v, str):
+        return Param(v)
+    return None
+
+
+def _pair(v) -> tuple[Num, Num]:
+    x, y = v
+    return (x, y)
+
+
+# --- bodies, slides, inputs ---
+
+
+@dataclass(frozen=True)
+class Link:
+    """A rigid body carrying named points, given in its own frame.
+
+    `Link.bar(name, P, Q, length)` is the two-point form: origin at P, x axis towards Q.
+    `Link(name, {"A": (0, 0), "E": (550, 0)})` is the local-coordinates form; the link's
+    angle is the angle of its frame's x axis.
+
+    >>> Link.bar("rod", "E", "F", 360).local("F")
+    (360, 0.0)
+    """
+
+    name: str
+    points: tuple[tuple[str, tuple[Num, Num]], ...]
+    two_point: bool = False
+
+    def __init__(self, name: str, points, two_point: bool = False):
+        items = points.items() if isinstance(points, Mapping) else points
+        object.__setattr__(self, "name", name)
+        object.__setattr__(self, "points", tuple((p, _pair(xy)) for p, xy in items))
+        object.__setattr__(self, "two_point", two_point)
+
+    @classmethod
+    def bar(cls, name: str, p: str, q: str, length: Num) -> "Link":
+        """Two-point link P-Q of the given length (a number or a parameter name)."""
+        return cls(name, ((p, (0.0, 0.0)), (q, (length, 0.0))), two_point=True)
+
+    @property
+    def point_names(self) -> tuple[str, ...]:
+        return tuple(p for p, _ in self.points)
+
+    def local(self, point: str) -> tuple[Num, Num]:
+        return dict(self.points)[point]
+
+
+@dataclass(frozen=True)
+class Slide:
+    """`point` stays on a line of body `along` (a link's name or "ground").
+
+    The line passes through `through` at `angle` (radians), both in that body's frame;
+    the default is the body's x axis. The slide's coordinate `s` is the signed distance
+    along the line from `through` to the point.
+
+    >>> Slide("F", "ground", through=(700, 0), angle=math.pi / 2, name="guide").name
+    'guide'
+    """
+
+    point: str
+    along: str
+    through: tuple[Num, Num] = (0.0, 0.0)
+    angle: Num = 0.0
+    name: str = ""
+
+    def __post_init__(self):
+        object.__setattr__(self, "through", _pair(self.through))
+        if not self.name:
+            object.__setattr__(self, "name", self.point)
+
+
+@dataclass(frozen=True)
+class Input:
+    """What drives the mechanism: a link's absolute angle, a slide's coordinate, or a parameter.
+
+    >>> Input.angle("crank").key, Input.slide("guide").key, Input.parameter("stroke").key
+    ('crank.angle', 'guide.s', 'stroke')
+    """
+
+    kind: str  # "angle" | "slide" | "parameter"
+    target: str
+
+    @classmethod
+    def angle(cls, link: str) -> "Input":
+        return cls("angle", link)
+
+    @classmethod
+    def slide(cls, slide: str) -> "Input":
+        return cls("slide", slide)
+
+    @classmethod
+    def parameter(cls, name: str) -> "Input":
+        return cls("parameter", name)
+
+    @property
+    def key(self) -> str:
+        return {"angle": f"{self.target}.angle", "slide": f"{self.target}.s"}.get(self.kind, self.target)
+
+    @property
+    def is_angle(self) -> bool:
+        return self.kind == "angle"
+
+
+# --- the structure of the chain: a spanning tree of revolute joints ---
+
+
+@dataclass(frozen=True)
+class Structure:
+    """How the loop-closure equations are laid out (derived from names only).
+
+    Links are placed from the ground outwards: a link that shares a point with what is
+    already placed hangs on that point and needs only its angle as an unknown; a link with
+    no such point floats (x, y, angle). Every other shared point closes a loop: two
+    equations saying that the two bodies put the point at the same place. Each slide adds
+    one equation (the point's distance from the line is zero).
+    """
+
+    order: tuple[tuple[str, str | None], ...]  # (link, point it hangs on, or None: floating)
+    owner: tuple[tuple[str, str], ...]  # point -> body whose frame defines it
+    closures: tuple[tuple[str, str], ...]  # (point, link): that link's copy must meet the owner's
+    n_unknowns: int
+    n_equations: int
+
+    @property
+    def mobility(self) -> int:
+        return self.n_unknowns - self.n_equations
+
+
+def _structure(ground: Iterable[str], links: tuple[Link, ...], n_slides: int) -> Structure:
+    owner = {g: GROUND for g in ground}
+    order, closures, remaining = [], [], list(links)
+    n_unknowns = 0
+
+    def place(link: Link, at: str | None):
+        nonlocal n_unknowns
+        order.append((link.name, at))
+        n_unknowns += 1 if at is not None else 3
+        for p in link.point_names:
+            if p == at:
+                continue
+            if p in owner:
+                closures.append((p, link.name))
+            else:
+                owner[p] = link.name
+        remaining.remove(link)
+
+    # Breadth-first from the ground keeps chains short, so each loop closes near its root.
+    while remaining:
+        ready = [(lk, next((p for p in lk.point_names if p in owner), None)) for lk in remaining]
+        ready = [(lk, at) for lk, at in ready if at is not None]
+        if not ready:
+            place(remaining[0], None)
+            continue
+        for lk, _ in ready:
+            at = next(p for p in lk.point_names if p in owner)
+            place(lk, at)
+    return Structure(tuple(order), tuple(owner.items()), tuple(closures),
+                     n_unknowns, 2 * len(closures) + n_slides)
+
+
+# --- the mechanism ---
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    """A planar mechanism: an immutable value, checked on construction.
+
+    Every problem found is gathered into one `ModelError`. Changing anything returns a new
+    mechanism (`with_parameters`, `with_guess`, `dataclasses.replace`).
+    """
+
+    parameters: tuple[tuple[str, float], ...] = ()
+    ground: tuple[tuple[str, tuple[Num, Num]], ...] = ()
+    links: tuple[Link, ...] = ()
+    slides: tuple[Slide, ...] = ()
+    inputs: tuple[Input, ...] = ()
+    guess: tuple[tuple[str, tuple[Num, Num]], ...] = ()
+    structure: Structure = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        def items(v):
+            return tuple((v.items() if isinstance(v, Mapping) else v))
+        object.__setattr__(self, "parameters", tuple((k, float(v)) for k, v in items(self.parameters)))
+        object.__setattr__(self, "ground", tuple((k, _pair(v)) for k, v in items(self.ground)))
+        object.__setattr__(self, "guess", tuple((k, _pair(v)) for k, v in items(self.guess)))
+        object.__setattr__(self, "links", tuple(self.links))
+        object.__setattr__(self, "slides", tuple(self.slides))
+        object.__setattr__(self, "inputs", tuple(self.inputs))
+        problems = _check(self)
+        if problems:
+            raise ModelError(problems)
+        object.__setattr__(self, "structure",
+                           _structure([g for g, _ in self.ground], self.links, len(self.slides)))
+        problems = _check_mobility(self)
+        if problems:
+            raise ModelError(problems)
+
+    # --- lookups ---
+    @property
+    def param_values(self) -> dict[str, float]:
+        return dict(self.parameters)
+
+    def parameter(self, name: str) -> float:
+        return self.param_values[name]
+
+    def link(self, name: str) -> Link:
+        return {lk.name: lk for lk in self.links}[name]
+
+    def slide(self, name: str) -> Slide:
+        return {s.name: s for s in self.slides}[name]
+
+    @property
+    def ground_points(self) -> tuple[str, ...]:
+        return tuple(g for g, _ in self.ground)
+
+    @property
+    def moving_points(self) -> tuple[str, ...]:
+        """Points carried by links and not fixed to the ground, in declaration order."""
+        seen = dict.fromkeys(p for lk in self.links for p in lk.point_names)
+        return tuple(p for p in seen if p not in dict(self.ground))
+
+    @property
+    def mobility(self) -> int:
+        """Degrees of freedom counted from the structure (unknowns minus equations)."""
+        return self.structure.mobility
+
+    def value(self, v: Num) -> float:
+        """The number `v`, resolving a parameter reference."""
+        p = as_param(v)
+        return float(v) if p is None else p.scale * self.param_values[p.name]
+
+    def size(self) -> float:
+        """The mechanism's characteristic length: tolerances are relative to it."""
+        pts = [(self.value(x), self.value(y)) for _, (x, y) in self.ground]
+        extent = 0.0
+        for lk in self.links:
+            loc = [(self.value(x), self.value(y)) for _, (x, y) in lk.points]
+            extent = max([extent] + [math.dist(a, b) for a in loc for b in loc])
+        if pts:
+            xs, ys = zip(*pts)
+            extent = max(extent, math.hypot(max(xs) - min(xs), max(ys) - min(ys)))
+        return extent if extent > 0 else 1.0
+
+    # --- new values ---
+    def with_parameters(self, **values: float) -> "Mechanism":
+        """A new mechanism with some parameters changed."""
+        unknown = [k for k in values if k not in self.param_values]
+        if unknown:
+            raise ModelError([f"[parameters] {k}: no such parameter" for k in unknown])
+        return replace(self, parameters={**self.param_values, **{k: float(v) for k, v in values.items()}})
+
+    def with_guess(self, **points: tuple[float, float]) -> "Mechanism":
+        """A new mechanism whose guess (which picks the assembly branch) is updated."""
+        return replace(self, guess={**dict(self.guess), **points})
+
+
+# --- validation: gather every problem, name the section and the field ---
+
+
+def _check(m: Mechanism) -> list[str]:
+    out: list[str] = []
+    params = m.param_values
+
+    def num(where: str, v):
+        p = as_param(v)
+        if p is not None:
+            if p.name not in params:
+                out.append(f"{where}: unknown parameter {p.name!r}")
+        elif isinstance(v, bool) or not isinstance(v, (int, float)):
+            out.append(f"{where}: expected a number or a parameter's name, got {v!r}")
+        elif not math.isfinite(v):
+            out.append(f"{where}: {v} is not a finite number")
+
+    for k, v in m.parameters:
+        if not _NAME.match(k):
+            out.append(f"[parameters] {k}: not a valid name")
+        if not math.isfinite(v):
+            out.append(f"[parameters] {k}: {v} is not a finite number")
+    gnames = set()
+    for g, (x, y) in m.ground:
+        if g == GROUND or not _NAME.match(g):
+            out.append(f"[ground] {g}: not a valid point name")
+        gnames.add(g)
+        num(f"[ground] {g}", x), num(f"[ground] {g}", y)
+    lnames: set[str] = set()
+    for lk in m.links:
+        where = f"[links] {lk.name}"
+        if lk.name == GROUND or not _NAME.match(lk.name):
+            out.append(f"{where}: not a valid link name")
+        if lk.name in lnames:
+            out.append(f"{where}: declared twice")
+        lnames.add(lk.name)
+        names = lk.point_names
+        if len(names) < 2:
+            out.append(f"{where}: points: a link needs at least two points")
+        if len(set(names)) != len(names):
+            out.append(f"{where}: points: a point is named twice")
+        for p, (x, y) in lk.points:
+            if not _NAME.match(p):
+                out.append(f"{where}: points: {p!r} is not a valid point name")
+            num(f"{where}: points.{p}" if not lk.two_point else f"{where}: length", x)
+            num(f"{where}: points.{p}", y)
+        if len([p for p in names if p in gnames]) > 1:
+            out.append(f"{where}: points: carries two ground points, so it cannot move")
+    if out:
+        return out  # the remaining checks need numbers and names that resolve
+    for lk in m.links:
+        loc = [(m.value(x), m.value(y)) for _, (x, y) in lk.points]
+        if lk.two_point and m.value(lk.points[1][1][0]) <= 0:
+            out.append(f"[links] {lk.name}: length must be positive")
+        elif all(math.dist(loc[0], b) == 0 for b in loc[1:]):
+            out.append(f"[links] {lk.name}: points: all its points coincide")
+    moving = set(m.moving_points)
+    snames: set[str] = set()
+    for i, s in enumerate(m.slides):
+        where = f"[[slides]] {s.name or i + 1}"
+        if s.name in snames:
+            out.append(f"{where}: name: two slides are named {s.name!r} (give each a `name`)")
+        snames.add(s.name)
+        if s.point not in moving:
+            what = "is a ground point" if s.point in gnames else "is not a point of any link"
+            out.append(f"{where}: point: {s.point!r} {what}")
+        if s.along != GROUND and s.along not in lnames:
+            out.append(f"{where}: along: unknown body {s.along!r} (a link's name or \"ground\")")
+        elif s.along != GROUND and s.point in m.link(s.along).point_names:
+            out.append(f"{where}: along: {s.point!r} is a point of {s.along!r} itself")
+        num(f"{where}: line.through", s.through[0]), num(f"{where}: line.through", s.through[1])
+        num(f"{where}: line.angle", s.angle)
+    keys = set()
+    for i, inp in enumerate(m.inputs):
+        where = f"[[inputs]] {i + 1}"
+        ok = {"angle": lnames, "slide": snames, "parameter": set(params)}.get(inp.kind)
+        if ok is None:
+            out.append(f"{where}: unknown kind {inp.kind!r} (angle, slide or parameter)")
+        elif inp.target not in ok:
+            what = {"angle": "link", "slide": "slide", "parameter": "parameter"}[inp.kind]
+            out.append(f"{where}: {inp.kind}: unknown {what} {inp.target!r}")
+        if inp.key in keys:
+            out.append(f"{where}: {inp.kind}: {inp.target!r} is driven twice")
+        keys.add(inp.key)
+    for p, (x, y) in m.guess:
+        if p not in moving:
+            what = "is a ground point (fixed)" if p in gnames else "is not a point of any link"
+            out.append(f"[guess] {p}: {what}")
+        num(f"[guess] {p}", x), num(f"[guess] {p}", y)
+    return out
+
+
+def _check_mobility(m: Mechanism) -> list[str]:
+    st = m.structure
+    n_param = sum(inp.kind == "parameter" for inp in m.inputs)
+    dof = st.mobility + n_param
+    if dof == len(m.inputs) and st.mobility >= 0:
+        return []
+    detail = (f"{st.n_unknowns} unknown coordinates, {st.n_equations} equations"
+              + (f", plus {n_param} driven parameter(s)" if n_param else ""))
+    return [f"[inputs]: the mechanism has {dof} degree(s) of freedom ({detail}) "
+            f"but {len(m.inputs)} input(s) drive it; give one input per degree of freedom"]

@@ -1,0 +1,327 @@
+"""TOML scene files (see docs/scene-format.md) -> a Mechanism and the study to run on it.
+
+Degrees live only here and in the CLI: angles in the file (line angles, angle inputs, their
+rates) are converted to radians, and angular results back to the scene's unit. Every problem
+in a scene is gathered into one `SceneError` naming the section and the field.
+
+>>> sc = loads('''
+... [ground]
+... A = [0, 0]
+... D = [4, 0]
+... [links]
+... crank = { points = ["A", "B"], length = 1 }
+... coupler = { points = ["B", "C"], length = 3.5 }
+... rocker = { points = ["D", "C"], length = 3 }
+... [[inputs]]
+... angle = "crank"
+... value = 90
+... [guess]
+... C = [3.6, 2.9]
+... ''')
+>>> out = sc.run()
+>>> out.status, round(sc.user_values(out)["rocker.angle"][0], 4)
+(['ok'], 84.1708)
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import KincasError, SceneError
+from .model import GROUND, Input, Link, Mechanism, Param, Slide
+from .results import Sweep
+
+SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
+            "output", "optimize"}
+
+
+@dataclass
+class Study:
+    """What to run: input values per pose (radians inside), rates, what to report."""
+
+    title: str
+    units: dict[str, str]
+    inputs: dict[str, np.ndarray]
+    rates: dict[str, float]
+    accelerations: dict[str, float]
+    report: list[str]
+    sensitivity: list[str] = field(default_factory=list)
+    raw: dict = field(default_factory=dict, repr=False)  # the parsed TOML, for extensions
+
+    @property
+    def deg(self) -> bool:
+        return self.units.get("angle", "deg") == "deg"
+
+
+@dataclass
+class Scene:
+    mechanism: Mechanism
+    study: Study
+
+    @property
+    def quantities(self) -> list[str]:
+        return self.study.report + [q for q in self.study.sensitivity if q not in self.study.report]
+
+    def run(self, **kw) -> Sweep:
+        from .solve import sweep  # casadi stays out of scene parsing
+        st = self.study
+        return sweep(self.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
+                     report=self.quantities, **kw)
+
+    def user_inputs(self, s: Sweep) -> dict[str, np.ndarray]:
+        """Input values in the scene's units."""
+        return {k: self._to_user(k, v, angle=k.endswith(".angle")) for k, v in s.inputs.items()}
+
+    def user_values(self, s: Sweep) -> dict[str, np.ndarray]:
+        """Reported quantities in the scene's units (degrees where the scene says so)."""
+        from .symbolic import is_angular
+        return {k: self._to_user(k, v, angle=is_angular(k)) for k, v in s.values.items()}
+
+    def _to_user(self, name, v, angle):
+        # A parameter used as an angle stays in the scene's unit inside, so d(Q)/d(p) is
+        # already per degree of p; only the quantity's own angle unit is converted here.
+        return np.degrees(v) if angle and self.study.deg else np.asarray(v, float)
+
+
+def load(path: str | Path) -> Scene:
+    """Read a scene file. Raises SceneError (naming section and field) when it is malformed."""
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as e:
+        raise SceneError(f"scene: cannot read {str(path)!r}: {e.strerror or e}") from None
+    return loads(text)
+
+
+def loads(text: str) -> Scene:
+    """Parse a scene from TOML text."""
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(f"scene: not valid TOML: {e}") from None
+    return _Reader(doc).scene()
+
+
+# --- reading, with every problem gathered ---
+
+
+class _Reader:
+    def __init__(self, doc: dict):
+        self.doc, self.problems = doc, []
+        units = doc.get("units", {})
+        self.deg = True
+        if not isinstance(units, dict):
+            self.err("[units]: expected a table like { length = \"mm\", angle = \"deg\" }")
+            units = {}
+        elif units.get("angle", "deg") not in ("deg", "rad"):
+            self.err(f"[units] angle: {units['angle']!r} is neither \"deg\" nor \"rad\"")
+        else:
+            self.deg = units.get("angle", "deg") == "deg"
+        self.units = {"length": "", "angle": "deg", "time": "s",
+                      **{k: str(v) for k, v in units.items()}} if isinstance(units, dict) else {}
+        self.params = {}
+
+    def err(self, msg: str):
+        self.problems.append(msg)
+
+    def table(self, name) -> dict:
+        t = self.doc.get(name, {})
+        if not isinstance(t, dict):
+            self.err(f"[{name}]: expected a table")
+            return {}
+        return t
+
+    def num(self, where: str, v, angle=False):
+        """A number or a parameter's name; angles converted to radians."""
+        k = math.pi / 180 if angle and self.deg else 1.0
+        if isinstance(v, str):
+            if v not in self.params:
+                self.err(f"{where}: unknown parameter {v!r}")
+                return 0.0
+            return Param(v, k) if k != 1.0 else v
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            self.err(f"{where}: expected a number or a parameter's name, got {v!r}")
+            return 0.0
+        if not math.isfinite(v):
+            self.err(f"{where}: {v} is not a finite number")
+            return 0.0
+        return float(v) * k
+
+    def value(self, where, v, angle=False) -> float:
+        """A plain float (parameter names resolved to their values)."""
+        x = self.num(where, v, angle)
+        if isinstance(x, (str, Param)):
+            p = x if isinstance(x, Param) else Param(x)
+            return p.scale * self.params[p.name]
+        return x
+
+    def xy(self, where, v, angle=False):
+        if not isinstance(v, list) or len(v) != 2:
+            self.err(f"{where}: expected [x, y], got {v!r}")
+            return (0.0, 0.0)
+        return (self.num(where, v[0]), self.num(where, v[1]))
+
+    def fields(self, where, t: dict, allowed: set[str]):
+        for k in t:
+            if k not in allowed:
+                self.err(f"{where}: unknown field {k!r} (expected one of {sorted(allowed)})")
+
+    # --- sections ---
+    def scene(self) -> Scene:
+        doc = self.doc
+        for k in doc:
+            if k not in SECTIONS:
+                self.err(f"scene: unknown section or key {k!r} (expected {sorted(SECTIONS)})")
+        title = doc.get("title", "")
+        if not isinstance(title, str):
+            self.err("title: expected a string")
+        for k, v in self.table("parameters").items():
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                self.err(f"[parameters] {k}: expected a number, got {v!r}")
+            elif not math.isfinite(v):
+                self.err(f"[parameters] {k}: {v} is not a finite number")
+            else:
+                self.params[k] = float(v)
+        ground = {k: self.xy(f"[ground] {k}", v) for k, v in self.table("ground").items()}
+        if GROUND in ground:
+            self.err("[ground] ground: the name `ground` means the fixed frame")
+        links = [self.link(k, v) for k, v in self.table("links").items()]
+        slides = [self.slide(i, s) for i, s in enumerate(self.array("slides"))]
+        inputs, values, rates, accs = self.inputs()
+        guess = {k: self.xy(f"[guess] {k}", v) for k, v in self.table("guess").items()}
+        report, sens = self.output()
+        if self.problems:
+            raise SceneError(self.problems)
+        try:
+            m = Mechanism(parameters=self.params, ground=ground, links=[lk for lk in links if lk],
+                          slides=slides, inputs=inputs, guess=guess)
+        except KincasError as e:
+            raise SceneError(e.problems) from None
+        if report is None:
+            from .symbolic import default_report
+            report = default_report(m)
+        self.check_quantities(m, report + sens)
+        study = Study(title=title if isinstance(title, str) else "", units=self.units,
+                      inputs=values, rates=rates, accelerations=accs, report=report,
+                      sensitivity=sens, raw=doc)
+        return Scene(m, study)
+
+    def array(self, name) -> list[dict]:
+        v = self.doc.get(name, [])
+        if not isinstance(v, list) or not all(isinstance(x, dict) for x in v):
+            self.err(f"[[{name}]]: expected an array of tables ([[{name}]] blocks)")
+            return []
+        return v
+
+    def link(self, name, t):
+        where = f"[links] {name}"
+        if not isinstance(t, dict) or "points" not in t:
+            self.err(f"{where}: points: missing (a link is {{ points = [\"P\", \"Q\"], length = L }} "
+                     f"or {{ points = {{ P = [x, y], ... }} }})")
+            return None
+        pts = t["points"]
+        if isinstance(pts, list):
+            self.fields(where, t, {"points", "length"})
+            if len(pts) != 2 or not all(isinstance(p, str) for p in pts):
+                self.err(f"{where}: points: the two-point form takes two point names")
+                return None
+            if "length" not in t:
+                self.err(f"{where}: length: missing (the two-point form needs a length)")
+                return None
+            return Link.bar(name, pts[0], pts[1], self.num(f"{where}: length", t["length"]))
+        if isinstance(pts, dict):
+            self.fields(where, t, {"points"})
+            if "length" in t:
+                self.err(f"{where}: length: only the two-point form takes a length")
+            return Link(name, {p: self.xy(f"{where}: points.{p}", xy) for p, xy in pts.items()})
+        self.err(f"{where}: points: expected a list of two names or a table of local coordinates")
+        return None
+
+    def slide(self, i, t):
+        where = f"[[slides]] {t.get('name', i + 1)}"
+        self.fields(where, t, {"name", "point", "along", "line"})
+        for k in ("point", "along"):
+            if not isinstance(t.get(k), str):
+                self.err(f"{where}: {k}: missing or not a name")
+        line = t.get("line", {})
+        if not isinstance(line, dict):
+            self.err(f"{where}: line: expected {{ through = [x, y], angle = a }}")
+            line = {}
+        self.fields(f"{where}: line", line, {"through", "angle"})
+        through = self.xy(f"{where}: line.through", line.get("through", [0.0, 0.0]))
+        angle = self.num(f"{where}: line.angle", line.get("angle", 0.0), angle=True)
+        return Slide(point=str(t.get("point", "")), along=str(t.get("along", "")),
+                     through=through, angle=angle, name=str(t.get("name", "")))
+
+    def inputs(self):
+        inputs, values, rates, accs, steps = [], {}, {}, {}, set()
+        for i, t in enumerate(self.array("inputs")):
+            where = f"[[inputs]] {i + 1}"
+            self.fields(where, t, {"angle", "parameter", "slide", "value", "sweep", "rate",
+                                   "acceleration"})
+            kinds = [k for k in ("angle", "parameter", "slide") if k in t]
+            if len(kinds) != 1:
+                self.err(f"{where}: give exactly one of angle, parameter or slide")
+                continue
+            kind = kinds[0]
+            if not isinstance(t[kind], str):
+                self.err(f"{where}: {kind}: expected a name")
+                continue
+            inp = Input(kind, t[kind])
+            where = f"[[inputs]] {inp.key}"
+            ang = kind == "angle"
+            if ("value" in t) == ("sweep" in t):
+                self.err(f"{where}: give either `value` or `sweep`")
+                continue
+            if "value" in t:
+                vals = np.array([self.value(f"{where}: value", t["value"], ang)])
+            else:
+                sw = t["sweep"]
+                if not isinstance(sw, dict) or not {"from", "to", "steps"} <= set(sw):
+                    self.err(f"{where}: sweep: expected {{ from = a, to = b, steps = n }}")
+                    continue
+                self.fields(f"{where}: sweep", sw, {"from", "to", "steps"})
+                n = sw["steps"]
+                if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+                    self.err(f"{where}: sweep.steps: expected a whole number >= 1, got {n!r}")
+                    continue
+                a = self.value(f"{where}: sweep.from", sw["from"], ang)
+                b = self.value(f"{where}: sweep.to", sw["to"], ang)
+                vals = np.linspace(a, b, n)
+                steps.add(n)
+            inputs.append(inp)
+            values[inp.key] = vals
+            rates[inp.key] = self.value(f"{where}: rate", t.get("rate", 1.0), ang)
+            accs[inp.key] = self.value(f"{where}: acceleration", t.get("acceleration", 0.0), ang)
+        if len(steps) > 1:
+            self.err(f"[[inputs]] sweep.steps: inputs that sweep advance together, but their "
+                     f"steps differ ({sorted(steps)})")
+        return inputs, values, rates, accs
+
+    def output(self):
+        out = self.table("output")
+        self.fields("[output]", out, {"report", "sensitivity"})
+        report = out.get("report")
+        if report is not None and (not isinstance(report, list)
+                                   or not all(isinstance(r, str) for r in report)):
+            self.err("[output] report: expected a list of quantity names")
+            report = []
+        sens = []
+        if "sensitivity" in out:
+            s = out["sensitivity"]
+            of, to = (s.get("of"), s.get("to")) if isinstance(s, dict) else (None, None)
+            if not (isinstance(of, list) and isinstance(to, list)):
+                self.err("[output] sensitivity: expected { of = [\"Q\", ...], to = [\"p\", ...] }")
+            else:
+                self.fields("[output] sensitivity", s, {"of", "to"})
+                sens = [f"d({q})/d({p})" for q in of for p in to]
+        return report, sens
+
+    def check_quantities(self, m: Mechanism, names: list[str]):
+        from .solve import compile
+        bad = compile(m).sym.check_names(names)
+        if bad:
+            raise SceneError(bad)

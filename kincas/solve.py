@@ -1,0 +1,335 @@
+"""Position solving (damped Newton, IPOPT fallback), sweeps with branch continuity.
+
+A pose is solved when its loop-closure residual is below `ACCEPT` times the mechanism's
+size; Newton aims at `TOL`. A pose that cannot be solved is data (status and NaN), never an
+exception. The guess picks the assembly branch; in a sweep each pose is predicted from the
+one before along the exact tangent dq/du = -g_q^-1 g_u, so the branch is kept.
+
+>>> import numpy as np, kincas
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+...            kincas.Link.bar("rocker", "D", "C", 3)],
+...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+>>> r = kincas.sweep(m, {"crank.angle": np.linspace(0, 2 * np.pi, 7)}, report=["C.x", "C.y"])
+>>> r.status[:2], bool(r.residual.max() < 1e-12)
+(['ok', 'ok'], True)
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Mapping
+
+import casadi as ca
+import numpy as np
+
+from .errors import ModelError
+from .model import Mechanism
+from .results import Pose, Sweep
+from .symbolic import Symbolic, default_report
+
+TOL = 1e-13  # Newton's target: residual relative to the mechanism's size
+ACCEPT = 1e-10  # a pose whose relative residual is above this is not solved
+MAX_STEP = 0.5  # largest Newton step per iteration: radians, or this times the size
+NO_ASSEMBLY = "no assembly"
+
+
+# --- compiled models, one per structure (parameter values stay numeric inputs) ---
+
+
+def _structure_key(m: Mechanism):
+    return (tuple(k for k, _ in m.parameters), m.ground, m.links, m.slides, m.inputs)
+
+
+_CACHE: dict = {}
+
+
+def compile(m: Mechanism) -> "Model":
+    """The compiled model of `m`'s structure (cached: changing parameters does not recompile)."""
+    key = _structure_key(m)
+    if key not in _CACHE:
+        if len(_CACHE) >= 64:
+            _CACHE.pop(next(iter(_CACHE)))
+        _CACHE[key] = Model(Symbolic(m))  # Symbolic never reads parameter values
+    return _CACHE[key]
+
+
+@dataclass
+class Solution:
+    q: np.ndarray
+    residual: float
+    iterations: int
+    ok: bool
+
+
+class Model:
+    """Numeric evaluation of a symbolic model: residuals, Newton, IPOPT, quantities."""
+
+    def __init__(self, sym: Symbolic):
+        self.sym = sym
+        self.nq, self.nu = sym.nq, sym.nu
+        m = sym.mech
+        locs = [sym.val(c) for lk in m.links for _, xy in lk.points for c in xy]
+        self.f_local = ca.Function("local", [sym.u, sym.p], [ca.vertcat(*locs)])
+        gxy = [c for g, _ in m.ground for c in sym.points[g]]
+        self.f_ground = ca.Function("ground", [sym.u, sym.p], [ca.vertcat(*gxy) if gxy else ca.SX(0, 1)])
+        self._nlp = None
+        self._qfun: dict[tuple, ca.Function] = {}
+
+    # --- residuals and Newton ---
+    def residual(self, q, u, p) -> np.ndarray:
+        return np.asarray(self.sym.f_res(q, u, p)).ravel()
+
+    def newton(self, q, u, p, L, max_iter=40) -> Solution:
+        """Damped Newton on g(q) = 0 with the exact Jacobian; the residual is relative to L."""
+        q = np.array(q, dtype=float)
+        g, J = (np.asarray(a) for a in self.sym.f_resjac(q, u, p))
+        g = g.ravel()
+        r = np.abs(g).max(initial=0.0) / L
+        scale = np.where(self.sym.is_length, MAX_STEP * L, MAX_STEP)
+        for it in range(max_iter):
+            if r <= TOL:
+                return Solution(q, r, it, True)
+            try:
+                dq = np.linalg.solve(J, -g)
+            except np.linalg.LinAlgError:
+                dq = np.linalg.lstsq(J, -g, rcond=None)[0]
+            if not np.all(np.isfinite(dq)):
+                break
+            dq /= max(1.0, np.abs(dq / scale).max())  # a trust region keeps steps on the branch
+            t = 1.0
+            while True:  # backtrack until the residual decreases
+                qn = q + t * dq
+                gn, Jn = (np.asarray(a) for a in self.sym.f_resjac(qn, u, p))
+                rn = np.abs(gn).max(initial=0.0) / L
+                if rn < (1 - 1e-4 * t) * r or rn <= TOL or t < 1 / 32:
+                    break
+                t /= 2
+            if not rn < r and rn > TOL:
+                break  # no progress: stagnation at a non-solution (or at rounding level)
+            q, g, J, r = qn, gn.ravel(), Jn, rn
+        return Solution(q, r, max_iter, r <= ACCEPT)
+
+    def tangent(self, q, u, p) -> np.ndarray:
+        """dq/du (nq x nu) at a solved pose, from the implicit function theorem."""
+        _, J, Ju = (np.asarray(a) for a in self.sym.f_tangent(q, u, p))
+        try:
+            return np.linalg.solve(J, -Ju)
+        except np.linalg.LinAlgError:
+            return np.linalg.lstsq(J, -Ju, rcond=None)[0]
+
+    def jac(self, q, u, p) -> np.ndarray:
+        return np.asarray(self.sym.f_resjac(q, u, p)[1])
+
+    def points(self, q, u, p) -> np.ndarray:
+        """World positions of the moving points, 2 x n."""
+        return np.asarray(self.sym.f_points(q, u, p))
+
+    # --- the first pose: from the user's guess ---
+    def initial_q(self, u, p, guess: dict[str, tuple[float, float]], L: float) -> np.ndarray:
+        """Unknowns placed from guessed points, walking the spanning tree from the ground.
+
+        A link hanging on point P takes the angle that points it at another of its points
+        whose position is guessed (or already known); with none, angle 0.
+        """
+        m, sym = self.sym.mech, self.sym
+        loc_flat = np.asarray(self.f_local(u, p)).ravel()
+        loc, k = {}, 0
+        for lk in m.links:
+            for pt, _ in lk.points:
+                loc[(lk.name, pt)] = loc_flat[k:k + 2]
+                k += 2
+        gflat = np.asarray(self.f_ground(u, p)).ravel()
+        gv = {g: gflat[2 * k:2 * k + 2] for k, (g, _) in enumerate(m.ground)}
+        known = dict(gv)
+        guessed = {k: np.asarray(v, float) for k, v in guess.items()}
+        q = np.zeros(self.nq)
+        index = {name: i for i, (name, _) in enumerate(sym.unknowns)}
+        angle_in = {i.target: u[k] for k, i in enumerate(m.inputs) if i.kind == "angle"}
+        centre = np.mean(list(gv.values()), axis=0) if gv else np.zeros(2)
+        for lname, at in m.structure.order:
+            pts = [pt for pt, _ in m.link(lname).points]
+            ref = [pt for pt in pts if pt in guessed or pt in known]
+            pos = {pt: guessed.get(pt, known.get(pt)) for pt in ref}
+            if at is not None:
+                anchor = guessed.get(at, known[at])
+                others = [pt for pt in ref if pt != at]
+                th = 0.0
+                if others:
+                    d = pos[others[0]] - anchor
+                    dl = loc[(lname, others[0])] - loc[(lname, at)]
+                    th = math.atan2(d[1], d[0]) - math.atan2(dl[1], dl[0])
+                th = float(angle_in.get(lname, th))
+                c, s = math.cos(th), math.sin(th)
+                R = np.array([[c, -s], [s, c]])
+                origin = known[at] - R @ loc[(lname, at)]
+            else:
+                th = 0.0
+                if len(ref) >= 2:
+                    d, dl = pos[ref[1]] - pos[ref[0]], loc[(lname, ref[1])] - loc[(lname, ref[0])]
+                    th = math.atan2(d[1], d[0]) - math.atan2(dl[1], dl[0])
+                th = float(angle_in.get(lname, th))
+                c, s = math.cos(th), math.sin(th)
+                R = np.array([[c, -s], [s, c]])
+                origin = (pos[ref[0]] - R @ loc[(lname, ref[0])]) if ref else centre
+                q[index[f"{lname}.x"]], q[index[f"{lname}.y"]] = origin
+            if f"{lname}.angle" in index:
+                q[index[f"{lname}.angle"]] = th
+            for pt in pts:
+                known.setdefault(pt, origin + R @ loc[(lname, pt)])
+        return q
+
+    # --- IPOPT: the assembly nearest to target positions ---
+    def nearest_assembly(self, q0, u, p, targets: dict[str, np.ndarray], L) -> Solution:
+        """min sum |P - target|^2 subject to g = 0, by IPOPT (scaled by the size L)."""
+        sym, names = self.sym, list(self.sym.mech.moving_points)
+        if self._nlp is None:
+            x = ca.SX.sym("x", self.nq)
+            npt = len(names)
+            T, W = ca.SX.sym("T", 2, npt), ca.SX.sym("W", npt)
+            x0, Ls = ca.SX.sym("x0", self.nq), ca.SX.sym("L")
+            qscale = ca.if_else(ca.DM(sym.is_length.astype(float)), Ls, 1)
+            q = x * qscale
+            subst = lambda e: ca.substitute(e, sym.q, q)
+            P = subst(sym._point_matrix())
+            obj = ca.sum1(ca.sum2((P - T) ** 2) .T * W) / Ls ** 2 + 1e-6 * ca.sumsqr(x - x0)
+            par = ca.vertcat(sym.u, sym.p, ca.vec(T), W, x0, Ls)
+            nlp = {"x": x, "p": par, "f": obj, "g": subst(sym.g) / Ls}
+            opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
+                    "ipopt.max_iter": 200, "ipopt.tol": 1e-12, "error_on_fail": False}
+            self._nlp = (ca.nlpsol("assemble", "ipopt", nlp, opts), qscale)
+        solver, qscale = self._nlp
+        T = np.zeros((2, len(names)))
+        W = np.zeros(len(names))
+        for k, n in enumerate(names):
+            if n in targets:
+                T[:, k], W[k] = targets[n], 1.0
+        qs = np.where(sym.is_length, L, 1.0)
+        par = np.concatenate([np.ravel(u), np.ravel(p), T.ravel(order="F"), W, q0 / qs, [L]])
+        out = solver(x0=q0 / qs, p=par, lbg=0, ubg=0)
+        q = np.asarray(out["x"]).ravel() * qs
+        return self.newton(q, u, p, L)  # polish, and judge by the residual alone
+
+    # --- quantities over many poses ---
+    def quantity_function(self, names: tuple[str, ...]) -> ca.Function:
+        if names not in self._qfun:
+            self._qfun[names] = self.sym.quantity_function(list(names))
+        return self._qfun[names]
+
+    def quantities(self, names, Q, U, P, Ud, Udd) -> np.ndarray:
+        """Quantities (len(names) x N) at N solved poses, in one vectorised call."""
+        n = Q.shape[0]
+        if n == 0 or not names:
+            return np.zeros((len(names), n))
+        f = self.quantity_function(tuple(names)).map(n)
+        rep = lambda a: np.repeat(np.reshape(a, (-1, 1)), n, axis=1)
+        return np.asarray(f(Q.T, U.T, rep(P), Ud.T, Udd.T))
+
+
+# --- sweeps ---
+
+
+def _input_table(m: Mechanism, inputs, what: str, default: float | None) -> tuple[np.ndarray, bool]:
+    """(N x nu) array of one value per input and pose from a mapping key -> scalar or array."""
+    keys = [i.key for i in m.inputs]
+    if inputs is None:
+        if default is None:
+            raise ModelError(f"{what}: give a value for each of {keys}")
+        inputs = {}
+    elif not isinstance(inputs, Mapping):
+        if len(keys) != 1:
+            raise ModelError(f"{what}: the mechanism has inputs {keys}; give a mapping")
+        inputs = {keys[0]: inputs}
+    problems = [f"{what}: {k!r} is not an input (inputs: {keys})" for k in inputs if k not in keys]
+    if default is None:
+        problems += [f"{what}: no value for input {k!r}" for k in keys if k not in inputs]
+    if problems:
+        raise ModelError(problems)
+    cols = [np.atleast_1d(np.asarray(inputs.get(k, default), dtype=float)) for k in keys]
+    scalar = all(np.ndim(inputs.get(k, default)) == 0 for k in keys)
+    n = max([len(c) for c in cols], default=1)
+    if any(len(c) not in (1, n) for c in cols):
+        raise ModelError(f"{what}: inputs that sweep advance together, so their lengths must agree")
+    return np.stack([np.broadcast_to(c, (n,)) for c in cols], axis=1).reshape(n, len(keys)), scalar
+
+
+def sweep(m: Mechanism, inputs, *, rates=None, accelerations=None, report=None,
+          guess=None) -> Sweep:
+    """Solve the mechanism at every pose of `inputs` (input key -> array), keeping the branch.
+
+    `rates` and `accelerations` give each input's first and second time derivative (default 1
+    and 0). `report` lists the quantities wanted (default: points and link angles); only what
+    they need is computed. `guess` overrides the mechanism's guessed points.
+    """
+    model = compile(m)
+    report = list(default_report(m) if report is None else report)
+    model.quantity_function(tuple(report))  # unknown names fail here, before any solving
+    U, _ = _input_table(m, inputs, "inputs", None)
+    n = U.shape[0]
+    Ud = _input_table(m, rates, "rates", 1.0)[0] if rates is not None else np.ones_like(U)
+    Udd = (_input_table(m, accelerations, "accelerations", 0.0)[0]
+           if accelerations is not None else np.zeros_like(U))
+    Ud, Udd = np.broadcast_to(Ud, U.shape), np.broadcast_to(Udd, U.shape)
+    p = np.array([v for _, v in m.parameters], dtype=float)
+    L = m.size()
+    g = {k: (m.value(x), m.value(y)) for k, (x, y) in {**dict(m.guess), **dict(guess or {})}.items()}
+    Q = np.full((n, model.nq), np.nan)
+    res, its = np.full(n, np.nan), np.zeros(n, dtype=int)
+    status = [NO_ASSEMBLY] * n
+    last = None  # (q, u) of the last solved pose: every pose continues from it
+    for k in range(n):
+        u = U[k]
+        if last is None:
+            q0 = model.initial_q(u, p, g, L)
+            sol = model.newton(q0, u, p, L)
+            if not sol.ok:  # IPOPT: the assembly nearest the guessed points
+                sol = model.nearest_assembly(q0, u, p, {k2: np.array(v) for k2, v in g.items()}, L)
+        else:
+            sol = _continue(model, last[0], last[1], u, p, L, depth=8 if status[k - 1] == "ok" else 0)
+            if sol is None or not sol.ok:
+                sol = model.newton(last[0], u, p, L)
+            if not sol.ok:  # IPOPT: the assembly nearest the last solved pose
+                pts = model.points(last[0], last[1], p)
+                targets = {nm: pts[:, j] for j, nm in enumerate(m.moving_points)}
+                sol = model.nearest_assembly(last[0], u, p, targets, L)
+        res[k], its[k] = sol.residual, sol.iterations
+        if sol.ok:
+            Q[k], status[k], last = sol.q, "ok", (sol.q, u)
+    ok = np.array([s == "ok" for s in status])
+    values = np.full((len(report), n), np.nan)
+    values[:, ok] = model.quantities(report, Q[ok], U[ok], p, Ud[ok], Udd[ok])
+    keys = [i.key for i in m.inputs]
+    return Sweep(inputs={k: U[:, j].copy() for j, k in enumerate(keys)},
+                 rates={k: Ud[:, j].copy() for j, k in enumerate(keys)},
+                 accelerations={k: Udd[:, j].copy() for j, k in enumerate(keys)},
+                 status=status, flags=[None] * n,
+                 values={nm: values[i] for i, nm in enumerate(report)},
+                 q=Q, residual=res, iterations=its,
+                 unknowns=[nm for nm, _ in model.sym.unknowns], size=L)
+
+
+def solve(m: Mechanism, inputs, *, rates=None, accelerations=None, report=None, guess=None) -> Pose:
+    """Solve one pose (inputs: key -> value, or a value for a one-input mechanism)."""
+    return sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
+                 guess=guess).pose(0)
+
+
+def _continue(model: Model, q0, u0, u1, p, L, depth: int) -> Solution | None:
+    """Predict along the exact tangent, correct with Newton; halve the step when the
+    corrector fails or the sign of det(g_q) flips (the sign tells the assembly branch)."""
+    sol = model.newton(q0 + model.tangent(q0, u0, p) @ (u1 - u0), u1, p, L)
+    if sol.ok and (depth == 0 or _same_branch(model, q0, u0, sol.q, u1, p, L)):
+        return sol
+    if depth == 0:
+        return None
+    um = 0.5 * (u0 + u1)
+    mid = _continue(model, q0, u0, um, p, L, depth - 1)
+    return None if mid is None else _continue(model, mid.q, um, u1, p, L, depth - 1)
+
+
+def _same_branch(model: Model, q0, u0, q1, u1, p, L) -> bool:
+    # Columns scaled to O(1) so the determinant's size means the same at every scale.
+    s = np.where(model.sym.is_length, 1.0, 1.0 / L)
+    d0 = np.linalg.det(model.jac(q0, u0, p) * s)
+    d1 = np.linalg.det(model.jac(q1, u1, p) * s)
+    return np.sign(d0) == np.sign(d1) or min(abs(d0), abs(d1)) < 1e-8

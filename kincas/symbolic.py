@@ -1,0 +1,221 @@
+"""Loop-closure residuals and quantity expressions of a mechanism, as CasADi Functions.
+
+Unknowns q: the angle of every link that hangs on a point of what is already placed, and
+(x, y, angle) of a link that floats; a link driven by an angle input takes the input instead
+of an unknown. Inputs u: one per `Input` (a driven parameter is replaced by its input).
+Parameters p: every named parameter. The residual g(q, u, p) = 0 is square.
+
+Time derivatives come from the exact Jacobians. With z = (q, u):
+    g_q q' = -g_u u'                                   (velocities)
+    g_q q'' = -g_u u'' - d2g/dz2 [z', z']              (accelerations)
+and a quantity E(z) has E' = E_z z', E'' = E_z z'' + d2E/dz2 [z', z'].
+
+>>> from kincas.model import Mechanism, Link, Input
+>>> m = Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[Link.bar("crank", "A", "B", 1), Link.bar("coupler", "B", "C", 3.5),
+...            Link.bar("rocker", "D", "C", 3)], inputs=[Input.angle("crank")])
+>>> s = Symbolic(m)
+>>> s.nq, s.nu, [k for k, _ in s.unknowns]
+(2, 1, ['coupler.angle', 'rocker.angle'])
+"""
+from __future__ import annotations
+
+import re
+
+import casadi as ca
+import numpy as np
+
+from .errors import ModelError
+from .model import GROUND, Mechanism, as_param
+
+# --- quantity names ---
+
+_POINT_Q = {"x": (0, 0), "y": (1, 0), "vx": (0, 1), "vy": (1, 1), "ax": (0, 2), "ay": (1, 2)}
+_LINK_Q = {"angle": 0, "omega": 1, "alpha": 2}
+_SLIDE_Q = {"s": 0, "v": 1, "a": 2}
+_SENS = re.compile(r"^d\((?P<q>[^()]+)\)/d\((?P<p>[^()]+)\)$")
+
+
+def parse_quantity(name: str):
+    """('sens', Q, p) for `d(Q)/d(p)`, else (kind, object, attribute) for `OBJ.attr`."""
+    m = _SENS.match(name)
+    if m:
+        return ("sens", m["q"], m["p"])
+    obj, _, attr = name.rpartition(".")
+    return ("plain", obj, attr)
+
+
+def is_angular(name: str) -> bool:
+    """Whether a quantity is an angle or an angle's rate (converted to degrees at the edge)."""
+    kind, a, b = parse_quantity(name)
+    if kind == "sens":
+        return is_angular(a)
+    return b in _LINK_Q
+
+
+def default_report(m: Mechanism) -> list[str]:
+    """Positions of all moving points and angles of all links."""
+    return [f"{p}.{c}" for p in m.moving_points for c in "xy"] + [f"{lk.name}.angle" for lk in m.links]
+
+
+class Symbolic:
+    """The symbolic model of one mechanism structure; parameters stay symbolic."""
+
+    def __init__(self, mech: Mechanism):
+        self.mech = mech
+        self.pnames = [k for k, _ in mech.parameters]
+        self.ukeys = [i.key for i in mech.inputs]
+        self.np, self.nu = len(self.pnames), len(mech.inputs)
+        self.p = ca.SX.sym("p", self.np)
+        self.u = ca.SX.sym("u", self.nu)
+        driven = {i.target: self.u[k] for k, i in enumerate(mech.inputs) if i.kind == "parameter"}
+        self._pvar = {n: driven.get(n, self.p[k]) for k, n in enumerate(self.pnames)}
+        self._build()
+
+    # --- numbers to expressions ---
+    def val(self, v):
+        p = as_param(v)
+        return ca.SX(float(v)) if p is None else p.scale * self._pvar[p.name]
+
+    def _build(self):
+        m = self.mech
+        angle_in = {i.target: self.u[k] for k, i in enumerate(m.inputs) if i.kind == "angle"}
+        qs, self.unknowns = [], []  # unknowns: (name, "angle" | "length")
+        self.frames: dict[str, tuple] = {GROUND: (ca.SX(0), ca.SX(0), ca.SX(0))}
+        self.points = {g: (self.val(x), self.val(y)) for g, (x, y) in m.ground}
+        eqs = []
+
+        def new(name, kind):
+            qs.append(ca.SX.sym(name))
+            self.unknowns.append((name, kind))
+            return qs[-1]
+
+        for lname, at in m.structure.order:
+            lk = m.link(lname)
+            loc = {p: (self.val(x), self.val(y)) for p, (x, y) in lk.points}
+            th = angle_in[lname] if lname in angle_in else new(f"{lname}.angle", "angle")
+            c, s = ca.cos(th), ca.sin(th)
+            if at is None:  # floating: its origin is unknown too
+                ox, oy = new(f"{lname}.x", "length"), new(f"{lname}.y", "length")
+            else:  # hangs on point `at`: origin = P - R(th) p_local
+                (px, py), (lx, ly) = self.points[at], loc[at]
+                ox, oy = px - (c * lx - s * ly), py - (s * lx + c * ly)
+            self.frames[lname] = (ox, oy, th)
+            for p, (lx, ly) in loc.items():
+                w = (ox + c * lx - s * ly, oy + s * lx + c * ly)
+                if p == at:
+                    continue
+                if p in self.points:  # loop closure: both bodies put p at the same place
+                    eqs += [w[0] - self.points[p][0], w[1] - self.points[p][1]]
+                else:
+                    self.points[p] = w
+        self.slide_s = {}
+        for sl in m.slides:
+            ox, oy, th = self.frames[sl.along]
+            c, s = ca.cos(th), ca.sin(th)
+            tx, ty = (self.val(v) for v in sl.through)
+            a = th + self.val(sl.angle)
+            dx, dy = ca.cos(a), ca.sin(a)
+            ex = self.points[sl.point][0] - (ox + c * tx - s * ty)
+            ey = self.points[sl.point][1] - (oy + s * tx + c * ty)
+            eqs.append(dx * ey - dy * ex)  # distance of the point from the line
+            self.slide_s[sl.name] = dx * ex + dy * ey
+        for k, i in enumerate(m.inputs):
+            if i.kind == "slide":
+                eqs.append(self.slide_s[i.target] - self.u[k])
+        self.q = ca.vertcat(*qs) if qs else ca.SX(0, 1)
+        self.nq = len(qs)
+        self.g = ca.vertcat(*eqs) if eqs else ca.SX(0, 1)
+        if self.g.numel() != self.nq:  # guarded by the model's mobility check
+            raise ModelError(f"[inputs]: {self.nq} unknowns but {self.g.numel()} equations")
+        self.angles = {lk.name: self.frames[lk.name][2] for lk in m.links}
+        self.is_length = np.array([k == "length" for _, k in self.unknowns], dtype=bool)
+        self.Jq = ca.jacobian(self.g, self.q)
+        self.Ju = ca.jacobian(self.g, self.u)
+        args = [self.q, self.u, self.p]
+        self.f_res = ca.Function("residual", args, [self.g])
+        self.f_resjac = ca.Function("residual_jac", args, [self.g, self.Jq])
+        self.f_tangent = ca.Function("tangent", args, [self.g, self.Jq, self.Ju])
+        self.f_points = ca.Function("points", args, [self._point_matrix()])
+
+    def _point_matrix(self):
+        pts = [self.points[p] for p in self.mech.moving_points]
+        return ca.horzcat(*[ca.vertcat(x, y) for x, y in pts]) if pts else ca.SX(2, 0)
+
+    # --- quantities ---
+    def position_expr(self, obj: str, attr: str):
+        """The position-level expression behind a quantity and the derivative order wanted."""
+        if attr in _POINT_Q and obj in self.points:
+            comp, order = _POINT_Q[attr]
+            return self.points[obj][comp], order
+        if attr in _LINK_Q and obj in self.angles:
+            return self.angles[obj], _LINK_Q[attr]
+        if attr in _SLIDE_Q and obj in self.slide_s:
+            return self.slide_s[obj], _SLIDE_Q[attr]
+        return None, None
+
+    def check_names(self, names: list[str], where: str = "[output] report") -> list[str]:
+        """Problems with quantity names (unknown object or attribute)."""
+        out = []
+        for n in names:
+            kind, a, b = parse_quantity(n)
+            if kind == "sens":
+                out += self.check_names([a], where)
+                if b not in self.pnames:
+                    out.append(f"{where}: {n!r}: unknown parameter {b!r}")
+                elif b in {i.target for i in self.mech.inputs if i.kind == "parameter"}:
+                    out.append(f"{where}: {n!r}: {b!r} is driven by an input (use its rate instead)")
+            elif self.position_expr(a, b)[0] is None:
+                out.append(f"{where}: unknown quantity {n!r} (expected P.x, P.vx, P.ax, L.angle, "
+                           f"L.omega, L.alpha, S.s, S.v, S.a or d(Q)/d(p) with declared names)")
+        return out
+
+    def quantity_function(self, names: list[str]) -> ca.Function:
+        """f(q, u, p, u', u'') -> the named quantities (only what they need is built).
+
+        Sensitivities d(Q)/d(p) follow the implicit function theorem on the same Jacobian:
+        dq/dp = -g_q^-1 g_p, so dQ/dp = Q_q dq/dp + Q_p, with Q written in (q, u, p, u', u'')
+        (its q' and q'' substituted), so that the sensitivity of a velocity is exact too.
+        """
+        bad = self.check_names(names)
+        if bad:
+            raise ModelError(bad)
+        z = ca.vertcat(self.q, self.u)
+        ud, udd = ca.SX.sym("ud", self.nu), ca.SX.sym("udd", self.nu)
+        qd_s, qdd_s = ca.SX.sym("qd", self.nq), ca.SX.sym("qdd", self.nq)
+        zd, zdd = ca.vertcat(qd_s, ud), ca.vertcat(qdd_s, udd)
+        parsed = [parse_quantity(n) for n in names]
+        raw = [self._order_expr(*(parse_quantity(a)[1:] if k == "sens" else (a, b)), z, zd, zdd)
+               for k, a, b in parsed]
+        out = ca.vertcat(*raw) if raw else ca.SX(0, 1)
+        orders = self._needs(out, qd_s, qdd_s)
+        if orders >= 1:  # only build the linear solves that the report needs
+            qd = -ca.solve(self.Jq, ca.mtimes(self.Ju, ud))
+            qdd = ca.SX.zeros(self.nq)
+            if orders >= 2:
+                gam = ca.jtimes(ca.jtimes(self.g, z, zd), z, zd)
+                qdd = ca.substitute(-ca.solve(self.Jq, ca.mtimes(self.Ju, udd) + gam), qd_s, qd)
+            out = ca.substitute(ca.substitute(out, qdd_s, qdd), qd_s, qd)
+        rows = [out[i] for i in range(out.numel())]
+        sens = [(i, b) for i, (k, _, b) in enumerate(parsed) if k == "sens"]
+        if sens:
+            gp = ca.jacobian(self.g, self.p)
+            dq_dp = -ca.solve(self.Jq, gp)  # one factorisation serves every parameter
+            for i, b in sens:
+                j = self.pnames.index(b)
+                rows[i] = ca.jtimes(rows[i], self.q, dq_dp[:, j]) + ca.jacobian(rows[i], self.p[j])
+        out = ca.vertcat(*rows) if rows else ca.SX(0, 1)
+        return ca.Function("quantities", [self.q, self.u, self.p, ud, udd], [out])
+
+    def _order_expr(self, obj, attr, z, zd, zdd):
+        e, order = self.position_expr(obj, attr)
+        if order >= 1:
+            ed = ca.jtimes(e, z, zd)
+            e = ed if order == 1 else ca.jtimes(ed, z, zd) + ca.jtimes(e, z, zdd)
+        return e
+
+    @staticmethod
+    def _needs(expr, qd_s, qdd_s) -> int:
+        if ca.depends_on(expr, qdd_s):
+            return 2
+        return 1 if ca.depends_on(expr, qd_s) else 0
