@@ -351,14 +351,6 @@ def _check(m: Mechanism) -> list[str]:
             num(f"{where}: points.{p}", y)
         if len([p for p in names if p in gnames]) > 1:
             out.append(f"{where}: points: carries two ground points, so it cannot move")
-    if out:
-        return out  # the remaining checks need numbers and names that resolve
-    for lk in m.links:
-        loc = [(m.value(x), m.value(y)) for _, (x, y) in lk.points]
-        if lk.two_point and m.value(lk.points[1][1][0]) <= 0:
-            out.append(f"[links] {lk.name}: length must be positive")
-        elif all(math.dist(loc[0], b) == 0 for b in loc[1:]):
-            out.append(f"[links] {lk.name}: points: all its points coincide")
     moving = set(m.moving_points)
     snames: set[str] = set()
     for i, s in enumerate(m.slides):
@@ -392,6 +384,14 @@ def _check(m: Mechanism) -> list[str]:
             what = "is a ground point (fixed)" if p in gnames else "is not a point of any link"
             out.append(f"[guess] {p}: {what}")
         num(f"[guess] {p}", x), num(f"[guess] {p}", y)
+    if out:
+        return out  # the numeric checks below need every name to resolve
+    for lk in m.links:
+        loc = [(m.value(x), m.value(y)) for _, (x, y) in lk.points]
+        if lk.two_point and m.value(lk.points[1][1][0]) <= 0:
+            out.append(f"[links] {lk.name}: length must be positive")
+        elif all(math.dist(loc[0], b) == 0 for b in loc[1:]):
+            out.append(f"[links] {lk.name}: points: all its points coincide")
     return out
 
 

@@ -9,7 +9,7 @@ wrapped to (-pi, pi].
 ...           status=["ok", "no assembly"], flags=[None, None],
 ...           values={"C.x": np.array([1.5, np.nan])}, q=np.zeros((2, 1)),
 ...           residual=np.zeros(2), iterations=np.zeros(2, int), unknowns=["q"], size=1.0)
->>> s["C.x"][0], s.ok.tolist(), s.pose(1).status
+>>> float(s["C.x"][0]), s.ok.tolist(), s.pose(1).status
 (1.5, [True, False], 'no assembly')
 """
 from __future__ import annotations

@@ -19,8 +19,8 @@ in a scene is gathered into one `SceneError` naming the section and the field.
 ... C = [3.6, 2.9]
 ... ''')
 >>> out = sc.run()
->>> out.status, round(sc.user_values(out)["rocker.angle"][0], 4)
-(['ok'], 84.1708)
+>>> out.status, round(float(sc.user_values(out)["rocker.angle"][0]), 4)
+(['ok'], 109.7303)
 """
 from __future__ import annotations
 

@@ -192,7 +192,7 @@ class Model:
             q = x * qscale
             subst = lambda e: ca.substitute(e, sym.q, q)
             P = subst(sym._point_matrix())
-            obj = ca.sum1(ca.sum2((P - T) ** 2) .T * W) / Ls ** 2 + 1e-6 * ca.sumsqr(x - x0)
+            obj = ca.mtimes(ca.sum1((P - T) ** 2), W) / Ls ** 2 + 1e-6 * ca.sumsqr(x - x0)
             par = ca.vertcat(sym.u, sym.p, ca.vec(T), W, x0, Ls)
             nlp = {"x": x, "p": par, "f": obj, "g": subst(sym.g) / Ls}
             opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",

@@ -16,7 +16,7 @@ and a quantity E(z) has E' = E_z z', E'' = E_z z'' + d2E/dz2 [z', z'].
 ...            Link.bar("rocker", "D", "C", 3)], inputs=[Input.angle("crank")])
 >>> s = Symbolic(m)
 >>> s.nq, s.nu, [k for k, _ in s.unknowns]
-(2, 1, ['coupler.angle', 'rocker.angle'])
+(2, 1, ['rocker.angle', 'coupler.angle'])
 """
 from __future__ import annotations
 
