@@ -10,6 +10,7 @@ kincas 0.1.0
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import math
 import sys
@@ -19,6 +20,15 @@ from .errors import KincasError
 
 EXIT_OK, EXIT_SCENE, EXIT_UNSOLVED = 0, 2, 3
 
+# Further commands live in their own modules: each defines `cli_arguments(parser)` and
+# `cli_run(args) -> exit status`, and is imported only when it exists.
+COMMANDS = {
+    "range": ("kincas.singular", "range of motion of the input, its limits and singular positions"),
+    "modes": ("kincas.modes", "the distinct assembly modes at the scene's input, as [guess] blocks"),
+    "optimize": ("kincas.optimize", "optimise parameters as the scene's [optimize] section says"),
+    "tolerance": ("kincas.tolerance", "first-order and Monte-Carlo spread of outputs from parameter tolerances"),
+}
+
 
 def _parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="kincas", description="Kinematics of planar closed-chain mechanisms.")
@@ -27,6 +37,21 @@ def _parser() -> argparse.ArgumentParser:
     s = sub.add_parser("solve", help="solve a scene: positions, velocities, accelerations over its inputs")
     s.add_argument("scene", help="the scene file (TOML)")
     s.add_argument("--json", action="store_true", help="print the documented JSON object")
+    s.add_argument("--csv", metavar="OUT.csv", help="write a row per pose, a column per quantity")
+    s.add_argument("--plot", metavar="OUT.png", help="draw the mechanism with the paths of its points")
+    s.add_argument("--animate", metavar="OUT.gif", help="animate the sweep")
+    s.add_argument("--plot-quantities", metavar="OUT.png", help="plot the reported quantities against the input")
+    s.add_argument("--no-progress", action="store_true", help="no progress bar, even on a terminal")
+    for name, (module, text) in COMMANDS.items():
+        try:
+            mod = importlib.import_module(module)
+        except ModuleNotFoundError as e:
+            if e.name != module:
+                raise
+            continue
+        c = sub.add_parser(name, help=text)
+        mod.cli_arguments(c)
+        c.set_defaults(run=mod.cli_run)
     return ap
 
 
@@ -41,7 +66,7 @@ def main(argv: list[str] | None = None) -> int:
         ap.print_help()
         return EXIT_SCENE
     try:
-        return _solve(args)
+        return args.run(args) if hasattr(args, "run") else _solve(args)
     except BrokenPipeError:  # `kincas solve ... | head`: the reader left, nothing is wrong
         sys.stderr.close()
         return EXIT_OK
@@ -53,7 +78,7 @@ def main(argv: list[str] | None = None) -> int:
 def _solve(args) -> int:
     from .scene import load
     sc = load(args.scene)
-    sw = sc.run()
+    sw = sc.run(progress=progress_for(args))
     inputs, values = sc.user_inputs(sw), sc.user_values(sw)
     if args.json:
         doc = {"title": sc.study.title, "units": sc.study.units,
@@ -64,7 +89,21 @@ def _solve(args) -> int:
         sys.stdout.write("\n")
     else:
         _table(sc, sw, inputs, values)
+    if args.csv or args.plot or args.animate or args.plot_quantities:
+        from .outputs import write_outputs
+        write_outputs(sc, sw, args)
     return EXIT_OK if all(s == "ok" for s in sw.status) else EXIT_UNSOLVED
+
+
+def progress_for(args):
+    """A progress callback for long runs on a terminal; None when piped or with --json."""
+    if getattr(args, "json", False) or getattr(args, "no_progress", False) or not sys.stderr.isatty():
+        return None
+    try:
+        from .progress import Progress
+    except ModuleNotFoundError:
+        return None
+    return Progress(stream=sys.stderr)
 
 
 def _list(v) -> list:

@@ -254,12 +254,13 @@ def _input_table(m: Mechanism, inputs, what: str, default: float | None) -> tupl
 
 
 def sweep(m: Mechanism, inputs, *, rates=None, accelerations=None, report=None,
-          guess=None) -> Sweep:
+          guess=None, progress=None) -> Sweep:
     """Solve the mechanism at every pose of `inputs` (input key -> array), keeping the branch.
 
     `rates` and `accelerations` give each input's first and second time derivative (default 1
     and 0). `report` lists the quantities wanted (default: points and link angles); only what
-    they need is computed. `guess` overrides the mechanism's guessed points.
+    they need is computed. `guess` overrides the mechanism's guessed points. `progress`, if
+    given, is called as progress(done, total) while solving.
     """
     model = compile(m)
     report = list(default_report(m) if report is None else report)
@@ -279,6 +280,8 @@ def sweep(m: Mechanism, inputs, *, rates=None, accelerations=None, report=None,
     last = None  # (q, u) of the last solved pose: every pose continues from it
     for k in range(n):
         u = U[k]
+        if progress is not None and k % 256 == 0:
+            progress(k, n)
         if last is None:
             q0 = model.initial_q(u, p, g, L)
             sol = model.newton(q0, u, p, L)
@@ -295,6 +298,8 @@ def sweep(m: Mechanism, inputs, *, rates=None, accelerations=None, report=None,
         res[k], its[k] = sol.residual, sol.iterations
         if sol.ok:
             Q[k], status[k], last = sol.q, "ok", (sol.q, u)
+    if progress is not None:
+        progress(n, n)
     ok = np.array([s == "ok" for s in status])
     values = np.full((len(report), n), np.nan)
     values[:, ok] = model.quantities(report, Q[ok], U[ok], p, Ud[ok], Udd[ok])
