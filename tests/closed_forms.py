@@ -208,6 +208,17 @@ class Solution:
             self.points.setdefault(name, origin + rot(angle, xy))
         return angle
 
+    def slider_dyad(self, rod: str, slide: str, side: int):
+        """RRP dyad: put the point of a ground slide at the rod's length from the rod's other
+        point (already placed), on the side'th intersection (+1: larger s); place the rod."""
+        spec = slide_spec(self.scene, slide)
+        assert spec["along"] == "ground"
+        p = spec["point"]
+        (q,) = [x for x in local_points(self.scene, rod) if x != p]
+        _, self.points[p] = line_circle(spec["through"], spec["direction"], self.points[q],
+                                        link_length(self.scene, rod, q, p), side)
+        self.place(rod, q, p)
+
     def frame(self, body: str):
         if body == "ground":
             return np.zeros(self.n), np.zeros((self.n, 2))
@@ -287,12 +298,7 @@ def fairbairn_poses(scene, u, sides):
     ad = sol.points[d] - sol.points[pivot]
     angle = np.arctan2(ad[:, 1], ad[:, 0]) - math.atan2(slot["direction"][1], slot["direction"][0])
     sol.place("lever", pivot, None, angle=angle + (0 if lever_side > 0 else math.pi))
-    e, f = scene["links"]["rod"]["points"]
-    guide = slide_spec(scene, "guide")
-    assert guide["point"] == f and guide["along"] == "ground"
-    _, sol.points[f] = line_circle(guide["through"], guide["direction"], sol.points[e],
-                                   link_length(scene, "rod", e, f), rod_side)
-    sol.place("rod", e, f)
+    sol.slider_dyad("rod", "guide", rod_side)
     return sol
 
 
@@ -308,16 +314,16 @@ def slider_crank_poses(scene, u, sides):
     kind, name = input_kind(scene)
     u = np.asarray(u, dtype=float)
     sol = Solution(scene, len(u))
-    r, rod = link_length(scene, "crank", o, a), link_length(scene, "rod", a, b)
     if kind == "angle":
         sol.place("crank", o, a, angle=_angle_input(scene, u, "crank"))
-        _, sol.points[b] = line_circle(spec["through"], spec["direction"], sol.points[a], rod, side)
+        sol.slider_dyad("rod", slide, side)
     else:
         assert (kind, name) == ("slide", slide)
         sol.points[b] = spec["through"] + u[:, None] * spec["direction"]
-        sol.points[a] = circle_circle(sol.points[o], r, sol.points[b], rod, side)
+        sol.points[a] = circle_circle(sol.points[o], link_length(scene, "crank", o, a),
+                                      sol.points[b], link_length(scene, "rod", a, b), side)
         sol.place("crank", o, a)
-    sol.place("rod", a, b)
+        sol.place("rod", a, b)
     return sol
 
 
@@ -345,11 +351,8 @@ def vtwin_poses(scene, u, sides):
     o, c = scene["links"]["crank"]["points"]
     sol.place("crank", o, c, angle=theta)
     for spec, side in zip(scene["slides"], sides, strict=True):
-        sl = slide_spec(scene, spec["name"])
-        rod = next(k for k, v in scene["links"].items() if v["points"] == [c, sl["point"]])
-        _, sol.points[sl["point"]] = line_circle(sl["through"], sl["direction"], sol.points[c],
-                                                 link_length(scene, rod, c, sl["point"]), side)
-        sol.place(rod, c, sl["point"])
+        rod = next(k for k, v in scene["links"].items() if v["points"] == [c, spec["point"]])
+        sol.slider_dyad(rod, spec["name"], side)
     return sol
 
 
@@ -370,11 +373,8 @@ def sixbar_poses(scene, u, sides):
     sol.place("coupler", a, b)
     sol.place("rocker", o4, b)
     (slide,) = [s["name"] for s in scene["slides"]]
-    sl = slide_spec(scene, slide)
-    assert sl["point"] == d and sl["along"] == "ground"
-    _, sol.points[d] = line_circle(sl["through"], sl["direction"], sol.points[c],
-                                   link_length(scene, "rod", c, d), rod_side)
-    sol.place("rod", c, d)
+    assert slide_spec(scene, slide)["point"] == d
+    sol.slider_dyad("rod", slide, rod_side)
     return sol
 
 
