@@ -49,6 +49,8 @@ def _parser() -> argparse.ArgumentParser:
             if e.name != module:
                 raise
             continue
+        if not hasattr(mod, "cli_run"):
+            continue
         c = sub.add_parser(name, help=text)
         mod.cli_arguments(c)
         c.set_defaults(run=mod.cli_run)
@@ -84,7 +86,8 @@ def _solve(args) -> int:
         doc = {"title": sc.study.title, "units": sc.study.units,
                "inputs": {k: _list(v) for k, v in inputs.items()},
                "status": sw.status, "flags": sw.flags,
-               "values": {k: _list(v) for k, v in values.items()}}
+               "values": {k: _list(v) for k, v in values.items()},
+               "events": [_user_event(sc, e) for e in sw.events]}
         json.dump(doc, sys.stdout, allow_nan=False)
         sys.stdout.write("\n")
     else:
@@ -104,6 +107,13 @@ def progress_for(args):
     except ModuleNotFoundError:
         return None
     return Progress(stream=sys.stderr)
+
+
+def _user_event(sc, e: dict) -> dict:
+    """A singular position or a resumption, with its input values in the scene's units."""
+    deg = sc.study.deg
+    ins = {k: (math.degrees(v) if deg and k.endswith(".angle") else v) for k, v in e["inputs"].items()}
+    return {**e, "inputs": ins}
 
 
 def _list(v) -> list:
@@ -135,5 +145,10 @@ def _table(sc, sw, inputs, values):
         cells = [("-" if not math.isfinite(d[i]) else f"{d[i]:.6g}").rjust(w) for d, w in zip(data, width)]
         flag = f" ({sw.flags[i]})" if sw.flags[i] else ""
         print("  ".join(cells) + f"  {sw.status[i]}{flag}")
+    for e in sw.events:
+        e = _user_event(sc, e)
+        at = ", ".join(f"{k} = {v:.12g}" for k, v in e["inputs"].items())
+        what = f"resumed on the {e['branch']} branch" if e["kind"] == "resume" else e["kind"]
+        print(f"pose {e['pose']}: {what} at {at}")
     bad = sum(s != "ok" for s in sw.status)
     print(f"{len(sw)} poses, {len(sw) - bad} solved" + (f", {bad} not solved" if bad else ""))

@@ -58,6 +58,7 @@ class Sweep:
     iterations: np.ndarray
     unknowns: list[str]
     size: float
+    events: list[dict] = field(default_factory=list)  # singular positions met, resumptions
     info: dict = field(default_factory=dict)
 
     def __post_init__(self):

@@ -50,6 +50,7 @@ class Study:
     accelerations: dict[str, float]
     report: list[str]
     sensitivity: list[str] = field(default_factory=list)
+    written: dict[str, np.ndarray] = field(default_factory=dict)  # inputs as the file gives them
     raw: dict = field(default_factory=dict, repr=False)  # the parsed TOML, for extensions
 
     @property
@@ -73,8 +74,13 @@ class Scene:
                      report=self.quantities, **kw)
 
     def user_inputs(self, s: Sweep) -> dict[str, np.ndarray]:
-        """Input values in the scene's units."""
-        return {k: self._to_user(k, v, angle=k.endswith(".angle")) for k, v in s.inputs.items()}
+        """Input values in the scene's units: the numbers as written, not through radians."""
+        out = {}
+        for k, v in s.inputs.items():
+            user, w = self._to_user(k, v, angle=k.endswith(".angle")), self.study.written.get(k)
+            same = w is not None and w.shape == user.shape and np.allclose(user, w, rtol=1e-12, atol=0)
+            out[k] = w if same else user
+        return out
 
     def user_values(self, s: Sweep) -> dict[str, np.ndarray]:
         """Reported quantities in the scene's units (degrees where the scene says so)."""
@@ -190,7 +196,7 @@ class _Reader:
             self.err("[ground] ground: the name `ground` means the fixed frame")
         links = [self.link(k, v) for k, v in self.table("links").items()]
         slides = [self.slide(i, s) for i, s in enumerate(self.array("slides"))]
-        inputs, values, rates, accs = self.inputs()
+        inputs, values, rates, accs, written = self.inputs()
         guess = {k: self.xy(f"[guess] {k}", v) for k, v in self.table("guess").items()}
         report, sens = self.output()
         if self.problems:
@@ -206,7 +212,7 @@ class _Reader:
         self.check_quantities(m, report + sens)
         study = Study(title=title if isinstance(title, str) else "", units=self.units,
                       inputs=values, rates=rates, accelerations=accs, report=report,
-                      sensitivity=sens, raw=doc)
+                      sensitivity=sens, written=written, raw=doc)
         return Scene(m, study)
 
     def array(self, name) -> list[dict]:
@@ -257,7 +263,7 @@ class _Reader:
                      through=through, angle=angle, name=str(t.get("name", "")))
 
     def inputs(self):
-        inputs, values, rates, accs, steps = [], {}, {}, {}, set()
+        inputs, values, rates, accs, steps, written = [], {}, {}, {}, set(), {}
         for i, t in enumerate(self.array("inputs")):
             where = f"[[inputs]] {i + 1}"
             self.fields(where, t, {"angle", "parameter", "slide", "value", "sweep", "rate",
@@ -276,8 +282,9 @@ class _Reader:
             if ("value" in t) == ("sweep" in t):
                 self.err(f"{where}: give either `value` or `sweep`")
                 continue
+            k = np.pi / 180 if ang and self.deg else 1.0
             if "value" in t:
-                vals = np.array([self.value(f"{where}: value", t["value"], ang)])
+                vals = np.array([self.value(f"{where}: value", t["value"])])
             else:
                 sw = t["sweep"]
                 if not isinstance(sw, dict) or not {"from", "to", "steps"} <= set(sw):
@@ -288,18 +295,19 @@ class _Reader:
                 if isinstance(n, bool) or not isinstance(n, int) or n < 1:
                     self.err(f"{where}: sweep.steps: expected a whole number >= 1, got {n!r}")
                     continue
-                a = self.value(f"{where}: sweep.from", sw["from"], ang)
-                b = self.value(f"{where}: sweep.to", sw["to"], ang)
+                a = self.value(f"{where}: sweep.from", sw["from"])
+                b = self.value(f"{where}: sweep.to", sw["to"])
                 vals = np.linspace(a, b, n)
                 steps.add(n)
             inputs.append(inp)
-            values[inp.key] = vals
+            written[inp.key] = vals
+            values[inp.key] = vals * k
             rates[inp.key] = self.value(f"{where}: rate", t.get("rate", 1.0), ang)
             accs[inp.key] = self.value(f"{where}: acceleration", t.get("acceleration", 0.0), ang)
         if len(steps) > 1:
             self.err(f"[[inputs]] sweep.steps: inputs that sweep advance together, but their "
                      f"steps differ ({sorted(steps)})")
-        return inputs, values, rates, accs
+        return inputs, values, rates, accs, written
 
     def output(self):
         out = self.table("output")

@@ -60,6 +60,7 @@ class Solution:
     residual: float
     iterations: int
     ok: bool
+    J: np.ndarray | None = None  # g_q at q
 
 
 class Model:
@@ -89,7 +90,7 @@ class Model:
         scale = np.where(self.sym.is_length, MAX_STEP * L, MAX_STEP)
         for it in range(max_iter):
             if r <= TOL:
-                return Solution(q, r, it, True)
+                return Solution(q, r, it, True, J)
             try:
                 dq = np.linalg.solve(J, -g)
             except np.linalg.LinAlgError:
@@ -108,7 +109,7 @@ class Model:
             if not rn < r and rn > TOL:
                 break  # no progress: stagnation at a non-solution (or at rounding level)
             q, g, J, r = qn, gn.ravel(), Jn, rn
-        return Solution(q, r, max_iter, r <= ACCEPT)
+        return Solution(q, r, max_iter, r <= ACCEPT, J)
 
     def tangent(self, q, u, p) -> np.ndarray:
         """dq/du (nq x nu) at a solved pose, from the implicit function theorem."""
@@ -229,11 +230,11 @@ class Model:
 # --- sweeps ---
 
 
-def _input_table(m: Mechanism, inputs, what: str, default: float | None) -> tuple[np.ndarray, bool]:
+def _input_table(m: Mechanism, inputs, what: str, default: float | None) -> np.ndarray:
     """(N x nu) array of one value per input and pose from a mapping key -> scalar or array."""
     keys = [i.key for i in m.inputs]
     if inputs is None:
-        if default is None:
+        if default is None and keys:
             raise ModelError(f"{what}: give a value for each of {keys}")
         inputs = {}
     elif not isinstance(inputs, Mapping):
@@ -245,15 +246,16 @@ def _input_table(m: Mechanism, inputs, what: str, default: float | None) -> tupl
         problems += [f"{what}: no value for input {k!r}" for k in keys if k not in inputs]
     if problems:
         raise ModelError(problems)
+    if not keys:  # a structure (no freedom): one pose
+        return np.zeros((1, 0))
     cols = [np.atleast_1d(np.asarray(inputs.get(k, default), dtype=float)) for k in keys]
-    scalar = all(np.ndim(inputs.get(k, default)) == 0 for k in keys)
-    n = max([len(c) for c in cols], default=1)
+    n = max(len(c) for c in cols)
     if any(len(c) not in (1, n) for c in cols):
         raise ModelError(f"{what}: inputs that sweep advance together, so their lengths must agree")
-    return np.stack([np.broadcast_to(c, (n,)) for c in cols], axis=1).reshape(n, len(keys)), scalar
+    return np.stack([np.broadcast_to(c, (n,)) for c in cols], axis=1)
 
 
-def sweep(m: Mechanism, inputs, *, rates=None, accelerations=None, report=None,
+def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,
           guess=None, progress=None) -> Sweep:
     """Solve the mechanism at every pose of `inputs` (input key -> array), keeping the branch.
 
@@ -261,70 +263,107 @@ def sweep(m: Mechanism, inputs, *, rates=None, accelerations=None, report=None,
     and 0). `report` lists the quantities wanted (default: points and link angles); only what
     they need is computed. `guess` overrides the mechanism's guessed points. `progress`, if
     given, is called as progress(done, total) while solving.
+
+    Each solved pose gets a flag where it sits at or next to a singular position ("limit",
+    "change point", "singular"); `Sweep.events` lists those positions with their input values
+    located exactly, and where a sweep resumed after poses with no assembly, on which branch.
     """
     model = compile(m)
     report = list(default_report(m) if report is None else report)
     model.quantity_function(tuple(report))  # unknown names fail here, before any solving
-    U, _ = _input_table(m, inputs, "inputs", None)
+    U = _input_table(m, inputs, "inputs", None)
     n = U.shape[0]
-    Ud = _input_table(m, rates, "rates", 1.0)[0] if rates is not None else np.ones_like(U)
-    Udd = (_input_table(m, accelerations, "accelerations", 0.0)[0]
-           if accelerations is not None else np.zeros_like(U))
-    Ud, Udd = np.broadcast_to(Ud, U.shape), np.broadcast_to(Udd, U.shape)
+    Ud = np.broadcast_to(_input_table(m, rates, "rates", 1.0), U.shape)
+    Udd = np.broadcast_to(_input_table(m, accelerations, "accelerations", 0.0), U.shape)
     p = np.array([v for _, v in m.parameters], dtype=float)
     L = m.size()
     g = {k: (m.value(x), m.value(y)) for k, (x, y) in {**dict(m.guess), **dict(guess or {})}.items()}
     Q = np.full((n, model.nq), np.nan)
     res, its = np.full(n, np.nan), np.zeros(n, dtype=int)
-    status = [NO_ASSEMBLY] * n
-    last = None  # (q, u) of the last solved pose: every pose continues from it
+    status, events = [NO_ASSEMBLY] * n, []
+    last = None  # (q, u, sign of det g_q) of the last solved pose: every pose continues from it
     for k in range(n):
         u = U[k]
         if progress is not None and k % 256 == 0:
             progress(k, n)
         if last is None:
-            q0 = model.initial_q(u, p, g, L)
-            sol = model.newton(q0, u, p, L)
-            if not sol.ok:  # IPOPT: the assembly nearest the guessed points
-                sol = model.nearest_assembly(q0, u, p, {k2: np.array(v) for k2, v in g.items()}, L)
+            sol = _first(model, u, p, L, g)
         else:
             sol = _continue(model, last[0], last[1], u, p, L, depth=8 if status[k - 1] == "ok" else 0)
-            if sol is None or not sol.ok:
-                sol = model.newton(last[0], u, p, L)
-            if not sol.ok:  # IPOPT: the assembly nearest the last solved pose
-                pts = model.points(last[0], last[1], p)
-                targets = {nm: pts[:, j] for j, nm in enumerate(m.moving_points)}
-                sol = model.nearest_assembly(last[0], u, p, targets, L)
+            if sol is None:
+                sol = _recover(model, m, last, u, p, L)
         res[k], its[k] = sol.residual, sol.iterations
-        if sol.ok:
-            Q[k], status[k], last = sol.q, "ok", (sol.q, u)
+        if not sol.ok:
+            continue
+        sign = _det_sign(model, sol, L)
+        if last is not None and status[k - 1] != "ok":  # back in range: say on which branch
+            events.append({"kind": "resume", "pose": int(k),
+                           "branch": "same" if sign == last[2] or 0 in (sign, last[2]) else "other"})
+        Q[k], status[k], last = sol.q, "ok", (sol.q, u, sign)
     if progress is not None:
         progress(n, n)
     ok = np.array([s == "ok" for s in status])
+    flags = [None] * n
+    events += _singular_events(model, m, U, Q, ok, p, L, flags)
     values = np.full((len(report), n), np.nan)
     values[:, ok] = model.quantities(report, Q[ok], U[ok], p, Ud[ok], Udd[ok])
     keys = [i.key for i in m.inputs]
+    events.sort(key=lambda e: e["pose"])
+    for e in events:
+        e.setdefault("inputs", {kk: float(U[e["pose"], j]) for j, kk in enumerate(keys)})
     return Sweep(inputs={k: U[:, j].copy() for j, k in enumerate(keys)},
                  rates={k: Ud[:, j].copy() for j, k in enumerate(keys)},
                  accelerations={k: Udd[:, j].copy() for j, k in enumerate(keys)},
-                 status=status, flags=[None] * n,
+                 status=status, flags=flags,
                  values={nm: values[i] for i, nm in enumerate(report)},
                  q=Q, residual=res, iterations=its,
-                 unknowns=[nm for nm, _ in model.sym.unknowns], size=L)
+                 unknowns=[nm for nm, _ in model.sym.unknowns], size=L, events=events)
 
 
-def solve(m: Mechanism, inputs, *, rates=None, accelerations=None, report=None, guess=None) -> Pose:
+def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,
+          guess=None) -> Pose:
     """Solve one pose (inputs: key -> value, or a value for a one-input mechanism)."""
     return sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
                  guess=guess).pose(0)
 
 
+# --- one pose: from the guess, from the previous pose, after a failure ---
+
+
+def _first(model: Model, u, p, L, guess) -> Solution:
+    q0 = model.initial_q(u, p, guess, L)
+    sol = model.newton(q0, u, p, L)
+    if not sol.ok:  # IPOPT: the assembly nearest the guessed points
+        sol = model.nearest_assembly(q0, u, p, {k: np.array(v) for k, v in guess.items()}, L)
+    return sol
+
+
+def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:
+    """Continuation failed: Newton straight from the last pose, then IPOPT (nearest assembly)."""
+    sol = model.newton(last[0], u, p, L)
+    if not sol.ok:
+        pts = model.points(last[0], last[1], p)
+        sol = model.nearest_assembly(last[0], u, p, {nm: pts[:, j] for j, nm in enumerate(m.moving_points)}, L)
+    return sol
+
+
+def _scaled_norm(model: Model, dq, L) -> float:
+    return float(np.abs(dq / np.where(model.sym.is_length, L, 1.0)).max(initial=0.0))
+
+
 def _continue(model: Model, q0, u0, u1, p, L, depth: int) -> Solution | None:
-    """Predict along the exact tangent, correct with Newton; halve the step when the
-    corrector fails or the sign of det(g_q) flips (the sign tells the assembly branch)."""
-    sol = model.newton(q0 + model.tangent(q0, u0, p) @ (u1 - u0), u1, p, L)
-    if sol.ok and (depth == 0 or _same_branch(model, q0, u0, sol.q, u1, p, L)):
+    """Predict along the exact tangent, correct with Newton. The step is halved when the
+    corrector fails or needs many iterations, lands far from the prediction, or the sign of
+    det(g_q) flips (the sign tells the assembly branch apart)."""
+    pred = q0 + model.tangent(q0, u0, p) @ (u1 - u0)
+    sol = model.newton(pred, u1, p, L)
+    if sol.ok and depth == 0:
         return sol
+    if sol.ok:
+        moved = _scaled_norm(model, pred - q0, L)
+        far = _scaled_norm(model, sol.q - pred, L) > max(0.05, 0.5 * moved)
+        if sol.iterations <= 8 and not far and _same_branch(model, q0, u0, sol, p, L):
+            return sol
     if depth == 0:
         return None
     um = 0.5 * (u0 + u1)
@@ -332,9 +371,60 @@ def _continue(model: Model, q0, u0, u1, p, L, depth: int) -> Solution | None:
     return None if mid is None else _continue(model, mid.q, um, u1, p, L, depth - 1)
 
 
-def _same_branch(model: Model, q0, u0, q1, u1, p, L) -> bool:
+def _scaled_det(model: Model, J, L) -> float:
     # Columns scaled to O(1) so the determinant's size means the same at every scale.
-    s = np.where(model.sym.is_length, 1.0, 1.0 / L)
-    d0 = np.linalg.det(model.jac(q0, u0, p) * s)
-    d1 = np.linalg.det(model.jac(q1, u1, p) * s)
+    return float(np.linalg.det(J * np.where(model.sym.is_length, 1.0, 1.0 / L))) if J.size else 1.0
+
+
+def _det_sign(model: Model, sol: Solution, L) -> int:
+    d = _scaled_det(model, sol.J, L)
+    return 0 if abs(d) < 1e-8 else int(np.sign(d))
+
+
+def _same_branch(model: Model, q0, u0, sol: Solution, p, L) -> bool:
+    d0 = _scaled_det(model, model.jac(q0, u0, p), L)
+    d1 = _scaled_det(model, sol.J, L)
     return np.sign(d0) == np.sign(d1) or min(abs(d0), abs(d1)) < 1e-8
+
+
+# --- singular positions met by a sweep ---
+
+
+def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags) -> list[dict]:
+    """Flag solved poses at or next to a singular position and locate it exactly.
+
+    A limit lies between a solved pose and a neighbour with no assembly; a sign change of
+    det(g_q) between two solved neighbours means the sweep crossed a singular position
+    (a change point, or a limit met exactly); a pose whose scaled g_q is numerically
+    singular is flagged where it stands.
+    """
+    from .singular import classify, locate_singular, scaled_jacobians
+    n, events = len(ok), []
+    if model.nq == 0 or m.inputs == ():
+        return events
+    idx = np.flatnonzero(ok)
+    jac = {k: scaled_jacobians(model, Q[k], U[k], p, L) for k in idx}
+    dets = {k: np.linalg.det(jac[k][0]) for k in idx}
+    for k in idx:
+        flags[k] = classify(*jac[k])
+    for k in idx:
+        for nb in (k - 1, k + 1):
+            if not 0 <= nb < n:
+                continue
+            crossing = ok[nb] and nb == k + 1 and np.sign(dets[k]) != np.sign(dets[nb])
+            if ok[nb] and not crossing:
+                continue
+            if np.allclose(U[nb], U[k]):
+                continue
+            found = locate_singular(model, Q[k], U[k], p, L, direction=U[nb] - U[k])
+            if found is None:
+                continue
+            s = found[2]
+            if not (-1e-9 <= s <= 1 + 1e-9):
+                continue  # the singular position found is not between these two poses
+            kind = classify(*scaled_jacobians(model, found[0], found[1], p, L), tol=1e-6) or "singular"
+            at = k if (not ok[nb] or s <= 0.5) else nb
+            flags[at] = flags[at] or kind
+            events.append({"kind": kind, "pose": int(at),
+                           "inputs": {i.key: float(v) for i, v in zip(m.inputs, found[1])}})
+    return events

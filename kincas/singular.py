@@ -1,0 +1,296 @@
+"""Singular positions and the range of motion of an input.
+
+With J = g_q (unknowns) and G = [g_q g_u] (unknowns and the swept input), both scaled so
+that their entries are O(1) at every size of mechanism:
+- J regular: an ordinary pose (the branch goes on, velocities are finite);
+- J singular, G of full rank: a **limit** (turning point: the input cannot go further; a
+  rocker's dead centre, the end of an actuator's reach);
+- J and G both rank-deficient: a **change point** (branches cross: a folding parallelogram);
+- anything else singular (several inputs): **singular**.
+A limit is located exactly by Newton on the extended system
+    g(q, u) = 0,   g_q(q, u) v = 0,   v0 . v = 1
+in (q, u, v), whose Jacobian (second derivatives of g, exact from CasADi) is regular at a
+simple turning point. The range of motion follows the branch by pseudo-arclength
+continuation (through the turns that natural-parameter continuation cannot pass) until the
+input turns back (a limit) or an angle input has made a full turn.
+
+>>> import math, kincas
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 1.9),
+...            kincas.Link.bar("rocker", "D", "C", 3)],
+...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.2, 2.5)})
+>>> r = input_range(m, {"crank.angle": 0.5})
+>>> [k for k, _ in r.limits], round(math.degrees(r.high), 9)  # |BD| = 1.9 + 3 there
+(['limit', 'limit'], 151.193259668)
+>>> round(math.degrees(math.acos((1 + 16 - 4.9 ** 2) / 8)), 9)
+151.193259668
+"""
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+from .model import Mechanism
+
+FLAG_SIGMA = 1e-7  # relative smallest singular value at which a pose *is* singular
+
+
+# --- scaled Jacobians and classification ---
+
+
+def _scales(model, L):
+    sym = model.sym
+    cq = np.where(sym.is_length, 1.0, 1.0 / L)
+    cu = np.array([1.0 / L if i.kind == "angle" else 1.0 for i in sym.mech.inputs])
+    return cq, cu
+
+
+def scaled_jacobians(model, q, u, p, L):
+    """(J, Gu): g_q and g_u with columns scaled so a size-L mechanism gives O(1) entries."""
+    _, J, Ju = (np.asarray(a) for a in model.sym.f_tangent(q, u, p))
+    cq, cu = _scales(model, L)
+    return J * cq, Ju * cu
+
+
+def classify(J: np.ndarray, Gu: np.ndarray, tol: float = FLAG_SIGMA) -> str | None:
+    """None, "limit", "change point" or "singular" from the scaled Jacobians at a pose."""
+    if J.size == 0:
+        return None
+    s = np.linalg.svd(J, compute_uv=False)
+    if s[-1] > tol * max(s[0], 1.0):
+        return None
+    G = np.hstack([J, Gu])
+    sg = np.linalg.svd(G, compute_uv=False)
+    if sg[J.shape[0] - 1] <= tol * max(sg[0], 1.0) * 1e3:
+        return "change point"
+    return "limit" if Gu.shape[1] == 1 else "singular"
+
+
+def sigma_min(J: np.ndarray) -> float:
+    return float(np.linalg.svd(J, compute_uv=False)[-1]) if J.size else np.inf
+
+
+# --- locating a limit exactly ---
+
+
+def _extended(model):
+    """F(q, u, p, v, v0) = [g; g_q v; v0.v - 1] and its Jacobian in (q, u, v)."""
+    if getattr(model, "_extended", None) is None:
+        sym = model.sym
+        v, v0 = ca.SX.sym("v", sym.nq), ca.SX.sym("v0", sym.nq)
+        F = ca.vertcat(sym.g, ca.mtimes(sym.Jq, v), ca.dot(v0, v) - 1)
+        z = ca.vertcat(sym.q, sym.u, v)
+        model._extended = ca.Function("extended", [sym.q, sym.u, sym.p, v, v0],
+                                      [F, ca.jacobian(F, z)])
+    return model._extended
+
+
+def locate_singular(model, q, u, p, L, direction, max_iter: int = 40):
+    """Newton on the extended system from a pose near a singular position, moving the
+    inputs along u + s * direction. Returns (q*, u*, s*) there, or None."""
+    nq = model.nq
+    if nq == 0:
+        return None
+    f = _extended(model)
+    J, _ = scaled_jacobians(model, q, u, p, L)
+    cq, _ = _scales(model, L)
+    v = np.linalg.svd(J)[2][-1] * cq  # the null direction, in unscaled unknowns
+    v0 = v / (v @ v)
+    d = np.asarray(direction, float)
+    q, u0, s = np.array(q, float), np.array(u, float), 0.0
+    for _ in range(max_iter):
+        F, JF = (np.asarray(a) for a in f(q, u0 + s * d, p, v, v0))
+        F = F.ravel()
+        r = np.abs(F[:2 * nq]).max() / L + abs(F[-1])
+        if r < 1e-14:
+            break
+        A = np.hstack([JF[:, :nq], JF[:, nq:-nq] @ d[:, None], JF[:, -nq:]])
+        try:
+            step = np.linalg.solve(A, -F)
+        except np.linalg.LinAlgError:
+            return None
+        if not np.all(np.isfinite(step)):
+            return None
+        q, s, v = q + step[:nq], s + step[nq], v + step[nq + 1:]
+    F = np.asarray(f(q, u0 + s * d, p, v, v0)[0]).ravel()
+    if np.abs(F[:2 * nq]).max() / L > 1e-11:
+        return None
+    return q, u0 + s * d, s
+
+
+# --- range of motion by pseudo-arclength continuation ---
+
+
+@dataclass
+class Range:
+    """The interval an input can sweep on the starting pose's branch."""
+
+    key: str
+    low: float
+    high: float
+    full_turn: bool
+    limits: list[tuple[str, float]] = field(default_factory=list)  # (kind, input value)
+    start: float = 0.0
+
+
+def input_range(m: Mechanism, inputs: dict, key: str | None = None, *, max_steps: int = 20000) -> Range:
+    """Range of input `key` (default: the first) on the branch of the pose at `inputs`,
+    the other inputs held at their values. Limits are located to rounding precision."""
+    from .solve import compile, solve
+    model = compile(m)
+    keys = [i.key for i in m.inputs]
+    key = key or keys[0]
+    i = keys.index(key)
+    pose = solve(m, inputs, report=[])
+    if not pose.ok:
+        raise ValueError(f"the mechanism does not assemble at {inputs}")
+    p = np.array([v for _, v in m.parameters], float)
+    L = m.size()
+    u0 = np.array([pose.inputs[k] for k in keys])
+    q0 = _pose_q(model, m, u0, p, L)
+    is_angle = m.inputs[i].kind == "angle"
+    cq, cu = _scales(model, L)
+    # unknowns / scale are O(1): angles as they are, lengths over the size
+    scale = np.concatenate([cq, [cu[i]]]) * L
+    ends, limits = {}, []
+    for direction in (+1, -1):
+        end, lim = _follow(model, q0, u0, p, L, i, direction, scale, is_angle, max_steps)
+        ends[direction] = end
+        if lim is not None:
+            limits.append(("limit", lim))
+    full = is_angle and (ends[+1] - u0[i] >= 2 * np.pi or u0[i] - ends[-1] >= 2 * np.pi)
+    if full:
+        return Range(key, u0[i] - np.pi, u0[i] + np.pi, True, [], u0[i])
+    return Range(key, min(ends.values()), max(ends.values()), False,
+                 sorted(limits, key=lambda t: t[1]), u0[i])
+
+
+def _pose_q(model, m, u, p, L):
+    from .solve import sweep
+    sw = sweep(m, {k: [v] for k, v in zip([i.key for i in m.inputs], u)}, report=[])
+    return sw.q[0]
+
+
+def _follow(model, q, u, p, L, i, direction, scale, is_angle, max_steps):
+    """Walk the branch from (q, u) while input i moves in `direction` at first.
+
+    Returns (the input value where the walk ended, the located limit or None)."""
+    nq = model.nq
+    z = np.concatenate([q, [u[i]]]) / scale
+    t = _curve_tangent(model, q, u, p, i, scale)
+    t = t if t[-1] * direction > 0 or abs(t[-1]) < 1e-12 else -t
+    h, u_start = 0.02, u[i]
+    for _ in range(max_steps):
+        zp = z + h * t
+        zn = _correct(model, zp, t, u, p, L, i, scale)
+        if zn is None:
+            h /= 2
+            if h < 1e-12:
+                return z[-1] * scale[-1], None
+            continue
+        qn = zn[:nq] * scale[:nq]
+        un = u.copy()
+        un[i] = zn[-1] * scale[-1]
+        tn = _curve_tangent(model, qn, un, p, i, scale)
+        tn = tn if tn @ t >= 0 else -tn
+        if np.sign(tn[-1]) != np.sign(t[-1]) and t[-1] != 0:
+            # the input turned back between z and zn: a limit; locate it exactly
+            start = (qn, un) if abs(tn[-1]) < abs(t[-1]) else (z[:nq] * scale[:nq], _with(u, i, z[-1] * scale[-1]))
+            found = locate_singular(model, start[0], start[1], p, L, np.eye(len(u))[i])
+            ul = found[1][i] if found is not None else 0.5 * (z[-1] + zn[-1]) * scale[-1]
+            return ul, ul
+        z, t = zn, tn
+        if is_angle and abs(un[i] - u_start) >= 2 * np.pi:
+            return un[i], None
+        h = min(0.2, h * 1.5)
+    return z[-1] * scale[-1], None
+
+
+def _with(u, i, v):
+    u = np.array(u, float)
+    u[i] = v
+    return u
+
+
+def _curve_tangent(model, q, u, p, i, scale):
+    """Unit null vector of [g_q g_ui] in scaled coordinates: the branch's direction."""
+    _, J, Ju = (np.asarray(a) for a in model.sym.f_tangent(q, u, p))
+    G = np.hstack([J, Ju[:, [i]]]) * scale
+    return np.linalg.svd(G)[2][-1]
+
+
+def _correct(model, zp, t, u, p, L, i, scale, max_iter=12):
+    """Newton on [g(z) = 0; t.(z - zp) = 0] (pseudo-arclength corrector)."""
+    nq = model.nq
+    z = zp.copy()
+    for _ in range(max_iter):
+        q = z[:nq] * scale[:nq]
+        uu = _with(u, i, z[-1] * scale[-1])
+        g, J, Ju = (np.asarray(a) for a in model.sym.f_tangent(q, uu, p))
+        g = g.ravel()
+        F = np.concatenate([g / L, [t @ (z - zp)]])
+        if np.abs(F).max() < 1e-13:
+            return z
+        A = np.vstack([np.hstack([J, Ju[:, [i]]]) * scale / L, t])
+        try:
+            d = np.linalg.solve(A, -F)
+        except np.linalg.LinAlgError:
+            return None
+        if not np.all(np.isfinite(d)) or np.abs(d).max() > 0.5:
+            return None
+        z = z + d
+    return None
+
+
+# --- `kincas range SCENE.toml` ---
+
+
+def cli_arguments(ap):
+    ap.add_argument("scene", help="the scene file (TOML)")
+    ap.add_argument("--input", help="the input whose range is wanted (default: every input)")
+    ap.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def cli_run(args) -> int:
+    """Range of motion of each input (the others held at their first values) on the branch
+    of the scene's first pose; limits located to rounding precision."""
+    import json
+    import math
+
+    from .errors import SceneError
+    from .scene import load
+    sc = load(args.scene)
+    m = sc.mechanism
+    keys = [i.key for i in m.inputs]
+    if args.input and args.input not in keys:
+        raise SceneError(f"--input: {args.input!r} is not an input of the scene (inputs: {keys})")
+    start = {k: float(v[0]) for k, v in sc.study.inputs.items()}
+    out, text = {}, []
+    for i, key in enumerate(keys):
+        if args.input and key != args.input:
+            continue
+        conv = math.degrees if (m.inputs[i].kind == "angle" and sc.study.deg) else float
+        unit = sc.study.units.get("angle") if m.inputs[i].kind == "angle" else sc.study.units.get("length", "")
+        try:
+            r = input_range(m, start, key)
+        except ValueError:
+            print(f"kincas: the mechanism does not assemble at its first pose ({key} = "
+                  f"{conv(start[key]):.12g} {unit})", file=sys.stderr)
+            return 3
+        out[key] = {"from": conv(r.low), "to": conv(r.high), "full_turn": r.full_turn,
+                    "start": conv(r.start),
+                    "limits": [{"kind": k, "input": conv(v)} for k, v in r.limits]}
+        if r.full_turn:
+            text.append(f"{key}: a full turn (no limit on this branch)")
+        else:
+            text.append(f"{key}: from {conv(r.low):.12g} to {conv(r.high):.12g} {unit}"
+                        + "".join(f"\n  {k} at {conv(v):.12g} {unit}" for k, v in r.limits))
+    if args.json:
+        print(json.dumps({"title": sc.study.title, "units": sc.study.units, "ranges": out}))
+    else:
+        print(sc.study.title or "kincas range")
+        print("\n".join(text))
+    return 0
