@@ -50,7 +50,7 @@ def _scales(model, L):
 
 def scaled_jacobians(model, q, u, p, L):
     """(J, Gu): g_q and g_u with columns scaled so a size-L mechanism gives O(1) entries."""
-    _, J, Ju = (np.asarray(a) for a in model.sym.f_tangent(q, u, p))
+    _, J, Ju = model._tangent(q, u, p)
     cq, cu = _scales(model, L)
     return J * cq, Ju * cu
 
@@ -217,7 +217,7 @@ def _with(u, i, v):
 
 def _curve_tangent(model, q, u, p, i, scale):
     """Unit null vector of [g_q g_ui] in scaled coordinates: the branch's direction."""
-    _, J, Ju = (np.asarray(a) for a in model.sym.f_tangent(q, u, p))
+    _, J, Ju = model._tangent(q, u, p)
     G = np.hstack([J, Ju[:, [i]]]) * scale
     return np.linalg.svd(G)[2][-1]
 
@@ -229,7 +229,7 @@ def _correct(model, zp, t, u, p, L, i, scale, max_iter=12):
     for _ in range(max_iter):
         q = z[:nq] * scale[:nq]
         uu = _with(u, i, z[-1] * scale[-1])
-        g, J, Ju = (np.asarray(a) for a in model.sym.f_tangent(q, uu, p))
+        g, J, Ju = model._tangent(q, uu, p)
         g = g.ravel()
         F = np.concatenate([g / L, [t @ (z - zp)]])
         if np.abs(F).max() < 1e-13:

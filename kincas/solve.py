@@ -54,6 +54,30 @@ def compile(m: Mechanism) -> "Model":
     return _CACHE[key]
 
 
+class _Call:
+    """A casadi Function called through zero-copy numpy buffers: no DM conversions, about
+    0.1 us of overhead instead of 10 (see shared/casadi-notes.md). Outputs are dense and
+    overwritten by the next call: copy what must be kept."""
+
+    def __init__(self, f: ca.Function):
+        ins = f.sx_in()
+        self.f = ca.Function(f.name() + "_dense", ins, [ca.densify(o) for o in f.call(ins)])
+        self._in = [np.zeros(self.f.nnz_in(i)) for i in range(self.f.n_in())]
+        self._flat = [np.zeros(self.f.nnz_out(i)) for i in range(self.f.n_out())]
+        self.out = [a.reshape(self.f.size_out(i), order="F") for i, a in enumerate(self._flat)]
+        self._buf, self._eval = self.f.buffer()  # keep both referenced (raw pointers inside)
+        for i, a in enumerate(self._in):
+            self._buf.set_arg(i, memoryview(a))
+        for i, a in enumerate(self._flat):
+            self._buf.set_res(i, memoryview(a))
+
+    def __call__(self, *args):
+        for a, x in zip(self._in, args):
+            a[:] = np.ravel(x, order="F")
+        self._eval()
+        return self.out
+
+
 @dataclass
 class Solution:
     q: np.ndarray
@@ -76,16 +100,22 @@ class Model:
         self.f_ground = ca.Function("ground", [sym.u, sym.p], [ca.vertcat(*gxy) if gxy else ca.SX(0, 1)])
         self._nlp = None
         self._qfun: dict[tuple, ca.Function] = {}
+        self._resjac, self._tangent = _Call(sym.f_resjac), _Call(sym.f_tangent)
+        self._res = _Call(sym.f_res)
 
     # --- residuals and Newton ---
     def residual(self, q, u, p) -> np.ndarray:
-        return np.asarray(self.sym.f_res(q, u, p)).ravel()
+        return self._res(q, u, p)[0].ravel().copy()
+
+    def resjac(self, q, u, p):
+        """(g, g_q) at a pose, as fresh numpy arrays."""
+        g, J = self._resjac(q, u, p)
+        return g.ravel().copy(), J.copy()
 
     def newton(self, q, u, p, L, max_iter=40) -> Solution:
         """Damped Newton on g(q) = 0 with the exact Jacobian; the residual is relative to L."""
         q = np.array(q, dtype=float)
-        g, J = (np.asarray(a) for a in self.sym.f_resjac(q, u, p))
-        g = g.ravel()
+        g, J = self.resjac(q, u, p)
         r = np.abs(g).max(initial=0.0) / L
         scale = np.where(self.sym.is_length, MAX_STEP * L, MAX_STEP)
         for it in range(max_iter):
@@ -101,26 +131,37 @@ class Model:
             t = 1.0
             while True:  # backtrack until the residual decreases
                 qn = q + t * dq
-                gn, Jn = (np.asarray(a) for a in self.sym.f_resjac(qn, u, p))
+                gn, Jn = self.resjac(qn, u, p)
                 rn = np.abs(gn).max(initial=0.0) / L
                 if rn < (1 - 1e-4 * t) * r or rn <= TOL or t < 1 / 32:
                     break
                 t /= 2
             if not rn < r and rn > TOL:
                 break  # no progress: stagnation at a non-solution (or at rounding level)
-            q, g, J, r = qn, gn.ravel(), Jn, rn
+            q, g, J, r = qn, gn, Jn, rn
         return Solution(q, r, max_iter, r <= ACCEPT, J)
 
     def tangent(self, q, u, p) -> np.ndarray:
         """dq/du (nq x nu) at a solved pose, from the implicit function theorem."""
-        _, J, Ju = (np.asarray(a) for a in self.sym.f_tangent(q, u, p))
+        _, J, Ju = self._tangent(q, u, p)
         try:
             return np.linalg.solve(J, -Ju)
         except np.linalg.LinAlgError:
             return np.linalg.lstsq(J, -Ju, rcond=None)[0]
 
     def jac(self, q, u, p) -> np.ndarray:
-        return np.asarray(self.sym.f_resjac(q, u, p)[1])
+        return self._resjac(q, u, p)[1].copy()
+
+    def jacobians_at(self, Q, U, p):
+        """g_q (N, nq, nq) and g_u (N, nq, nu) at N poses in one mapped call."""
+        n = Q.shape[0]
+        if n == 0:
+            return np.zeros((0, self.nq, self.nq)), np.zeros((0, self.nq, self.nu))
+        f = self.sym.f_tangent.map(n)
+        _, J, Ju = f(Q.T, U.T, np.repeat(np.reshape(p, (-1, 1)), n, axis=1))
+        J = np.asarray(ca.densify(J)).reshape(self.nq, n, self.nq).transpose(1, 0, 2)
+        Ju = np.asarray(ca.densify(Ju)).reshape(self.nq, n, self.nu).transpose(1, 0, 2)
+        return J, Ju
 
     def points(self, q, u, p) -> np.ndarray:
         """World positions of the moving points, 2 x n."""
@@ -398,15 +439,18 @@ def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags) -> list[
     (a change point, or a limit met exactly); a pose whose scaled g_q is numerically
     singular is flagged where it stands.
     """
-    from .singular import classify, locate_singular, scaled_jacobians
+    from .singular import FLAG_SIGMA, _scales, classify, locate_singular, scaled_jacobians
     n, events = len(ok), []
     if model.nq == 0 or m.inputs == ():
         return events
     idx = np.flatnonzero(ok)
-    jac = {k: scaled_jacobians(model, Q[k], U[k], p, L) for k in idx}
-    dets = {k: np.linalg.det(jac[k][0]) for k in idx}
-    for k in idx:
-        flags[k] = classify(*jac[k])
+    J, Ju = model.jacobians_at(Q[idx], U[idx], p)  # one mapped call for every solved pose
+    cq, cu = _scales(model, L)
+    J, Ju = J * cq, Ju * cu
+    dets = dict(zip(idx, np.linalg.det(J) if len(idx) else []))
+    sv = np.linalg.svd(J, compute_uv=False) if len(idx) else np.zeros((0, model.nq))
+    for j in np.flatnonzero(sv[:, -1] <= FLAG_SIGMA * np.maximum(sv[:, 0], 1.0)):
+        flags[idx[j]] = classify(J[j], Ju[j])
     for k in idx:
         for nb in (k - 1, k + 1):
             if not 0 <= nb < n:
