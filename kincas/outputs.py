@@ -1,0 +1,255 @@
+"""A sweep's outputs as files: CSV tables, plots of the quantities against the input, and the
+`kincas solve` flags that write them (--csv, --plot, --animate, --plot-quantities).
+
+Values are written in the scene's units (degrees where the scene says so); without a scene,
+as the sweep holds them (radians). A pose that was not solved has empty cells.
+
+>>> import io, numpy as np, kincas
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+...            kincas.Link.bar("rocker", "D", "C", 3)],
+...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+>>> sw = kincas.sweep(m, {"crank.angle": [0.0, 0.5]}, report=["C.x", "rocker.omega"])
+>>> out = io.StringIO(); write_csv(out, sw)
+>>> print(out.getvalue().splitlines()[0])
+crank.angle [rad],C.x,rocker.omega [rad/s],status,flag
+"""
+from __future__ import annotations
+
+import csv
+import math
+import sys
+from types import SimpleNamespace
+
+import numpy as np
+
+from .results import Sweep
+
+FLAG_STYLE = {"limit": ("#d62728", "limit of motion"), "change point": ("#9467bd", "change point"),
+              "singular": ("#ff7f0e", "singular position")}
+
+
+# --- names, units and values in the scene's units ---
+
+
+def _units_of(scene):
+    """What `kincas.cli._unit` needs: the scene, or plain radians/seconds without one."""
+    if scene is not None:
+        return scene
+    return SimpleNamespace(study=SimpleNamespace(units={"length": "", "angle": "rad", "time": "s"}),
+                           mechanism=SimpleNamespace(param_values={}))
+
+
+def heading(name: str, scene=None) -> str:
+    """`name [unit]`, units as in the printed table (just `name` when it has none).
+
+    >>> heading("rocker.alpha")
+    'rocker.alpha [rad/s^2]'
+    """
+    from .cli import _unit
+    u = _unit(_units_of(scene), name)
+    return f"{name} [{u}]" if u else name
+
+
+def user_columns(sweep: Sweep, scene=None, names=None):
+    """(inputs, values): name -> array in the scene's units (the sweep's own without one)."""
+    inputs = scene.user_inputs(sweep) if scene is not None else dict(sweep.inputs)
+    values = scene.user_values(sweep) if scene is not None else dict(sweep.values)
+    if names is not None:
+        missing = [n for n in names if n not in values]
+        if missing:
+            raise KeyError(f"not reported: {missing} (reported: {list(values)})")
+        values = {n: values[n] for n in names}
+    return inputs, values
+
+
+# --- CSV ---
+
+
+def write_csv(out, sweep: Sweep, scene=None) -> None:
+    """A row per pose: inputs, then reported quantities, then status and flag; a header row of
+    `name [unit]`; empty cells where a pose was not solved. `out`: a path or an open text file.
+    Numbers are written with all their digits (shortest text that reads back the same float).
+    """
+    if isinstance(out, (str, bytes)) or hasattr(out, "__fspath__"):
+        with open(out, "w", newline="", encoding="utf-8") as f:
+            return write_csv(f, sweep, scene)
+    inputs, values = user_columns(sweep, scene)
+    w = csv.writer(out, lineterminator="\n")
+    w.writerow([heading(k, scene) for k in [*inputs, *values]] + ["status", "flag"])
+    cols = [*inputs.values(), *values.values()]
+    for i in range(len(sweep)):
+        cells = ["" if not math.isfinite(c[i]) else repr(float(c[i])) for c in cols]
+        w.writerow(cells + [sweep.status[i], sweep.flags[i] or ""])
+
+
+# --- quantities against the input ---
+
+
+def _abscissa(sweep: Sweep, inputs: dict) -> tuple[str | None, np.ndarray]:
+    """The first input that varies (inputs that sweep advance together), else the pose index."""
+    for k, v in inputs.items():
+        if len(v) > 1 and np.ptp(v) > 0:
+            return k, np.asarray(v, float)
+    return None, np.arange(len(sweep), dtype=float)
+
+
+def _runs(mask: np.ndarray):
+    """(first, last) index of every run of True in mask."""
+    idx = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(int), [0]])))
+    return list(zip(idx[::2], idx[1::2] - 1))
+
+
+def _break_wraps(name: str, x, v, half):
+    """An angle wrapped to (-half turn, half turn] jumps by a whole turn: no line there.
+
+    >>> _break_wraps("L.angle", np.arange(3.0), np.array([3.0, -3.1, -3.0]), np.pi)[1].tolist()
+    [3.0, nan, -3.1, -3.0]
+    """
+    if not name.endswith(".angle") or name.startswith("d(") or len(v) < 2:
+        return x, v
+    jumps = np.flatnonzero(np.abs(np.diff(v)) > half) + 1
+    return np.insert(x.astype(float), jumps, np.nan), np.insert(np.asarray(v, float), jumps, np.nan)
+
+
+def plot_quantities(sweep: Sweep, names=None, *, scene=None, fig=None):
+    """Plot reported quantities (default: all) against the input, one panel each; returns the
+    Figure. Poses flagged "limit", "change point" or "singular" are marked by vertical lines,
+    poses that were not solved (beyond the limits of motion) are shaded.
+
+    >>> import numpy as np, kincas
+    >>> from matplotlib.figure import Figure
+    >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+    ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+    ...            kincas.Link.bar("rocker", "D", "C", 3)],
+    ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+    >>> sw = kincas.sweep(m, {"crank.angle": np.linspace(0, 6.28, 50)}, report=["C.x", "C.y"])
+    >>> len(plot_quantities(sw, fig=Figure()).axes)
+    2
+    """
+    from .plot import new_figure, require_matplotlib
+    require_matplotlib("kincas.outputs.plot_quantities")
+    inputs, values = user_columns(sweep, scene, names)
+    xkey, x = _abscissa(sweep, inputs)
+    n = max(len(values), 1)
+    ncols = 1 if n <= 4 else 2 if n <= 10 else 3
+    nrows = -(-n // ncols)
+    if fig is None:
+        fig = new_figure((4.6 * ncols, 1.7 * nrows + 0.9))
+    axes = np.atleast_1d(fig.subplots(nrows, ncols, sharex=True, squeeze=False)).ravel()
+    ok = sweep.ok
+    half = 180.0 if scene is not None and scene.study.deg else np.pi  # half a turn
+    style = "-" if len(x) > 1 else "o"
+    shown = set()
+    for ax, (name, v) in zip(axes, values.items()):
+        ax.plot(*_break_wraps(name, x, v, half), style, color="C0", lw=1.4, ms=4)
+        ax.set_ylabel(heading(name, scene), fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(True, color="#e6e6e6", lw=0.6)
+        for a, b in _runs(~ok):  # not assembled: shade from halfway to the neighbouring poses
+            lo = x[a] if a == 0 else 0.5 * (x[a - 1] + x[a])
+            hi = x[b] if b == len(x) - 1 else 0.5 * (x[b] + x[b + 1])
+            lab = None if "unsolved" in shown else "not solved"
+            ax.axvspan(min(lo, hi), max(lo, hi), color="#bbbbbb", alpha=0.5, lw=0, label=lab)
+            shown.add("unsolved")
+        for i, flag in enumerate(sweep.flags):
+            if flag:
+                colour, text = FLAG_STYLE.get(flag, ("#8c564b", flag))
+                ax.axvline(x[i], color=colour, lw=1.0, ls="--", label=None if flag in shown else text)
+                if math.isfinite(v[i]):
+                    ax.plot([x[i]], [v[i]], "o", color=colour, ms=4)
+                shown.add(flag)
+    for ax in axes[len(values):]:
+        ax.set_visible(False)
+    for ax in axes[max(len(values) - ncols, 0):len(values)]:
+        ax.set_xlabel(heading(xkey, scene) if xkey else "pose", fontsize=8)
+        ax.xaxis.set_tick_params(labelbottom=True)  # the bottom panel of its column
+    title = getattr(getattr(scene, "study", None), "title", "") or ""
+    if title:
+        fig.suptitle(title, fontsize=10)
+    handles, labels = axes[0].get_legend_handles_labels()
+    for ax in axes[1:len(values)]:  # every kind of mark once, whichever panel drew it first
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            if lab not in labels:
+                handles.append(h), labels.append(lab)
+    if handles:
+        fig.legend(handles, labels, loc="outside lower center", ncols=len(handles), fontsize=8)
+    return fig
+
+
+# --- the command line's output flags ---
+
+
+def _fail(message: str):
+    """One line on standard error, exit status 2 (a wrong invocation, like a wrong scene)."""
+    print(f"kincas: {message}", file=sys.stderr)
+    raise SystemExit(2)
+
+
+def check_outputs(args, mechanism=None) -> None:
+    """Fail early (one line, exit 2) when a picture is asked for and matplotlib is missing,
+    or when --paths or --pose name what does not exist."""
+    from .plot import require_matplotlib
+    for flag, attr in (("--plot", "plot"), ("--animate", "animate"), ("--plot-quantities", "plot_quantities")):
+        if getattr(args, attr, None):
+            try:
+                require_matplotlib(flag)
+            except ModuleNotFoundError as e:
+                _fail(str(e))
+    if mechanism is not None and getattr(args, "paths", None):
+        known = set(mechanism.moving_points) | set(mechanism.ground_points)
+        bad = [p for p in _names(args.paths) if p not in known]
+        if bad:
+            _fail(f"--paths: unknown point(s) {', '.join(bad)} (points: {', '.join(sorted(known))})")
+
+
+def _names(text: str) -> list[str]:
+    return [p.strip() for p in str(text).split(",") if p.strip()]
+
+
+def write_outputs(scene, sweep: Sweep, args) -> None:
+    """Write what the flags ask for: args.csv, args.plot, args.animate, args.plot_quantities
+    (and, when the parser has them, args.paths "P,Q" and args.pose, the index drawn)."""
+    m = scene.mechanism
+    check_outputs(args, m)
+    paths = _names(args.paths) if getattr(args, "paths", None) else None
+    pose = getattr(args, "pose", None)
+    if pose is not None and not -len(sweep) <= pose < len(sweep):
+        _fail(f"--pose: {pose} is not a pose of this sweep (0 to {len(sweep) - 1})")
+    length = scene.study.units.get("length", "")
+    inputs = scene.user_inputs(sweep)
+    captions = [_caption(scene, sweep, inputs, i) for i in range(len(sweep))]
+    jobs = [("csv", lambda p: write_csv(p, sweep, scene)),
+            ("plot", lambda p: _save_drawing(p, m, sweep, pose, paths, captions, length)),
+            ("animate", lambda p: _animate(p, m, sweep, paths, captions, length)),
+            ("plot_quantities", lambda p: plot_quantities(sweep, scene=scene).savefig(p, dpi=100))]
+    for attr, job in jobs:
+        path = getattr(args, attr, None)
+        if path:
+            try:
+                job(path)
+            except OSError as e:
+                _fail(f"cannot write {path}: {e.strerror or e}")
+
+
+def _caption(scene, sweep, inputs, i) -> str:
+    from .cli import _unit
+    parts = []
+    for k, v in inputs.items():
+        u = _unit(scene, k)
+        parts.append(f"{k} = {v[i]:.4g}" + ("°" if u == "deg" else f" {u}" if u else ""))
+    head = (scene.study.title + ": ") if scene.study.title else ""
+    return head + ", ".join(parts) + ("" if sweep.status[i] == "ok" else f" ({sweep.status[i]})")
+
+
+def _save_drawing(path, m, sweep, pose, paths, captions, length):
+    from .plot import default_pose, draw, new_figure
+    fig = new_figure()
+    i = default_pose(sweep) if pose is None else pose % len(sweep)
+    draw(m, sweep, i, ax=fig.subplots(), paths=paths, caption=captions[i], units=length)
+    fig.savefig(path, dpi=100)
+
+
+def _animate(path, m, sweep, paths, captions, length):
+    from .plot import animate
+    animate(m, sweep, path, paths=paths, captions=captions, units=length)

@@ -1,0 +1,431 @@
+"""Pictures of a mechanism: the drawing at a pose with the paths of its points, animations of
+a sweep, and the reported quantities plotted against the input.
+
+matplotlib is an optional extra (`pip install "kincas[plot]"`): this module imports it only
+when a picture is drawn, so `import kincas.plot` works without it. Positions come from the
+solved unknowns `sweep.q` through the compiled model, so a drawing shows exactly the poses
+that were solved; poses whose status is not "ok" are left out of paths and animations.
+
+>>> import numpy as np, kincas
+>>> from matplotlib.figure import Figure
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+...            kincas.Link.bar("rocker", "D", "C", 3)],
+...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+>>> sw = kincas.sweep(m, {"crank.angle": np.linspace(0, 2 * np.pi, 37)})
+>>> ax = draw(m, sw, pose=9, ax=Figure().subplots())    # crank at 90 deg, paths of B and C
+>>> ax.get_aspect()
+1.0
+"""
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+
+from .model import GROUND, Mechanism
+from .results import Sweep
+
+PLOT_EXTRA = 'pip install "kincas[plot]"'
+
+
+def require_matplotlib(what: str = "kincas.plot") -> None:
+    """Raise ModuleNotFoundError with a one-line message saying what to install.
+
+    >>> require_matplotlib("--plot")
+    """
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        raise ModuleNotFoundError(f"{what} needs matplotlib: {PLOT_EXTRA}", name="matplotlib") from None
+
+
+# --- geometry of every pose (the one place casadi is used here) ---
+
+
+@dataclass
+class Geometry:
+    """World positions over a sweep: `xy[i, k]` is point `names[k]` at pose i (NaN when the
+    pose was not solved); each slide's line at each pose as a point `through` (N x 2), a unit
+    direction `direction` (N x 2) and the slide coordinate `s` (N,) of its point.
+
+    >>> import numpy as np, kincas
+    >>> m = kincas.Mechanism(ground={"O": (0, 0)},
+    ...     links=[kincas.Link.bar("crank", "O", "A", 1), kincas.Link.bar("rod", "A", "B", 3)],
+    ...     slides=[kincas.Slide("B", "ground", name="slider")],
+    ...     inputs=[kincas.Input.angle("crank")], guess={"B": (3.5, 0)})
+    >>> g = geometry(m, kincas.sweep(m, {"crank.angle": [0.0, np.pi / 2]}))
+    >>> np.round(g.point("B"), 6).tolist(), np.round(g.slides["slider"][2], 6).tolist()
+    ([[4.0, 0.0], [2.828427, 0.0]], [4.0, 2.828427])
+    """
+
+    names: list[str]
+    xy: np.ndarray
+    slides: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]
+    ok: np.ndarray
+
+    def point(self, name: str) -> np.ndarray:
+        """(N x 2) positions of one point."""
+        return self.xy[:, self.names.index(name)]
+
+
+_POSE_FUNCTIONS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _pose_function(model):
+    """(q, u, p) -> ground points, moving points, and for each slide its line's point
+    `through` and direction angle, all in world coordinates (a body's frame is origin
+    (ox, oy) and angle th: a local vector v maps to origin + R(th) v)."""
+    if model not in _POSE_FUNCTIONS:
+        import casadi as ca
+        sym, m = model.sym, model.sym.mech
+        out = [c for g in m.ground_points for c in sym.points[g]]
+        out += [c for p in m.moving_points for c in sym.points[p]]
+        for sl in m.slides:
+            ox, oy, th = sym.frames[sl.along]
+            tx, ty = (sym.val(v) for v in sl.through)
+            out += [ox + ca.cos(th) * tx - ca.sin(th) * ty, oy + ca.sin(th) * tx + ca.cos(th) * ty,
+                    th + sym.val(sl.angle)]
+        _POSE_FUNCTIONS[model] = ca.Function("pose", [sym.q, sym.u, sym.p], [ca.vertcat(*out)])
+    return _POSE_FUNCTIONS[model]
+
+
+def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
+    """Positions of all points and the lines of all slides at every pose of `sweep`."""
+    from .solve import compile
+    model = compile(m)
+    keys = [i.key for i in m.inputs]
+    missing = [k for k in keys if k not in sweep.inputs]
+    if missing:
+        raise ValueError(f"the sweep has no values for the inputs {missing}: was it made with this mechanism?")
+    n, ok = len(sweep), sweep.ok
+    names = list(m.ground_points) + list(m.moving_points)
+    U = np.stack([np.asarray(sweep.inputs[k], float) for k in keys], axis=1).reshape(n, len(keys))
+    p = np.array([v for _, v in m.parameters], float).reshape(-1, 1)
+    Q = np.where(ok[:, None], sweep.q, 0.0)  # what depends on q is masked below
+    f = _pose_function(model).map(n)
+    raw = np.asarray(f(Q.T, U.T, np.repeat(p, n, axis=1))).T.reshape(n, -1)
+    ng = len(m.ground_points)
+    xy = raw[:, :2 * len(names)].reshape(n, len(names), 2).copy()
+    xy[~ok, ng:] = np.nan  # ground points are known at every pose, moving ones when solved
+    slides = {}
+    for k, sl in enumerate(m.slides):
+        c = 2 * len(names) + 3 * k
+        through, angle = raw[:, c:c + 2].copy(), raw[:, c + 2].copy()
+        if sl.along != GROUND:
+            through[~ok], angle[~ok] = np.nan, np.nan
+        d = np.stack([np.cos(angle), np.sin(angle)], axis=1)
+        s = np.einsum("ij,ij->i", xy[:, names.index(sl.point)] - through, d)  # signed distance
+        slides[sl.name] = (through, d, s)
+    return Geometry(names, xy, slides, ok)
+
+
+# --- shapes ---
+
+
+def _hull(pts: np.ndarray) -> list[int]:
+    """Indices of the convex hull of 2-D points, counter-clockwise (Andrew's monotone chain)."""
+    order = sorted(range(len(pts)), key=lambda i: (pts[i][0], pts[i][1]))
+
+    def cross(o, a, b):
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    def chain(idx):
+        out: list[int] = []
+        for i in idx:
+            while len(out) >= 2 and cross(pts[out[-2]], pts[out[-1]], pts[i]) <= 0:
+                out.pop()
+            out.append(i)
+        return out
+
+    lower, upper = chain(order), chain(order[::-1])
+    return lower[:-1] + upper[:-1]
+
+
+def _rectangle(centre, d, length, width) -> np.ndarray:
+    """Corners of a rectangle centred at `centre` with its long side along unit vector d."""
+    n = np.array([-d[1], d[0]])
+    a, b = 0.5 * length * np.asarray(d), 0.5 * width * n
+    return np.array([centre - a - b, centre + a - b, centre + a + b, centre - a + b])
+
+
+# --- the drawing: artists made once, moved to any pose ---
+
+INK, PAPER = "#222222", "white"
+
+
+class _Drawing:
+    """Every artist of a mechanism drawing; `update(i)` moves them to pose i."""
+
+    def __init__(self, ax, m: Mechanism, geo: Geometry, paths, labels: bool, units: str = ""):
+        self.ax, self.m, self.geo = ax, m, geo
+        self.i0 = default_pose_of(geo.ok)
+        pts = geo.xy[np.isfinite(geo.xy).all(axis=2)]
+        pts = pts if pts.size else np.zeros((1, 2))
+        span = np.ptp(pts, axis=0).max()
+        self.r = r = 0.02 * (span if span > 0 else m.size())  # the drawing's unit of size
+        ends, self.sref = [pts], {}
+        for name, (through, d, s) in geo.slides.items():
+            # each guide spans the slide coordinates reached, with room for the block
+            sv = s[np.isfinite(s)] if np.isfinite(s).any() else np.zeros(1)
+            self.sref[name] = (sv.min() - 4 * r, sv.max() + 4 * r)
+            for sx in self.sref[name]:
+                e = through + sx * d
+                ends.append(e[np.isfinite(e).all(axis=1)])
+        allpts = np.concatenate([e for e in ends if e.size] or [np.zeros((1, 2))])
+        lo, hi = allpts.min(axis=0) - 5 * r, allpts.max(axis=0) + 5 * r
+        self.box = np.array([lo, hi])  # the whole sweep fits: an animation keeps its frame
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(True, color="#e6e6e6", lw=0.6, zorder=0)
+        if units:
+            ax.set_xlabel(f"x [{units}]"), ax.set_ylabel(f"y [{units}]")
+        colours = [f"C{k % 10}" for k in range(len(m.links))]
+        self.colour = {lk.name: c for lk, c in zip(m.links, colours)}
+        owner = {}
+        for lk in m.links:
+            for p in lk.point_names:
+                owner.setdefault(p, lk.name)
+        # --- paths of points over the sweep (NaN at unsolved poses breaks the line) ---
+        for p in paths:
+            xy = geo.point(p)
+            if np.isfinite(xy).all(axis=1).sum() >= 2:
+                ax.plot(xy[:, 0], xy[:, 1], "--", lw=1.0, color=self.colour.get(owner.get(p), INK),
+                        alpha=0.7, zorder=2)
+        self._ground_symbols()
+        self._make_bodies()
+        self._make_slides()
+        self._make_points(labels)
+        self.caption = ax.set_title("", fontsize=9)
+        # The limits follow this box, widened to equal scales by matplotlib when drawn (the
+        # placeholder positions of the artists above are not part of it).
+        ax.dataLim.set_points(self.box)
+        ax.set_xmargin(0), ax.set_ymargin(0)
+        ax.autoscale_view()
+
+    # --- fixed parts ---
+    def _ground_symbols(self):
+        """A triangle under each ground pivot standing on a hatched base."""
+        from matplotlib.collections import LineCollection
+        from matplotlib.patches import Polygon
+        r, ax = self.r, self.ax
+        ticks = []
+        for g in self.m.ground_points:
+            x, y = self.geo.point(g)[self.i0]  # fixed: known at every pose
+            if not np.isfinite(x):
+                continue
+            h = 2.5 * r
+            ax.add_patch(Polygon([(x, y), (x - 0.7 * h, y - h), (x + 0.7 * h, y - h)], closed=True,
+                                 fc="#dddddd", ec=INK, lw=1.0, zorder=1.5))
+            base = y - h
+            ticks.append([(x - 1.1 * h, base), (x + 1.1 * h, base)])
+            for t in np.linspace(-1.1 * h, 0.8 * h, 6):
+                ticks.append([(x + t, base), (x + t + 0.3 * h, base - 0.35 * h)])
+        if ticks:
+            ax.add_collection(LineCollection(ticks, colors=INK, linewidths=0.8, zorder=1.5))
+
+    # --- bodies ---
+    def _make_bodies(self):
+        from matplotlib.patches import Polygon
+        self.bodies = []  # (kind, artist, indices of the points drawn)
+        first = np.flatnonzero(self.geo.ok)
+        driven = {i.target for i in self.m.inputs if i.kind == "angle"}  # drawn on top
+        for lk in self.m.links:
+            idx = [self.geo.names.index(p) for p in lk.point_names]
+            c = self.colour[lk.name]
+            ring = idx
+            if len(idx) >= 3 and first.size:
+                pts = self.geo.xy[first[0], idx]
+                hull = _hull(pts)
+                area = 0.5 * abs(sum(np.cross(pts[hull[k]], pts[hull[(k + 1) % len(hull)]])
+                                     for k in range(len(hull))))
+                if len(hull) >= 3 and area > (0.5 * self.r) ** 2:
+                    ring = [idx[k] for k in hull]
+                    patch = Polygon(np.zeros((len(ring), 2)), closed=True, fc=c, ec=c, alpha=0.45,
+                                    lw=2.5, zorder=3)
+                    self.ax.add_patch(patch)
+                    self.bodies.append(("polygon", patch, ring))
+                    continue
+                # collinear points: a bar between the two extreme ones
+                far = max(((a, b) for a in range(len(idx)) for b in range(len(idx))),
+                          key=lambda ab: np.hypot(*(pts[ab[0]] - pts[ab[1]])))
+                ring = [idx[far[0]], idx[far[1]]]
+            line, = self.ax.plot([], [], "-", lw=5, color=c, solid_capstyle="round",
+                                 zorder=4.5 if lk.name in driven else 4, label=lk.name)
+            self.bodies.append(("bar", line, ring[:2]))
+
+    def _make_slides(self):
+        from matplotlib.collections import LineCollection
+        from matplotlib.patches import Polygon
+        self.guides = []
+        for sl in self.m.slides:
+            c = INK if sl.along == GROUND else self.colour[sl.along]
+            rails = [self.ax.plot([], [], "-", lw=1.2, color=c, zorder=3.5)[0] for _ in range(2)]
+            block = Polygon(np.zeros((4, 2)), closed=True, fc="#f2f2f2", ec=INK, lw=1.2, zorder=5)
+            self.ax.add_patch(block)
+            hatch = None
+            if sl.along == GROUND:
+                hatch = LineCollection([], colors=INK, linewidths=0.7, zorder=3.5)
+                self.ax.add_collection(hatch)
+            self.guides.append((sl, rails, block, hatch))
+
+    def _make_points(self, labels: bool):
+        bodies = {}
+        for lk in self.m.links:
+            for p in lk.point_names:
+                bodies[p] = bodies.get(p, 0) + 1
+        for g in self.m.ground_points:
+            bodies[g] = bodies.get(g, 0) + 1
+        names = self.geo.names
+        joints = [k for k, p in enumerate(names) if bodies.get(p, 0) >= 2]
+        single = [k for k, p in enumerate(names) if bodies.get(p, 0) < 2]
+        self.joints = (joints, self.ax.plot([], [], "o", ms=6, mfc=PAPER, mec=INK, mew=1.3,
+                                            ls="none", zorder=6)[0])
+        self.dots = (single, self.ax.plot([], [], "o", ms=4, color=INK, ls="none", zorder=6)[0])
+        self.labels = [self.ax.text(0, 0, p, fontsize=8, zorder=7, ha="center", va="center",
+                                    bbox=dict(fc=PAPER, ec="none", alpha=0.75, pad=0.3))
+                       for p in names] if labels else []
+        # what surrounds each point: the other points of its bodies, its ground symbol below
+        self.near = {k: sorted({names.index(q) for lk in self.m.links if p in lk.point_names
+                                for q in lk.point_names if q != p}) for k, p in enumerate(names)}
+
+    def _free_side(self, k: int, xy: np.ndarray, i: int) -> np.ndarray:
+        """A unit vector from point k into free space: minus the sum of the unit vectors
+        towards what is drawn around it (its neighbours, a ground symbol, a slide's guide)."""
+        def unit(v):
+            n = np.hypot(*v)
+            return v / n if n > 0 and np.isfinite(n) else np.zeros(2)
+        v = sum((unit(xy[j] - xy[k]) for j in self.near[k]), np.zeros(2))
+        name = self.geo.names[k]
+        if name in self.m.ground_points:
+            v = v + np.array([0.0, -1.0])
+        along = None
+        for sl, *_ in self.guides:
+            if sl.point == name:  # a ground guide's hatch is on its -n side
+                along = self.geo.slides[sl.name][1][i]
+                v = v + (np.array([along[1], -along[0]]) if sl.along == GROUND else 0.0)
+        v = -v
+        if along is not None and np.isfinite(along).all():  # the guide runs both ways: go across
+            n = np.array([-along[1], along[0]])
+            v = n * (1.0 if n @ v >= 0 else -1.0)
+        v = unit(v)
+        return v if v.any() else np.array([0.6, 0.8])
+
+    # --- moving to a pose ---
+    def update(self, i: int, caption: str = ""):
+        """Move every artist to pose i (nothing moving is shown when it was not solved)."""
+        geo, r = self.geo, self.r
+        xy = geo.xy[i] if 0 <= i < len(geo.ok) else np.full((len(geo.names), 2), np.nan)
+        for kind, artist, idx in self.bodies:
+            if kind == "polygon":
+                artist.set_xy(xy[idx] if np.isfinite(xy[idx]).all() else np.zeros((len(idx), 2)))
+                artist.set_visible(bool(np.isfinite(xy[idx]).all()))
+            else:
+                artist.set_data(xy[idx, 0], xy[idx, 1])
+        for sl, rails, block, hatch in self.guides:
+            through, d, s = (a[i] for a in geo.slides[sl.name])
+            ok = bool(np.isfinite(through).all() and np.isfinite(s))
+            lo, hi = self.sref[sl.name]
+            w, nrm = 1.4 * r, np.array([-d[1], d[0]]) if ok else np.zeros(2)
+            for sign, rail in zip((-1, 1), rails):  # a channel either side of the line
+                e = np.array([through + lo * d, through + hi * d]) + sign * w * nrm if ok else np.full((2, 2), np.nan)
+                rail.set_data(e[:, 0], e[:, 1])
+            block.set_visible(ok)
+            if ok:
+                block.set_xy(_rectangle(xy[geo.names.index(sl.point)], d, 4 * r, 2 * w))
+            if hatch is not None and ok:  # ground guide: ticks on the far side of one rail
+                base = through - w * nrm
+                hatch.set_segments([[base + t * d, base + (t - 0.8 * r) * d - 0.8 * r * nrm]
+                                    for t in np.arange(lo, hi + 1e-12, 1.2 * r)])
+        for idx, line in (self.joints, self.dots):
+            line.set_data(xy[idx, 0], xy[idx, 1])
+        for k, t in enumerate(self.labels):
+            ok = bool(np.isfinite(xy[k]).all())
+            t.set_visible(ok)
+            if ok:
+                t.set_position(xy[k] + 3.0 * r * self._free_side(k, xy, i))
+        self.caption.set_text(caption)
+        return [a for _, a, _ in self.bodies] + [self.joints[1], self.dots[1], self.caption] + self.labels
+
+
+# --- public drawing functions ---
+
+
+def _caption(sweep: Sweep, i: int) -> str:
+    if not 0 <= i < len(sweep):
+        return ""
+    text = ", ".join(f"{k} = {v[i]:.4g}" for k, v in sweep.inputs.items())
+    return text + ("" if sweep.status[i] == "ok" else f" ({sweep.status[i]})")
+
+
+def default_pose(sweep: Sweep) -> int:
+    """The pose drawn when none is asked for: the first one solved (0 when none was)."""
+    return default_pose_of(sweep.ok)
+
+
+def default_pose_of(ok: np.ndarray) -> int:
+    k = np.flatnonzero(ok)
+    return int(k[0]) if k.size else 0
+
+
+def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=None,
+         labels: bool = True, caption: str | None = None, units: str = ""):
+    """Draw `m` at pose `pose` of `sweep` (default: the first solved) with the paths of
+    `paths` (default: every moving point) over the sweep; returns the matplotlib Axes.
+
+    Links with two points are bars, links with three or more are filled polygons, ground
+    pivots stand on hatched bases, slides show their guide and block; axes have equal scales.
+    """
+    require_matplotlib("kincas.plot.draw")
+    if ax is None:
+        import matplotlib.pyplot as plt
+        ax = plt.subplots(figsize=(6.4, 4.8))[1]
+    paths = _check_paths(m, paths)
+    i = default_pose(sweep) if pose is None else int(pose) % max(len(sweep), 1)  # -1: the last
+    d = _Drawing(ax, m, geometry(m, sweep), paths, labels, units)
+    d.update(i, _caption(sweep, i) if caption is None else caption)
+    return ax
+
+
+def _check_paths(m: Mechanism, paths) -> list[str]:
+    if paths is None:
+        return list(m.moving_points)
+    known = set(m.moving_points) | set(m.ground_points)
+    bad = [p for p in paths if p not in known]
+    if bad:
+        raise ValueError(f"paths: unknown point(s) {bad} (points: {sorted(known)})")
+    return list(paths)
+
+
+def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, fps: int = 20,
+            captions=None, units: str = "", dpi: int = 80, size=(6.4, 4.8)) -> int:
+    """Write an animated GIF of the sweep's solved poses (at most `frames` of them, evenly
+    spread); returns the number of frames written. `captions[i]` titles pose i."""
+    require_matplotlib("kincas.plot.animate")
+    from matplotlib.animation import PillowWriter
+    ok = np.flatnonzero(sweep.ok)
+    if ok.size == 0:
+        ok = np.array([0])
+    pick = ok[np.unique(np.round(np.linspace(0, ok.size - 1, min(frames, ok.size))).astype(int))]
+    fig = new_figure(size)
+    d = _Drawing(fig.subplots(), m, geometry(m, sweep), _check_paths(m, paths), True, units)
+    cap = captions if captions is not None else [_caption(sweep, i) for i in range(len(sweep))]
+    d.update(int(pick[0]), cap[pick[0]])
+    fig.canvas.draw()  # lay the figure out once; every frame keeps that layout
+    fig.set_layout_engine("none")
+    writer = PillowWriter(fps=fps)
+    with writer.saving(fig, str(path), dpi):
+        for i in pick:  # one drawing per frame
+            d.update(int(i), cap[i])
+            writer.grab_frame()
+    return len(pick)
+
+
+def new_figure(size=(6.4, 4.8)):
+    """A matplotlib Figure for writing files, independent of pyplot and its backends."""
+    require_matplotlib()
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=size, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
