@@ -1,0 +1,388 @@
+"""Tolerance analysis: the spread of outputs caused by the spread of parameters.
+
+Parameters (link lengths, ground coordinates, anything named in `[parameters]`) are taken as
+independent normal variables with the given standard deviations sigma_j. Two answers:
+
+* first order: Q(p0 + dp) ~ Q(p0) + sum_j dQ/dp_j dp_j, so std(Q) = sqrt(sum_j (dQ/dp_j sigma_j)^2),
+  with the exact sensitivities of the implicit function theorem (`kincas.sensitivity`);
+* Monte Carlo: N mechanisms drawn at random, each solved at every pose. One drawn mechanism
+  is one manufactured part, so the same draw is used at all poses. All N x poses solves run in
+  one vectorised CasADi call (`Function.map`): from the nominal pose q0, a first-order
+  predictor q0 + dq/dp dp, then a few Newton steps with the exact Jacobian. A sample counts
+  only if its residual is below the solver's acceptance and the sign of det(g_q) is the
+  nominal one (the same assembly branch); the others go once through the careful Newton of
+  `kincas.solve`, and those that still fail are counted per pose and left out, never used.
+
+The two agree when the outputs are close to linear over the tolerance band; their ratio is
+reported beside the Monte-Carlo sampling error, 1 / sqrt(2 (N - 1)) relative.
+
+>>> import numpy as np, kincas
+>>> m = kincas.Mechanism(parameters={"a": 1.0, "b": 3.5}, ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", "b"),
+...            kincas.Link.bar("rocker", "D", "C", 3)],
+...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+>>> r = analyse(m, {"crank.angle": np.array([0.5, 1.0])}, std={"a": 0.01, "b": 0.01},
+...             report=["C.y"], samples=400, seed=1)
+>>> r.failed.tolist(), bool(np.all(np.abs(r.agreement["C.y"] - 1) < 0.2))
+([0, 0], True)
+"""
+from __future__ import annotations
+
+import json
+import math
+import sys
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ModelError, SceneError
+from .model import Mechanism
+
+NEWTON_STEPS = 5  # after the first-order predictor; quadratic convergence needs few
+CHUNK = 40_000  # columns per mapped call: bounds the memory of very large runs
+RETRY_LIMIT = 1000  # samples per analysis that may take the careful (per-pose) path
+
+
+@dataclass
+class ToleranceResult:
+    """First-order and Monte-Carlo standard deviations of each output at each pose.
+
+    `first_order[Q]`, `monte_carlo[Q]`, `nominal[Q]`, `mean_shift[Q]` (Monte-Carlo mean minus
+    nominal) are arrays over the poses; `failed[i]` counts the samples that did not assemble
+    on the nominal branch at pose i (left out of the statistics); `agreement[Q]` is
+    monte_carlo / first_order."""
+
+    names: list[str]
+    std: dict[str, float]
+    samples: int
+    seed: int | None
+    inputs: dict[str, np.ndarray]
+    status: list[str]
+    nominal: dict[str, np.ndarray]
+    first_order: dict[str, np.ndarray]
+    monte_carlo: dict[str, np.ndarray]
+    mean_shift: dict[str, np.ndarray]
+    failed: np.ndarray
+    info: dict = field(default_factory=dict)
+
+    @property
+    def agreement(self) -> dict[str, np.ndarray]:
+        """Monte-Carlo std over first-order std (1 where both are zero)."""
+        out = {}
+        for n in self.names:
+            fo, mc = self.first_order[n], self.monte_carlo[n]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                r = mc / fo
+            tiny = 1e-12 * max(1.0, float(np.nanmax(np.abs(self.nominal[n]), initial=0.0)))
+            out[n] = np.where((fo <= tiny) & (mc <= tiny), 1.0, r)
+        return out
+
+    @property
+    def standard_error(self) -> float:
+        """Relative sampling error of a Monte-Carlo standard deviation, 1 / sqrt(2 (n - 1))."""
+        return 1.0 / math.sqrt(2.0 * max(self.samples - 1, 1))
+
+    def agrees(self, k: float = 4.0) -> bool:
+        """Whether, at every solved pose, |Monte Carlo - first order| is within k sampling
+        errors of the output's largest first-order std over the sweep. (Relative to each
+        pose's own std would fail where a derivative crosses zero: there the first-order std
+        vanishes and the small second-order spread is all that is left.)"""
+        ok = np.array([s == "ok" for s in self.status])
+        for n in self.names:
+            fo, mc = self.first_order[n][ok], self.monte_carlo[n][ok]
+            top = float(np.nanmax(fo, initial=0.0))
+            if not np.all(np.abs(mc - fo) <= k * self.standard_error * top + 1e-300):
+                return False
+        return True
+
+
+# --- the analysis ---
+
+
+def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | None = None, *,
+            samples: int = 2000, seed: int | None = 0, rates=None, accelerations=None,
+            progress=None) -> ToleranceResult:
+    """Spread of the `report` quantities over `inputs` from independent normal parameter
+    errors with standard deviations `std` (parameter name -> sigma, in its own unit)."""
+    from .sensitivity import sensitivities
+    from .symbolic import default_report, parse_quantity
+
+    report = list(default_report(m) if report is None else report)
+    problems = _check_std(m, std, "std")
+    problems += [f"report: {n!r}: a sensitivity has no spread to analyse" for n in report
+                 if parse_quantity(n)[0] == "sens"]
+    if not isinstance(samples, int) or isinstance(samples, bool) or samples < 2:
+        problems.append(f"samples: expected a whole number >= 2, got {samples!r}")
+    if problems:
+        raise ModelError(problems)
+    to = list(std)
+    sig = np.array([float(std[p]) for p in to])
+    sens = sensitivities(m, inputs, of=report, to=to, rates=rates, accelerations=accelerations,
+                         progress=progress)
+    sw = sens.sweep
+    fo = np.sqrt(np.einsum("ijk,k->ij", sens.matrix ** 2, sig ** 2))  # poses x outputs
+    rng = np.random.default_rng(seed)
+    dp = rng.standard_normal((samples, len(to))) * sig  # one row per manufactured mechanism
+    mc, shift, failed, retried = _monte_carlo(m, sw, report, to, dp)
+    nominal = {n: sw[n] for n in report}
+    return ToleranceResult(
+        names=report, std={p: float(std[p]) for p in to}, samples=samples, seed=seed,
+        inputs=sw.inputs, status=sw.status, nominal=nominal,
+        first_order={n: fo[:, j] for j, n in enumerate(report)},
+        monte_carlo={n: mc[:, j] for j, n in enumerate(report)},
+        mean_shift={n: shift[:, j] for j, n in enumerate(report)}, failed=failed,
+        info={"retried": retried})
+
+
+def _check_std(m: Mechanism, std, where: str) -> list[str]:
+    out = []
+    driven = {i.target for i in m.inputs if i.kind == "parameter"}
+    if not isinstance(std, dict) or not std:
+        return [f"{where}: expected a table of parameter names and standard deviations"]
+    for p, s in std.items():
+        if p not in m.param_values:
+            out.append(f"{where}: {p}: unknown parameter (declare it in [parameters])")
+        elif p in driven:
+            out.append(f"{where}: {p}: driven by an input, so it has no tolerance")
+        if isinstance(s, bool) or not isinstance(s, (int, float)) or not math.isfinite(s) or s < 0:
+            out.append(f"{where}: {p}: expected a standard deviation >= 0, got {s!r}")
+    return out
+
+
+def _monte_carlo(m: Mechanism, sw, report, to, dp):
+    """Monte-Carlo std and mean shift (poses x outputs), failures per pose, samples retried."""
+    from .solve import ACCEPT, compile
+
+    model = compile(m)
+    sym, nq = model.sym, model.nq
+    n_s, n_pose = dp.shape[0], len(sw)
+    p0 = np.array([v for _, v in m.parameters], dtype=float)
+    cols = [sym.pnames.index(p) for p in to]
+    keys = list(sw.inputs)
+    U = np.stack([sw.inputs[k] for k in keys], axis=1)
+    Ud = np.stack([sw.rates[k] for k in keys], axis=1)
+    Udd = np.stack([sw.accelerations[k] for k in keys], axis=1)
+    L = m.size()
+    mc = np.full((n_pose, len(report)), np.nan)
+    shift = np.full((n_pose, len(report)), np.nan)
+    failed = np.zeros(n_pose, dtype=int)
+    ok_poses = np.flatnonzero(sw.ok)
+    if not len(ok_poses):
+        return mc, shift, failed, 0
+    F = _sample_function(model, tuple(report))
+    det_scale = np.where(sym.is_length, 1.0, 1.0 / L)  # columns to O(1): det signs comparable
+    # Columns: sample-major within each solved pose, so each pose is one contiguous block.
+    Pall = p0[:, None] + np.zeros((len(p0), n_s))
+    Pall[cols, :] += dp.T
+    DP = np.zeros((len(p0), n_s))
+    DP[cols, :] = dp.T
+    total = len(ok_poses) * n_s
+    Qv = np.empty((len(report), total))
+    res = np.empty(total)
+    dets = np.empty(total)
+    qs = np.empty((nq, total))
+    for start in range(0, total, CHUNK):
+        idx = np.arange(start, min(start + CHUNK, total))
+        pose, samp = ok_poses[idx // n_s], idx % n_s
+        f = F.map(len(idx))
+        q, r, J, vals = (np.asarray(a) for a in f(
+            sw.q[pose].T, U[pose].T, np.repeat(p0[:, None], len(idx), 1), DP[:, samp],
+            Ud[pose].T, Udd[pose].T))
+        J = J.T.reshape(len(idx), nq, nq).transpose(0, 2, 1) if nq else np.zeros((len(idx), 0, 0))
+        qs[:, idx], res[idx], Qv[:, idx] = q, r.ravel() / L, vals
+        dets[idx] = np.linalg.det(J * det_scale) if nq else 1.0
+    # The nominal branch: the sign of det(g_q) at each nominal pose.
+    ref = np.array([np.sign(np.linalg.det(model.jac(sw.q[k], U[k], p0) * det_scale))
+                    if nq else 1.0 for k in ok_poses])
+    good = (res <= ACCEPT) & np.all(np.isfinite(Qv), axis=0) & (np.sign(dets) == np.repeat(ref, n_s))
+    bad = np.flatnonzero(~good)
+    retried = 0
+    for i in bad[:RETRY_LIMIT]:  # the careful path: damped Newton from the predictor
+        k, s = ok_poses[i // n_s], i % n_s
+        start = qs[:, i] if np.all(np.isfinite(qs[:, i])) else sw.q[k]
+        sol = model.newton(start, U[k], Pall[:, s], L)
+        retried += 1
+        if not sol.ok:
+            continue
+        d = np.linalg.det(model.jac(sol.q, U[k], Pall[:, s]) * det_scale) if nq else 1.0
+        if np.sign(d) != ref[i // n_s]:
+            continue
+        Qv[:, i] = model.quantities(list(report), sol.q[None, :], U[k][None, :], Pall[:, s],
+                                    Ud[k][None, :], Udd[k][None, :])[:, 0]
+        good[i] = True
+    angular = np.array([n.endswith(".angle") for n in report])
+    for b, k in enumerate(ok_poses):
+        block = slice(b * n_s, (b + 1) * n_s)
+        g = good[block]
+        failed[k] = int(n_s - g.sum())
+        if g.sum() < 2:
+            continue
+        nom = np.array([sw[n][k] for n in report])
+        d = Qv[:, block][:, g] - nom[:, None]
+        d[angular] = np.angle(np.exp(1j * d[angular]))  # deviations of angles across +-pi
+        mc[k] = d.std(axis=1, ddof=1)
+        shift[k] = d.mean(axis=1)
+    return mc, shift, failed, retried
+
+
+_FUNCS: dict = {}
+
+
+def _sample_function(model, report: tuple[str, ...]):
+    """F(q0, u, p0, dp, u', u'') -> (q, |g|max, g_q, quantities): first-order predictor from
+    the nominal pose, then NEWTON_STEPS Newton steps, all as one CasADi expression graph."""
+    key = (id(model), report)
+    if key in _FUNCS:
+        return _FUNCS[key]
+    import casadi as ca
+
+    sym = model.sym
+    q0, u, p0, dp = (ca.SX.sym(n, k) for n, k in
+                     (("q0", sym.nq), ("u", sym.nu), ("p0", sym.np), ("dp", sym.np)))
+    ud, udd = ca.SX.sym("ud", sym.nu), ca.SX.sym("udd", sym.nu)
+    p = p0 + dp
+    gp = ca.Function("gp", [sym.q, sym.u, sym.p], [ca.jacobian(sym.g, sym.p)])
+    if sym.nq:
+        # Predictor: the tangent of the solution manifold, dq/dp = -g_q^-1 g_p, at the nominal.
+        _, J0 = sym.f_resjac(q0, u, p0)
+        q = q0 - ca.solve(J0, ca.mtimes(gp(q0, u, p0), dp))
+        for _ in range(NEWTON_STEPS):  # Newton with the exact Jacobian: g_q dq = -g
+            g, J = sym.f_resjac(q, u, p)
+            q = q - ca.solve(J, g)
+        g, J = sym.f_resjac(q, u, p)
+        r = ca.mmax(ca.fabs(g))
+    else:
+        q, J, r = ca.SX(0, 1), ca.SX(0, 0), ca.SX(0)
+    vals = model.quantity_function(report)(q, u, p, ud, udd)
+    F = ca.Function("tolerance_sample", [q0, u, p0, dp, ud, udd], [q, r, ca.vec(J), vals])
+    if len(_FUNCS) > 32:
+        _FUNCS.clear()
+    _FUNCS[key] = F
+    return F
+
+
+# --- scenes: the [tolerance] section ---
+
+
+def load_scene(path, section: str):
+    """Read a scene that carries an extension section. Until the scene reader lists the
+    section among its known ones, it is taken out before reading and put back in `raw`."""
+    from . import scene as _scene
+
+    if section in _scene.SECTIONS:
+        return _scene.load(path)
+    try:
+        doc = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as e:
+        raise SceneError(f"scene: cannot read {str(path)!r}: {e.strerror or e}") from None
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(f"scene: not valid TOML: {e}") from None
+    own = doc.pop(section, None)
+    sc = _scene._Reader(doc).scene()
+    if own is not None:
+        sc.study.raw[section] = own
+    return sc
+
+
+def read_section(sc) -> dict:
+    """The `[tolerance]` section as analyse()'s keywords; SceneError naming the field."""
+    from .solve import compile
+    from .symbolic import parse_quantity
+
+    t = sc.study.raw.get("tolerance")
+    if not isinstance(t, dict):
+        raise SceneError("[tolerance]: missing or not a table (give at least "
+                         "std = { PARAMETER = standard deviation, ... })")
+    problems = [f"[tolerance]: unknown field {k!r} (expected one of "
+                f"['report', 'samples', 'seed', 'std'])" for k in t
+                if k not in ("std", "samples", "seed", "report")]
+    if "std" not in t:
+        problems.append("[tolerance] std: missing (std = { PARAMETER = standard deviation, ... })")
+    else:
+        problems += _check_std(sc.mechanism, t["std"], "[tolerance] std")
+    samples, seed = t.get("samples", 2000), t.get("seed", 0)
+    for k, v, lo in (("samples", samples, 2), ("seed", seed, 0)):
+        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+            problems.append(f"[tolerance] {k}: expected a whole number >= {lo}, got {v!r}")
+    report = t.get("report", [n for n in sc.study.report if parse_quantity(n)[0] != "sens"])
+    if not isinstance(report, list) or not all(isinstance(n, str) for n in report):
+        problems.append("[tolerance] report: expected a list of quantity names")
+    else:
+        problems += compile(sc.mechanism).sym.check_names(report, "[tolerance] report")
+        problems += [f"[tolerance] report: {n!r}: a sensitivity has no spread to analyse"
+                     for n in report if parse_quantity(n)[0] == "sens"]
+    if problems:
+        raise SceneError(problems)
+    return {"std": {k: float(v) for k, v in t["std"].items()}, "samples": samples,
+            "seed": seed, "report": report}
+
+
+# --- the command line: kincas tolerance SCENE.toml ---
+
+
+def cli_arguments(parser) -> None:
+    """Arguments of `kincas tolerance`."""
+    parser.add_argument("scene", help="the scene file (TOML) with a [tolerance] section")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--samples", type=int, help="Monte-Carlo samples (overrides the scene)")
+    parser.add_argument("--seed", type=int, help="random seed (overrides the scene)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def cli_run(args) -> int:
+    """Run `kincas tolerance`: 0 when every pose and sample was solved, 3 otherwise."""
+    from .cli import _list, _unit, progress_for
+    from .symbolic import is_angular
+
+    sc = load_scene(args.scene, "tolerance")
+    kw = read_section(sc)
+    for k in ("samples", "seed"):
+        if getattr(args, k) is not None:
+            kw[k] = getattr(args, k)
+    if kw["samples"] < 2:
+        raise SceneError(f"--samples: expected a whole number >= 2, got {kw['samples']}")
+    st = sc.study
+    r = analyse(sc.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
+                progress=progress_for(args), **kw)
+    user = lambda n, v: np.degrees(v) if is_angular(n) and st.deg else np.asarray(v, float)
+    inputs = {k: user(k, v) for k, v in r.inputs.items()}
+    fo = {n: user(n, r.first_order[n]) for n in r.names}
+    mc = {n: user(n, r.monte_carlo[n]) for n in r.names}
+    if args.json:
+        doc = {"title": st.title, "units": st.units, "samples": r.samples, "seed": r.seed,
+               "std": r.std, "inputs": {k: _list(v) for k, v in inputs.items()},
+               "status": r.status, "failed": r.failed.tolist(),
+               "nominal": {n: _list(user(n, r.nominal[n])) for n in r.names},
+               "first_order": {n: _list(v) for n, v in fo.items()},
+               "monte_carlo": {n: _list(v) for n, v in mc.items()},
+               "agreement": {n: _list(v) for n, v in r.agreement.items()},
+               "standard_error": r.standard_error, "agrees": r.agrees()}
+        json.dump(doc, sys.stdout, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        _print(sc, r, inputs, fo, mc, lambda n: _unit(sc, n))
+    unsolved = any(s != "ok" for s in r.status) or int(r.failed.sum()) > 0
+    return 3 if unsolved else 0
+
+
+def _print(sc, r: ToleranceResult, inputs, fo, mc, unit):
+    stds = ", ".join(f"{p} {s:g}" for p, s in r.std.items())
+    print(f"{sc.study.title or 'kincas'}: tolerance analysis, {r.samples} samples (seed {r.seed})")
+    print(f"standard deviations: {stds}")
+    print("first-order std (exact sensitivities) and Monte-Carlo std, per pose:")
+    cols = [(k, v, unit(k)) for k, v in inputs.items()]
+    for n in r.names:
+        cols += [(f"std {n}", fo[n], unit(n)), (f"mc {n}", mc[n], unit(n))]
+    heads = [f"{h} [{u}]" if u else h for h, _, u in cols]
+    width = [max(12, len(h)) for h in heads]
+    print("  ".join(h.rjust(w) for h, w in zip(heads, width)) + "  failed")
+    for i in range(len(r.status)):
+        cells = [("-" if not math.isfinite(v[i]) else f"{v[i]:.6g}").rjust(w)
+                 for (_, v, _), w in zip(cols, width)]
+        tail = f"  {r.failed[i]}" if r.status[i] == "ok" else f"  ({r.status[i]})"
+        print("  ".join(cells) + tail)
+    verdict = "agree" if r.agrees() else "differ (the outputs are not linear over the tolerances)"
+    print(f"Monte Carlo and first order {verdict}: sampling error {100 * r.standard_error:.2g} %; "
+          f"{int(r.failed.sum())} sample poses did not assemble on the nominal branch")
