@@ -1,5 +1,5 @@
-"""Pictures of a mechanism: the drawing at a pose with the paths of its points, animations of
-a sweep, and the reported quantities plotted against the input.
+"""Pictures of a mechanism: the drawing at a pose with the paths of its points over a sweep,
+and animations of the sweep (plots of quantities: `kincas.outputs.plot_quantities`).
 
 matplotlib is an optional extra (`pip install "kincas[plot]"`): this module imports it only
 when a picture is drawn, so `import kincas.plot` works without it. Positions come from the
@@ -20,6 +20,7 @@ that were solved; poses whose status is not "ok" are left out of paths and anima
 from __future__ import annotations
 
 import weakref
+from collections import Counter
 from dataclasses import dataclass
 
 import numpy as np
@@ -143,6 +144,11 @@ def _hull(pts: np.ndarray) -> list[int]:
     return lower[:-1] + upper[:-1]
 
 
+def _unit(v: np.ndarray) -> np.ndarray:
+    n = np.hypot(*v)
+    return v / n if n > 0 and np.isfinite(n) else np.zeros(2)
+
+
 def _rectangle(centre, d, length, width) -> np.ndarray:
     """Corners of a rectangle centred at `centre` with its long side along unit vector d."""
     n = np.array([-d[1], d[0]])
@@ -160,7 +166,7 @@ class _Drawing:
 
     def __init__(self, ax, m: Mechanism, geo: Geometry, paths, labels: bool, units: str = ""):
         self.ax, self.m, self.geo = ax, m, geo
-        self.i0 = default_pose_of(geo.ok)
+        self.i0 = default_pose(geo.ok)
         pts = geo.xy[np.isfinite(geo.xy).all(axis=2)]
         pts = pts if pts.size else np.zeros((1, 2))
         span = np.ptp(pts, axis=0).max()
@@ -180,18 +186,15 @@ class _Drawing:
         ax.grid(True, color="#e6e6e6", lw=0.6, zorder=0)
         if units:
             ax.set_xlabel(f"x [{units}]"), ax.set_ylabel(f"y [{units}]")
-        colours = [f"C{k % 10}" for k in range(len(m.links))]
-        self.colour = {lk.name: c for lk, c in zip(m.links, colours)}
-        owner = {}
-        for lk in m.links:
-            for p in lk.point_names:
-                owner.setdefault(p, lk.name)
-        # --- paths of points over the sweep (NaN at unsolved poses breaks the line) ---
-        for p in paths:
+        self.colour = {lk.name: f"C{k % 10}" for k, lk in enumerate(m.links)}
+        owner = {p: lk.name for lk in reversed(m.links) for p in lk.point_names}  # the first link
+        for p in paths:  # a path in its link's colour; NaN at unsolved poses breaks the line
             xy = geo.point(p)
             if np.isfinite(xy).all(axis=1).sum() >= 2:
-                ax.plot(xy[:, 0], xy[:, 1], "--", lw=1.0, color=self.colour.get(owner.get(p), INK),
-                        alpha=0.7, zorder=2)
+                ax.plot(*xy.T, "--", lw=1.0, color=self.colour.get(owner.get(p), INK), alpha=0.7, zorder=2)
+        names = geo.names  # what surrounds each point: the other points of its bodies
+        self.near = {k: sorted({names.index(q) for lk in m.links if p in lk.point_names
+                                for q in lk.point_names if q != p}) for k, p in enumerate(names)}
         self._ground_symbols()
         self._make_bodies()
         self._make_slides()
@@ -226,89 +229,84 @@ class _Drawing:
 
     # --- bodies ---
     def _make_bodies(self):
+        """Two points: a bar. Three or more: their convex hull filled (a bar between the two
+        outermost when they are collinear). The links the inputs turn are drawn on top."""
         from matplotlib.patches import Polygon
         self.bodies = []  # (kind, artist, indices of the points drawn)
-        first = np.flatnonzero(self.geo.ok)
-        driven = {i.target for i in self.m.inputs if i.kind == "angle"}  # drawn on top
+        driven = {i.target for i in self.m.inputs if i.kind == "angle"}
         for lk in self.m.links:
             idx = [self.geo.names.index(p) for p in lk.point_names]
-            c = self.colour[lk.name]
-            ring = idx
-            if len(idx) >= 3 and first.size:
-                pts = self.geo.xy[first[0], idx]
-                hull = _hull(pts)
-                area = 0.5 * abs(sum(np.cross(pts[hull[k]], pts[hull[(k + 1) % len(hull)]])
-                                     for k in range(len(hull))))
-                if len(hull) >= 3 and area > (0.5 * self.r) ** 2:
-                    ring = [idx[k] for k in hull]
+            c, ring = self.colour[lk.name], idx
+            if len(idx) >= 3:
+                pts = self.geo.xy[self.i0, idx]
+                ring = [idx[k] for k in _hull(pts)] if np.isfinite(pts).all() else idx[:2]
+                x, y = self.geo.xy[self.i0, ring].T
+                area = 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))  # shoelace
+                if len(ring) >= 3 and area > (0.5 * self.r) ** 2:
                     patch = Polygon(np.zeros((len(ring), 2)), closed=True, fc=c, ec=c, alpha=0.45,
                                     lw=2.5, zorder=3)
-                    self.ax.add_patch(patch)
-                    self.bodies.append(("polygon", patch, ring))
+                    self.bodies.append(("polygon", self.ax.add_patch(patch), ring))
                     continue
-                # collinear points: a bar between the two extreme ones
-                far = max(((a, b) for a in range(len(idx)) for b in range(len(idx))),
-                          key=lambda ab: np.hypot(*(pts[ab[0]] - pts[ab[1]])))
-                ring = [idx[far[0]], idx[far[1]]]
+                far = np.hypot(*(self.geo.xy[self.i0, ring] - self.geo.xy[self.i0, ring[0]]).T)
+                ring = [ring[0], ring[int(np.argmax(far))]]
             line, = self.ax.plot([], [], "-", lw=5, color=c, solid_capstyle="round",
                                  zorder=4.5 if lk.name in driven else 4, label=lk.name)
-            self.bodies.append(("bar", line, ring[:2]))
+            self.bodies.append(("bar", line, ring))
 
     def _make_slides(self):
+        """A slot along a link: two rails in the link's colour. A guide on the ground: one
+        hatched surface on the side away from the links that pull the block, so they do not
+        cross it. The block rides between the rails, or against the surface."""
         from matplotlib.collections import LineCollection
         from matplotlib.patches import Polygon
-        self.guides = []
+        self.guides = []  # (slide, [(side, rail)], block, hatch or None)
         for sl in self.m.slides:
-            c = INK if sl.along == GROUND else self.colour[sl.along]
-            rails = [self.ax.plot([], [], "-", lw=1.2, color=c, zorder=3.5)[0] for _ in range(2)]
-            block = Polygon(np.zeros((4, 2)), closed=True, fc="#f2f2f2", ec=INK, lw=1.2, zorder=5)
-            self.ax.add_patch(block)
-            hatch = None
+            sides = (-1.0, 1.0)
             if sl.along == GROUND:
-                hatch = LineCollection([], colors=INK, linewidths=0.7, zorder=3.5)
-                self.ax.add_collection(hatch)
+                k, (_, d, _) = self.geo.names.index(sl.point), self.geo.slides[sl.name]
+                n = np.stack([-d[:, 1], d[:, 0]], axis=1)
+                pull = sum(np.nanmean(np.einsum("ij,ij->i", self.geo.xy[:, j] - self.geo.xy[:, k], n))
+                           for j in self.near[k]) if self.geo.ok.any() else 0.0
+                sides = (-1.0 if not pull < 0 else 1.0,)  # the side the links are not on
+            c = INK if sl.along == GROUND else self.colour[sl.along]
+            rails = [(side, self.ax.plot([], [], "-", lw=1.2, color=c, zorder=3.5)[0]) for side in sides]
+            block = self.ax.add_patch(Polygon(np.zeros((4, 2)), closed=True, fc="#f2f2f2", ec=INK,
+                                              lw=1.2, zorder=5))
+            hatch = (self.ax.add_collection(LineCollection([], colors=INK, linewidths=0.7, zorder=3.5))
+                     if sl.along == GROUND else None)
             self.guides.append((sl, rails, block, hatch))
 
     def _make_points(self, labels: bool):
-        bodies = {}
-        for lk in self.m.links:
-            for p in lk.point_names:
-                bodies[p] = bodies.get(p, 0) + 1
-        for g in self.m.ground_points:
-            bodies[g] = bodies.get(g, 0) + 1
-        names = self.geo.names
-        joints = [k for k, p in enumerate(names) if bodies.get(p, 0) >= 2]
-        single = [k for k, p in enumerate(names) if bodies.get(p, 0) < 2]
+        """Joints (on two bodies or more, the ground counting as one) as rings, other points
+        as dots, and the name of each."""
+        names, m = self.geo.names, self.m
+        count = Counter([p for lk in m.links for p in lk.point_names] + list(m.ground_points))
+        joints = [k for k, p in enumerate(names) if count[p] >= 2]
         self.joints = (joints, self.ax.plot([], [], "o", ms=6, mfc=PAPER, mec=INK, mew=1.3,
                                             ls="none", zorder=6)[0])
+        single = [k for k, p in enumerate(names) if count[p] < 2]
         self.dots = (single, self.ax.plot([], [], "o", ms=4, color=INK, ls="none", zorder=6)[0])
         self.labels = [self.ax.text(0, 0, p, fontsize=8, zorder=7, ha="center", va="center",
                                     bbox=dict(fc=PAPER, ec="none", alpha=0.75, pad=0.3))
                        for p in names] if labels else []
-        # what surrounds each point: the other points of its bodies, its ground symbol below
-        self.near = {k: sorted({names.index(q) for lk in self.m.links if p in lk.point_names
-                                for q in lk.point_names if q != p}) for k, p in enumerate(names)}
 
     def _free_side(self, k: int, xy: np.ndarray, i: int) -> np.ndarray:
         """A unit vector from point k into free space: minus the sum of the unit vectors
         towards what is drawn around it (its neighbours, a ground symbol, a slide's guide)."""
-        def unit(v):
-            n = np.hypot(*v)
-            return v / n if n > 0 and np.isfinite(n) else np.zeros(2)
-        v = sum((unit(xy[j] - xy[k]) for j in self.near[k]), np.zeros(2))
+        v = sum((_unit(xy[j] - xy[k]) for j in self.near[k]), np.zeros(2))
         name = self.geo.names[k]
         if name in self.m.ground_points:
             v = v + np.array([0.0, -1.0])
         along = None
-        for sl, *_ in self.guides:
-            if sl.point == name:  # a ground guide's hatch is on its -n side
+        for sl, rails, *_ in self.guides:
+            if sl.point == name:  # a ground guide's surface is on one side
                 along = self.geo.slides[sl.name][1][i]
-                v = v + (np.array([along[1], -along[0]]) if sl.along == GROUND else 0.0)
+                v = v + (rails[0][0] * np.array([-along[1], along[0]]) if sl.along == GROUND else 0.0)
         v = -v
         if along is not None and np.isfinite(along).all():  # the guide runs both ways: go across
             n = np.array([-along[1], along[0]])
             v = n * (1.0 if n @ v >= 0 else -1.0)
-        v = unit(v)
+        v = _unit(v)
         return v if v.any() else np.array([0.6, 0.8])
 
     # --- moving to a pose ---
@@ -317,54 +315,49 @@ class _Drawing:
         geo, r = self.geo, self.r
         xy = geo.xy[i] if 0 <= i < len(geo.ok) else np.full((len(geo.names), 2), np.nan)
         for kind, artist, idx in self.bodies:
-            if kind == "polygon":
-                artist.set_xy(xy[idx] if np.isfinite(xy[idx]).all() else np.zeros((len(idx), 2)))
-                artist.set_visible(bool(np.isfinite(xy[idx]).all()))
+            if kind == "bar":
+                artist.set_data(*xy[idx].T)
             else:
-                artist.set_data(xy[idx, 0], xy[idx, 1])
+                artist.set_visible(bool(np.isfinite(xy[idx]).all()))
+                artist.set_xy(np.nan_to_num(xy[idx]))
         for sl, rails, block, hatch in self.guides:
             through, d, s = (a[i] for a in geo.slides[sl.name])
-            ok = bool(np.isfinite(through).all() and np.isfinite(s))
+            fixed = bool(np.isfinite(through).all() and np.isfinite(d).all())  # the guide is there
+            ok = fixed and bool(np.isfinite(s))  # and so is the block
             lo, hi = self.sref[sl.name]
-            w, nrm = 1.4 * r, np.array([-d[1], d[0]]) if ok else np.zeros(2)
-            for sign, rail in zip((-1, 1), rails):  # a channel either side of the line
-                e = np.array([through + lo * d, through + hi * d]) + sign * w * nrm if ok else np.full((2, 2), np.nan)
-                rail.set_data(e[:, 0], e[:, 1])
+            w, nrm = 1.4 * r, np.array([-d[1], d[0]])
+            for side, rail in rails:  # w either side of the line the point keeps to
+                e = np.array([through + lo * d, through + hi * d]) + side * w * nrm
+                rail.set_data(*(e.T if fixed else np.full((2, 2), np.nan)))
             block.set_visible(ok)
             if ok:
                 block.set_xy(_rectangle(xy[geo.names.index(sl.point)], d, 4 * r, 2 * w))
-            if hatch is not None and ok:  # ground guide: ticks on the far side of one rail
-                base = through - w * nrm
-                hatch.set_segments([[base + t * d, base + (t - 0.8 * r) * d - 0.8 * r * nrm]
+            if hatch is not None and fixed:  # a ground guide: ticks beyond its surface
+                side = rails[0][0]
+                base = through + side * w * nrm
+                hatch.set_segments([[base + t * d, base + (t - 0.8 * r) * d + side * 0.8 * r * nrm]
                                     for t in np.arange(lo, hi + 1e-12, 1.2 * r)])
         for idx, line in (self.joints, self.dots):
-            line.set_data(xy[idx, 0], xy[idx, 1])
+            line.set_data(*xy[idx].T)
         for k, t in enumerate(self.labels):
             ok = bool(np.isfinite(xy[k]).all())
             t.set_visible(ok)
             if ok:
                 t.set_position(xy[k] + 3.0 * r * self._free_side(k, xy, i))
         self.caption.set_text(caption)
-        return [a for _, a, _ in self.bodies] + [self.joints[1], self.dots[1], self.caption] + self.labels
 
 
 # --- public drawing functions ---
 
 
 def _caption(sweep: Sweep, i: int) -> str:
-    if not 0 <= i < len(sweep):
-        return ""
     text = ", ".join(f"{k} = {v[i]:.4g}" for k, v in sweep.inputs.items())
     return text + ("" if sweep.status[i] == "ok" else f" ({sweep.status[i]})")
 
 
-def default_pose(sweep: Sweep) -> int:
+def default_pose(sweep: Sweep | np.ndarray) -> int:
     """The pose drawn when none is asked for: the first one solved (0 when none was)."""
-    return default_pose_of(sweep.ok)
-
-
-def default_pose_of(ok: np.ndarray) -> int:
-    k = np.flatnonzero(ok)
+    k = np.flatnonzero(sweep.ok if isinstance(sweep, Sweep) else sweep)
     return int(k[0]) if k.size else 0
 
 
@@ -388,13 +381,10 @@ def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=
 
 
 def _check_paths(m: Mechanism, paths) -> list[str]:
-    if paths is None:
-        return list(m.moving_points)
-    known = set(m.moving_points) | set(m.ground_points)
-    bad = [p for p in paths if p not in known]
+    bad = [p for p in paths or () if p not in m.moving_points + m.ground_points]
     if bad:
-        raise ValueError(f"paths: unknown point(s) {bad} (points: {sorted(known)})")
-    return list(paths)
+        raise ValueError(f"paths: unknown point(s) {bad} (points: {m.ground_points + m.moving_points})")
+    return list(m.moving_points if paths is None else paths)
 
 
 def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, fps: int = 20,
@@ -403,9 +393,7 @@ def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, 
     spread); returns the number of frames written. `captions[i]` titles pose i."""
     require_matplotlib("kincas.plot.animate")
     from matplotlib.animation import PillowWriter
-    ok = np.flatnonzero(sweep.ok)
-    if ok.size == 0:
-        ok = np.array([0])
+    ok = np.flatnonzero(sweep.ok) if sweep.ok.any() else np.array([0])
     pick = ok[np.unique(np.round(np.linspace(0, ok.size - 1, min(frames, ok.size))).astype(int))]
     fig = new_figure(size)
     d = _Drawing(fig.subplots(), m, geometry(m, sweep), _check_paths(m, paths), True, units)
