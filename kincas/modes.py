@@ -1,0 +1,369 @@
+"""Assembly modes: every distinct real assembly of a mechanism at given input values.
+
+A closed chain has, for the same inputs, several ways to be put together: a four-bar two
+(the coupler above or below), an Assur class-III triad up to six. A sweep follows one of
+them, the one its `[guess]` points at. `find_modes` finds them all: Newton's method with the
+exact Jacobian run from many starts scattered over the reachable workspace (every unknown
+angle uniform in (-pi, pi], every floating link's origin within the mechanism's size around
+a ground point), all starts at once in one vectorised evaluation per iteration; the
+converged ones are polished one by one, checked by their residual, and duplicates removed.
+Each `Mode` gives its points and a ready `[guess]` block that picks it.
+
+There is no proof of completeness (a root that no start reaches is missed), but a mode's
+basin of attraction under a trust-region Newton is rarely small: with a few hundred starts
+the six assemblies of the class-III triad are found from every seed in the tests.
+
+>>> import numpy as np, kincas
+>>> from kincas.modes import find_modes
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
+>>> modes = find_modes(m, {"crank.angle": np.pi / 2}, starts=64)
+>>> len(modes), sorted(round(md.points["C"][1], 6) for md in modes)
+(2, [-2.015052, 2.823876])
+>>> print(modes[0].guess_block().splitlines()[0])
+[guess]
+>>> sw = kincas.sweep(m, {"crank.angle": [np.pi / 2, np.pi]}, guess=modes[0].guess)
+>>> bool(abs(sw["C.y"][0] - modes[0].points["C"][1]) < 1e-12)
+True
+"""
+from __future__ import annotations
+
+import json
+import math
+import re
+import sys
+import tomllib
+import weakref
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Mapping
+
+import casadi as ca
+import numpy as np
+
+from .errors import ModelError, SceneError
+from .model import Mechanism
+from .results import wrap_angle
+from .solve import ACCEPT, MAX_STEP, TOL, compile
+
+SAME = 1e-6  # two assemblies are one mode when every point agrees to this times the size
+CONVERGED = 1e-8  # a start whose relative residual reaches this is worth polishing
+
+
+# --- a mode ---
+
+
+@dataclass(frozen=True)
+class Mode:
+    """One real assembly: the unknowns `q`, the moving points' positions, the link angles
+    (radians, wrapped to (-pi, pi]), the relative residual after polishing, the sign of the
+    Jacobian's determinant (which side of the singular positions the mode lies on; 0 when
+    singular), and whether the mechanism's own guess leads to it."""
+
+    q: np.ndarray
+    unknowns: tuple[str, ...]
+    points: dict[str, tuple[float, float]]
+    angles: dict[str, float]
+    residual: float
+    orientation: int
+    from_guess: bool = False
+    inputs: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def guess(self) -> dict[str, tuple[float, float]]:
+        """The points as a guess: `kincas.sweep(m, ..., guess=mode.guess)` follows this mode."""
+        return dict(self.points)
+
+    def guess_block(self, digits: int = 12) -> str:
+        """A `[guess]` section for a scene file that picks this mode.
+
+        >>> Mode(np.zeros(1), ("a",), {"C": (1.0, -2.5)}, {}, 0.0, 1).guess_block()
+        '[guess]\\nC = [1, -2.5]\\n'
+        """
+        rows = [f"{p} = [{x:.{digits}g}, {y:.{digits}g}]" for p, (x, y) in self.points.items()]
+        return "[guess]\n" + "".join(r + "\n" for r in rows)
+
+
+# --- the search ---
+
+
+def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
+               iterations: int = 60) -> list[Mode]:
+    """The distinct real assemblies of `m` at `inputs` (input key -> value; a plain number
+    for a one-input mechanism; nothing for a structure without inputs).
+
+    Deterministic for a given `seed`. Modes are sorted by their points (x, then y, of each
+    moving point in declaration order); an empty list means no assembly was found.
+    """
+    if starts < 1:
+        raise ModelError(f"starts: expected a whole number >= 1, got {starts!r}")
+    model = compile(m)
+    u = _input_vector(m, inputs)
+    driven = {i.target: float(u[k]) for k, i in enumerate(m.inputs) if i.kind == "parameter"}
+    m_at = m.with_parameters(**driven) if driven else m
+    p = np.array([v for _, v in m.parameters], dtype=float)
+    L = m_at.size()
+
+    # The mechanism's own guess is start 0, so the mode a sweep would take is always found.
+    guess = {k: (m_at.value(x), m_at.value(y)) for k, (x, y) in m.guess}
+    Q = np.vstack([model.initial_q(u, p, guess, L), _scatter(m_at, model, starts - 1, L, seed)])
+    Q, r = _batch_newton(model, Q, u, p, L, iterations)
+    Q = Q[np.isfinite(r) & (r <= CONVERGED)]
+    Q = Q[_unique(_point_rows(model, Q, u, p), 10 * SAME * L)]  # many starts, few modes
+
+    found = [sol.q for sol in (model.newton(q, u, p, L) for q in Q) if sol.ok]  # polish
+    from .solve import sweep  # the assembly a sweep from the mechanism's guess starts on
+    first = sweep(m, {k: [v] for k, v in zip([i.key for i in m.inputs], u)}, report=[])
+    picked = first.q[0] if first.ok[0] else None
+    return _distinct(m, model, found + ([picked] if picked is not None else []), u, p, L, picked)
+
+
+def _input_vector(m: Mechanism, inputs) -> np.ndarray:
+    keys = [i.key for i in m.inputs]
+    if inputs is None:
+        inputs = {}
+    elif not isinstance(inputs, Mapping):
+        if len(keys) != 1:
+            raise ModelError(f"inputs: the mechanism has inputs {keys}; give a mapping")
+        inputs = {keys[0]: inputs}
+    problems = [f"inputs: {k!r} is not an input (inputs: {keys})" for k in inputs if k not in keys]
+    problems += [f"inputs: no value for input {k!r}" for k in keys if k not in inputs]
+    vals = {}
+    for k, v in inputs.items():
+        v = np.asarray(v, dtype=float)
+        if v.size != 1 or not np.isfinite(v).all():
+            problems.append(f"inputs: {k!r}: expected one finite number, got {inputs[k]!r}")
+        else:
+            vals[k] = float(v.ravel()[0])
+    if problems:
+        raise ModelError(problems)
+    return np.array([vals[k] for k in keys], dtype=float)
+
+
+def _scatter(m: Mechanism, model, n: int, L: float, seed: int) -> np.ndarray:
+    """n starts over the reachable workspace: angles uniform in (-pi, pi]; the origin of a
+    floating link uniform in a square of half-side L around a randomly chosen ground point."""
+    rng = np.random.default_rng(seed)
+    names = [nm for nm, _ in model.sym.unknowns]
+    Q = rng.uniform(-math.pi, math.pi, size=(n, len(names)))
+    ground = np.array([(m.value(x), m.value(y)) for _, (x, y) in m.ground]).reshape(-1, 2)
+    if len(ground) == 0:
+        ground = np.zeros((1, 2))
+    for j, nm in enumerate(names):
+        if nm.endswith(".x") and f"{nm[:-2]}.y" in names:  # a floating link's origin
+            jy = names.index(f"{nm[:-2]}.y")
+            centre = ground[rng.integers(len(ground), size=n)]
+            Q[:, j], Q[:, jy] = (centre + rng.uniform(-L, L, size=(n, 2))).T
+    return Q
+
+
+# --- Newton from every start at once ---
+
+_STEPS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _step_function(model) -> ca.Function:
+    """(q, u, p, L) -> (q after one Newton step, relative residual at q), one start.
+
+    The step solves g_q dq = -g with the exact Jacobian and is shortened so that no angle
+    moves by more than MAX_STEP rad and no coordinate by more than MAX_STEP * L: a trust
+    region that keeps a start from being thrown across the workspace by a near-singular
+    Jacobian. Where g_q is singular the step is NaN and that start is dropped.
+    """
+    if model not in _STEPS:
+        sym = model.sym
+        Ls = ca.SX.sym("L")
+        dq = -ca.solve(sym.Jq, sym.g)
+        scale = ca.if_else(ca.DM(sym.is_length.astype(float)), MAX_STEP * Ls, MAX_STEP)
+        shrink = ca.fmax(1, ca.mmax(ca.fabs(dq) / scale)) if sym.nq else ca.SX(1)
+        r = ca.mmax(ca.fabs(sym.g)) / Ls if sym.nq else ca.SX(0)
+        _STEPS[model] = ca.Function("newton_step", [sym.q, sym.u, sym.p, Ls],
+                                    [sym.q + dq / shrink, r])
+    return _STEPS[model]
+
+
+def _batch_newton(model, Q, u, p, L, iterations):
+    """Trust-region Newton on every row of Q at once; returns the iterates and their
+    relative residuals (NaN where a start diverged)."""
+    n = Q.shape[0]
+    if model.nq == 0:
+        return Q, np.full(n, np.abs(model.residual(np.zeros(0), u, p)).max(initial=0.0) / L)
+    step = _step_function(model).map(n)
+    U, P = np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)
+    X, r = Q.T.copy(), np.full(n, np.inf)
+    for _ in range(iterations):
+        Xn, rn = (np.asarray(a) for a in step(X, U, P, L))
+        r = rn.ravel()
+        done = ~np.isfinite(r) | (r <= TOL)
+        X = np.where(done, X, Xn)  # a converged start stays where it is
+        if done.all():
+            break
+    r = np.where(np.all(np.isfinite(X), axis=0), r, np.nan)
+    return X.T, r
+
+
+# --- duplicates ---
+
+
+def _point_rows(model, Q, u, p) -> np.ndarray:
+    """The moving points of every row of Q, one row (x1, y1, x2, y2, ...) per start."""
+    n = Q.shape[0]
+    if n == 0:
+        return np.zeros((0, 0))
+    f = model.sym.f_points.map(n)
+    pts = np.asarray(f(Q.T, np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)))
+    return pts.reshape(2, -1, n, order="F").transpose(2, 1, 0).reshape(n, -1)
+
+
+def _unique(rows: np.ndarray, tol: float) -> list[int]:
+    """Indices of the first row of each group of rows that agree to `tol` (max norm)."""
+    keep: list[int] = []
+    for k, row in enumerate(rows):
+        if all(np.abs(row - rows[j]).max() > tol for j in keep):
+            keep.append(k)
+    return keep
+
+
+def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
+    """One Mode per distinct assembly: two solutions are the same mode when all their moving
+    points agree to SAME * L (the points fix every link's angle modulo 2 pi)."""
+    sym, names = model.sym, m.moving_points
+    picked = None if picked_q is None else model.points(picked_q, u, p).T.ravel()
+    Q = np.array(found).reshape(len(found), model.nq)
+    rows = _point_rows(model, Q, u, p)
+    keep = [(Q[k], rows[k]) for k in _unique(rows, SAME * L)]
+    keep.sort(key=lambda t: tuple(np.round(t[1] / (SAME * L))))
+    links = [lk.name for lk in m.links]
+    out = []
+    s = np.where(sym.is_length, 1.0, 1.0 / L)  # columns scaled to O(1), as solve.py does
+    for q, pts in keep:
+        ang = model.quantities([f"{lk}.angle" for lk in links], q[None, :], u[None, :], p,
+                               np.ones((1, len(u))), np.zeros((1, len(u))))[:, 0]
+        det = np.linalg.det(model.jac(q, u, p) * s) if model.nq else 1.0
+        res = float(np.abs(model.residual(q, u, p)).max(initial=0.0) / L)
+        out.append(Mode(q=np.array(q), unknowns=tuple(nm for nm, _ in sym.unknowns),
+                        points={nm: (float(pts[2 * j]), float(pts[2 * j + 1]))
+                                for j, nm in enumerate(names)},
+                        angles={lk: float(wrap_angle(a)) for lk, a in zip(links, ang)},
+                        residual=res, orientation=int(np.sign(det)) if abs(det) > 1e-12 else 0,
+                        from_guess=bool(picked is not None and np.abs(pts - picked).max() <= SAME * L),
+                        inputs={i.key: float(v) for i, v in zip(m.inputs, u)}))
+    return [md for md in out if md.residual <= ACCEPT]  # each checked by its residual
+
+
+# --- scenes with a mode's guess ---
+
+_GUESS_HEADER = re.compile(r"^\s*\[\s*guess\s*\]\s*(#.*)?$")
+_ANY_HEADER = re.compile(r"^\s*\[")
+_FILLER = re.compile(r"^\s*(#.*)?$")
+
+
+def scene_with_guess(text: str, mode: Mode, note: str = "") -> str:
+    """The scene's TOML text with its `[guess]` table replaced by the mode's (appended when
+    the scene has none); everything else is kept as written.
+
+    >>> md = Mode(np.zeros(1), ("a",), {"C": (3.5, -2.0)}, {}, 0.0, 1)
+    >>> print(scene_with_guess('a = 1\\n[guess]\\nC = [1, 2]\\n\\n[output]\\n', md), end="")
+    a = 1
+    [guess]
+    C = [3.5, -2]
+    <BLANKLINE>
+    [output]
+    """
+    lines = text.splitlines(keepends=True)
+    if lines and not lines[-1].endswith("\n"):
+        lines[-1] += "\n"
+    block = ([f"# {note}\n"] if note else []) + mode.guess_block().splitlines(keepends=True)
+    start = next((i for i, ln in enumerate(lines) if _GUESS_HEADER.match(ln)), None)
+    if start is None:
+        lines += ["\n"] + block
+    else:
+        end = next((j for j in range(start + 1, len(lines)) if _ANY_HEADER.match(lines[j])), len(lines))
+        while end > start + 1 and _FILLER.match(lines[end - 1]):
+            end -= 1  # blank lines and comments before the next table belong to it
+        lines[start:end] = block
+    out = "".join(lines)
+    try:
+        written = tomllib.loads(out).get("guess", {})
+    except tomllib.TOMLDecodeError:
+        written = None
+    if written is None or set(written) != set(mode.points):
+        raise SceneError("[guess]: not written as a [guess] table, so it cannot be replaced; "
+                         "copy the printed [guess] block into the scene instead")
+    return out
+
+
+# --- the command line: kincas modes SCENE.toml ---
+
+
+def cli_arguments(parser) -> None:
+    """Arguments of `kincas modes`."""
+    parser.add_argument("scene", help="the scene file (TOML)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--starts", type=int, default=512,
+                        help="number of scattered Newton starts (default 512)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the scattered starts")
+    parser.add_argument("--write", metavar="DIR",
+                        help="also write DIR/<scene>_mode<k>.toml: the scene with mode k's [guess]")
+
+
+def cli_run(args) -> int:
+    """Find the modes at the scene's first pose; print them (and write scenes with --write).
+    Exit status 0 when at least one assembly was found, 3 when none."""
+    from .scene import load
+    if args.starts < 1:
+        raise SceneError(f"--starts: expected a whole number >= 1, got {args.starts}")
+    sc = load(args.scene)
+    at = {k: float(v[0]) for k, v in sc.study.inputs.items()}
+    modes = find_modes(sc.mechanism, at, starts=args.starts, seed=args.seed)
+    deg = sc.study.deg
+    user_in = {k: (math.degrees(v) if deg and k.endswith(".angle") else v) for k, v in at.items()}
+    user_ang = [{lk: (math.degrees(a) if deg else a) for lk, a in md.angles.items()} for md in modes]
+    if args.write:
+        _write_scenes(args.scene, args.write, modes)
+    if args.json:
+        doc = {"title": sc.study.title, "units": sc.study.units, "inputs": user_in,
+               "starts": args.starts, "seed": args.seed,
+               "modes": [{"points": {p: list(xy) for p, xy in md.points.items()},
+                          "angles": ang, "residual": md.residual, "orientation": md.orientation,
+                          "from_guess": md.from_guess, "guess": md.guess_block()}
+                         for md, ang in zip(modes, user_ang)]}
+        json.dump(doc, sys.stdout, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        _print_modes(sc, modes, user_in, user_ang, args)
+    return 0 if modes else 3
+
+
+def _print_modes(sc, modes, user_in, user_ang, args):
+    units = sc.study.units
+    unit = {k: units.get("angle", "deg") if k.endswith(".angle") else
+            units.get("length", "") if k.endswith(".s") else "" for k in user_in}
+    at = ", ".join(f"{k} = {v:.6g}" + (f" {unit[k]}" if unit[k] else "") for k, v in user_in.items())
+    print(sc.study.title or "kincas")
+    n = len(modes)
+    print(f"{n} assembly mode{'s' if n != 1 else ''}" + (f" at {at}" if at else "")
+          + f" ({args.starts} starts, seed {args.seed})")
+    for k, (md, ang) in enumerate(zip(modes, user_ang), 1):
+        mark = "  <- the scene's [guess] gives this one" if md.from_guess else ""
+        print(f"\nmode {k} of {n}: residual {md.residual:.1e}, orientation {md.orientation:+d}{mark}")
+        print("  angles: " + ", ".join(f"{lk} {a:.6g}" for lk, a in ang.items())
+              + f" {units.get('angle', 'deg')}")
+        print(md.guess_block(), end="")
+    if not modes:
+        print("no assembly found: the mechanism cannot be put together at this input")
+
+
+def _write_scenes(path, directory, modes) -> list[Path]:
+    """DIR/<scene>_mode<k>.toml for every mode: the scene as written, with that mode's guess."""
+    src, out = Path(path), Path(directory)
+    text = src.read_text(encoding="utf-8")
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for k, md in enumerate(modes, 1):
+        target = out / f"{src.stem}_mode{k}.toml"
+        note = f"assembly mode {k} of {len(modes)}, found by `kincas modes {src.name}`"
+        target.write_text(scene_with_guess(text, md, note), encoding="utf-8")
+        written.append(target)
+    return written
