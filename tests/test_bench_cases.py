@@ -1,0 +1,130 @@
+"""The benchmark harness's own correctness (no timing here): its references agree with each
+other and with the geometry, and its classification counts what it says it counts."""
+from __future__ import annotations
+
+import doctest
+import importlib
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mpmath")  # the references' 30-digit arithmetic
+pytest.importorskip("scipy")
+BENCH = Path(__file__).resolve().parent.parent / "benchmarks"
+sys.path.insert(0, str(BENCH))
+
+import cases  # noqa: E402
+from peers import Run  # noqa: E402
+from peers.closed_form import reference, solve_numpy  # noqa: E402
+from peers.measure import classify, errors  # noqa: E402
+from peers.mp_newton import pairs  # noqa: E402
+from peers.mp_newton import reference as newton_reference  # noqa: E402
+
+SMALL = [cases.fourbar(12), cases.slider_crank(12), cases.jansen(12)]
+
+
+def constraint_violation(case, P) -> float:
+    """Largest |distance - length| / L over every link, and every slide point's distance from its line."""
+    worst = 0.0
+    for p, q, l in pairs(case):
+        worst = max(worst, np.abs(np.linalg.norm(P[p] - P[q], axis=1) - l).max())
+    for p, t, ang in case.slides:
+        w = P[p] - np.asarray(case.ground[t])
+        worst = max(worst, np.abs(w[:, 1] * math.cos(ang) - w[:, 0] * math.sin(ang)).max())
+    return worst / case.size
+
+
+@pytest.mark.parametrize("case", SMALL, ids=lambda c: c.name)
+def test_closed_forms_keep_every_link_length(case):
+    P, _ = reference(case)
+    assert constraint_violation(case, P) < 1e-14
+
+
+@pytest.mark.parametrize("case", SMALL, ids=lambda c: c.name)
+def test_numpy_closed_form_agrees_with_the_30_digit_one(case):
+    P, V = reference(case)
+    Pn, Vn = solve_numpy(case)
+    for p in case.moving:
+        assert np.abs(Pn[p] - P[p]).max() < 1e-13 * case.size
+        assert np.abs(Vn[p] - V[p]).max() < 1e-11 * case.size * case.omega
+
+
+@pytest.mark.parametrize("case", SMALL, ids=lambda c: c.name)
+def test_two_independent_references_agree(case):
+    """The closed form and the 30-digit Newton method on the distance equations (the class-III
+    reference) give the same positions and velocities on the dyad chains."""
+    P, V = reference(case)
+    Q, W = newton_reference(case)
+    for p in case.moving:
+        assert np.abs(Q[p] - P[p]).max() < 1e-15 * case.size
+        assert np.abs(W[p] - V[p]).max() < 1e-14 * case.size * case.omega
+
+
+@pytest.mark.parametrize("case", SMALL + [cases.class3(12)], ids=lambda c: c.name)
+def test_reference_velocities_match_central_differences(case):
+    h = 1e-6
+    Pp, _ = reference(case.with_theta(case.theta + h))
+    Pm, _ = reference(case.with_theta(case.theta - h))
+    _, V = reference(case)
+    for p in case.moving:
+        fd = (Pp[p] - Pm[p]) / (2 * h) * case.omega
+        assert np.abs(fd - V[p]).max() < 1e-7 * case.size * case.omega
+
+
+def test_class3_reference_is_a_solution_of_the_triad():
+    case = cases.class3(24)
+    P, V = reference(case)
+    assert np.isfinite(P["P1"]).all()
+    assert constraint_violation(case, P) < 1e-14
+
+
+def test_jansen_uses_the_published_lengths_and_walks():
+    case = cases.jansen(72)
+    P, _ = reference(case)
+    lengths = sorted(x for _, _, ls in case.links for x in ls) + [case.crank[2]]
+    assert sorted(lengths) == sorted(v for k, v in cases.JANSEN.items() if k not in "al")
+    foot = P["F"]
+    assert np.isfinite(foot).all()
+    # the foot's path: a long, nearly flat bottom (the stride) and a lift well above it
+    low = foot[:, 1] < foot[:, 1].min() + 0.5
+    assert np.ptp(foot[low, 0]) > 30 and np.ptp(foot[:, 1]) > 10
+
+
+def test_classify_counts_a_branch_jump_and_a_false_claim():
+    case = cases.stiff_cases(36)[-1]  # the triple rocker: some poses do not assemble
+    P, _ = reference(case)
+    alt = [reference(case, steps=s)[0] for s in cases.alternatives(case)]
+    other = next(O for O in alt if np.nanmax(np.abs(O["B"] - P["B"])) > 1e-3)
+    ok = np.isfinite(P["B"]).all(axis=1)
+    k = int(np.flatnonzero(ok & (np.linalg.norm(other["B"] - P["B"], axis=1) > 1e-3))[0])
+    run_P = {p: P[p].copy() for p in case.outputs}
+    run_P["B"][k] = other["B"][k]
+    bad = int(np.flatnonzero(~ok)[0])
+    run_P["A"][bad], run_P["B"][bad] = (0.0, 0.0), (1.0, 1.0)
+    c = classify(case, Run(run_P, None, np.ones(case.theta.size, dtype=bool)), P, alt)
+    assert (c["jumps"], c["false"], c["wrong"]) == (1, 1, 0)
+    assert c["correct"] == ok.sum() - 1
+
+
+def test_errors_are_relative_and_ignore_unsolved_poses():
+    case = cases.fourbar(6)
+    P, V = reference(case)
+    run = Run({p: P[p] + [case.size * 1e-9, 0] for p in case.outputs},
+              {p: V[p].copy() for p in case.outputs}, np.array([True] * 5 + [False]))
+    run.P["B"][5] += 1.0  # an unsolved pose's values do not count
+    pe, ve = errors(case, run, P, V)
+    assert pe == pytest.approx(1e-9, rel=1e-5) and ve == 0.0
+
+
+@pytest.mark.parametrize("module", ["cases", "peers", "peers.closed_form", "peers.mp_newton", "peers.measure",
+                                    "peers.report", "peers.fsolve_peer", "peers.kincas_runs",
+                                    "peers.solvespace_peer", "peers.mechanism_peer"])
+def test_doctests_of_the_harness(module):
+    mod = importlib.import_module(module)
+    if hasattr(mod, "available") and mod.available() is not None:
+        pytest.skip(f"{module}: its peer is not installed")
+    result = doctest.testmod(mod)
+    assert result.failed == 0 and result.attempted > 0
