@@ -1,0 +1,163 @@
+"""CasADi functions compiled with a C driver into a shared library, cached on disk.
+
+`Library` code-generates casadi functions together with a hand-written C loop that calls
+them, compiles the whole with the C compiler ($CC, else gcc or cc) and keeps the result in
+the cache directory under a hash of its source, the compiler and casadi's version: a second
+process, or a second run, loads it without compiling. `Backend` decides when compiling is
+worth it and falls back to casadi's virtual machine, with a warning, when it fails: a missing
+compiler never fails a user's solve.
+
+>>> import casadi as ca
+>>> x = ca.SX.sym("x")
+>>> lib = Library("kincas_doc", [ca.Function("twice", [x], [2 * x])], "", {}, {})
+>>> lib.path.suffix, len(lib.path.stem) > 20
+('.so', True)
+"""
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import shutil
+import subprocess
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+
+COMPILE_MIN_POSES = 50_000  # compile=None compiles for fewer poses only if already cached
+_FLAGS = ["-O3", "-shared", "-fPIC", "-Wl,-Bsymbolic"]  # own symbols bind inside each library
+_LIBS: dict[str, ctypes.CDLL] = {}  # loaded libraries by path (the path holds the hash)
+
+
+def cache_dir() -> Path:
+    """Where compiled libraries are kept: $KINCAS_CACHE, else $XDG_CACHE_HOME/kincas, else
+    ~/.cache/kincas.
+
+    >>> cache_dir().name == "kincas" or "KINCAS_CACHE" in os.environ
+    True
+    """
+    if os.environ.get("KINCAS_CACHE"):
+        return Path(os.environ["KINCAS_CACHE"])
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "kincas"
+
+
+def compiling_disabled() -> bool:
+    """$KINCAS_NO_COMPILE set (to anything but 0): always use the virtual machine."""
+    return os.environ.get("KINCAS_NO_COMPILE", "") not in ("", "0")
+
+
+class Library:
+    """Casadi functions code-generated with a C driver, compiled once, cached on disk.
+
+    `defines` become C macros ahead of the driver (SZ_ARG, SZ_RES, SZ_IW, SZ_W, the largest
+    work sizes of the functions, are added); `signatures` gives the ctypes argument types of
+    the driver's entry points (each returns an int). `cached` says whether it was found
+    built; `times` the seconds spent generating, compiling and loading. `load()` raises on
+    any failure.
+    """
+
+    def __init__(self, tag: str, functions: list[ca.Function], driver: str, defines: dict,
+                 signatures: dict[str, list]):
+        t0 = time.perf_counter()
+        cg = ca.CodeGenerator(f"{tag}.c", {"with_header": False})
+        for f in functions:
+            cg.add(f)
+        work = {"SZ_ARG": [f.sz_arg() for f in functions], "SZ_RES": [f.sz_res() for f in functions],
+                "SZ_IW": [f.sz_iw() for f in functions], "SZ_W": [f.sz_w() for f in functions]}
+        defines = {**{k: max([1, *v]) for k, v in work.items()}, **defines}
+        self.source = cg.dump() + "".join(f"#define {k} {v}\n" for k, v in defines.items()) + driver
+        self.cc = os.environ.get("CC") or shutil.which("gcc") or shutil.which("cc")
+        key = hashlib.sha256("\n".join([self.source, str(self.cc), *_FLAGS, ca.__version__]).encode())
+        self.path = cache_dir() / f"{tag}-{key.hexdigest()[:24]}.so"
+        self.cached = str(self.path) in _LIBS or self.path.exists()
+        self.signatures = signatures
+        self.times = {"generate": time.perf_counter() - t0, "compile": 0.0, "load": 0.0}
+
+    def load(self) -> ctypes.CDLL:
+        """The loaded library, compiled first if it is not in the cache."""
+        if str(self.path) not in _LIBS:
+            if not self.path.exists():
+                self._compile()
+            t0 = time.perf_counter()
+            lib = ctypes.CDLL(str(self.path))
+            for name, args in self.signatures.items():
+                getattr(lib, name).argtypes, getattr(lib, name).restype = args, ctypes.c_int
+            _LIBS[str(self.path)] = lib
+            self.times["load"] = time.perf_counter() - t0
+        return _LIBS[str(self.path)]
+
+    def _compile(self):
+        if self.cc is None:
+            raise RuntimeError("no C compiler found (set CC)")
+        t0 = time.perf_counter()
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(dir=self.path.parent) as tmp:
+            src, out = Path(tmp) / "k.c", Path(tmp) / "k.so"
+            src.write_text(self.source)
+            done = subprocess.run([self.cc, *_FLAGS, str(src), "-o", str(out), "-lm"],
+                                  capture_output=True, text=True, timeout=600)
+            if done.returncode != 0:
+                raise RuntimeError(f"{self.cc} failed: {done.stderr.strip()[-400:]}")
+            os.replace(out, self.path)  # atomic: other processes see all of it or nothing
+        self.times["compile"] = time.perf_counter() - t0
+
+
+class Backend:
+    """Chooses between a compiled `Library` and casadi's virtual machine.
+
+    compile=True: compile when first needed; False (or $KINCAS_NO_COMPILE): never; None:
+    compile when the library is already cached or a call has COMPILE_MIN_POSES poses or
+    more. `make_library()` builds the `Library` (code generation only) when first asked.
+
+    >>> Backend(False, None, "nothing").compiled(10**6) is None
+    True
+    """
+
+    def __init__(self, compile, make_library, what: str):
+        self.compile, self.make_library, self.what = compile, make_library, what
+        self.library: Library | None = None
+        self.lib: ctypes.CDLL | None = None
+        self.failed = False
+
+    def compiled(self, n: int) -> ctypes.CDLL | None:
+        """The loaded library to use for n poses, or None for the virtual machine."""
+        if self.lib is not None or self.failed or self.compile is False or compiling_disabled():
+            return self.lib
+        try:  # a failed build must never fail a user's solve
+            if self.library is None:
+                self.library = self.make_library()
+            if self.compile or self.library.cached or n >= COMPILE_MIN_POSES:
+                self.lib = self.library.load()
+        except Exception as e:
+            self.failed = True
+            warnings.warn(f"kincas: could not compile the {self.what} ({e}); using the slower "
+                          f"uncompiled path", RuntimeWarning, stacklevel=3)
+        return self.lib
+
+
+# --- numpy arrays handed to C without copies ---
+
+
+def ptr(a: np.ndarray, offset: int = 0) -> int:
+    """The address of a float64 array's element `offset` (C order)."""
+    return a.ctypes.data + 8 * offset
+
+
+def rows(a, n: int, width: int) -> tuple[np.ndarray, int]:
+    """(array, row stride in elements) of an (n, width) float64 table given as a table or
+    as one row for every pose (stride 0): no copy unless the table is not C-contiguous.
+
+    >>> rows([1.0, 2.0], 5, 2)[1], rows(np.zeros((5, 2)), 5, 2)[1]
+    (0, 2)
+    """
+    a = np.asarray(a, dtype=float)
+    if a.ndim == 1 and a.shape[0] == width:
+        return np.ascontiguousarray(a), 0
+    a = np.broadcast_to(a.reshape(-1, width), (n, width))
+    if width == 0 or a.strides[0] == 0:
+        return np.ascontiguousarray(a[0] if n else np.zeros(width)), 0
+    return np.ascontiguousarray(a), width

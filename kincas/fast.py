@@ -1,0 +1,412 @@
+"""Fast sweeps: each pose predicted along the tangent and corrected by Newton, in compiled C.
+
+The careful path (`kincas.solve`) spends about 70 us per pose in Python. Here one call solves
+a whole stretch of a sweep: pose k is predicted from the last solved pose along the exact
+tangent, q_pred = q_prev + dq/du (u_k - u_prev) with dq/du = -g_q^-1 g_u, then corrected by
+Newton, q <- q - g_q^-1 g, until the next step would be negligible. A pose is *accepted* only
+when it is verified in the same pass:
+
+- residual: max |g| / L <= RESIDUAL (the careful path's acceptance);
+- converged: the Newton step that would follow, |g_q^-1 g| (radians, lengths / L) <= STEP;
+- same branch: M = J_prev^-1 J with J = g_q. If ||D^-1 (M - I) D|| < 1 (D scales lengths by
+  L), every matrix on the segment from I to M is invertible, so det M > 0: det g_q kept its
+  sign and no singular position lies between the two poses. The test fails near a singular
+  position too (J_prev^-1 grows), where fixed-step kernels jump branch silently;
+- small correction: ||D^-1 (q - q_pred)|| <= CORRECTION.
+
+The pass stops at the first pose that fails (every later pose would start from it); the
+caller re-solves that pose carefully and restarts the pass after it (`FastRun.advance`: a
+call, not a recompilation; `FastSweeper.sweep` runs that loop). The reported quantities are
+computed in the same pass, sharing the trigonometry of the last Newton evaluation. Compiled
+(see `kincas.cbuild`): the casadi functions are code-generated and driven by a small C loop,
+the library cached on disk. Without a compiler, or with KINCAS_NO_COMPILE=1, the same
+arithmetic runs in casadi's virtual machine, `mapaccum` over chunks of CHUNK poses.
+
+>>> import numpy as np, kincas
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
+>>> model, U = kincas.compile(m), np.linspace(0, 2 * np.pi, 721)[:, None]
+>>> q0 = model.newton(model.initial_q(U[0], [], {"C": (3.6, 2.9)}, 5), U[0], [], 5).q
+>>> run = FastSweeper(model, compile=False).run(U, [], 5.0, q0, U[0], start=1)
+>>> run.first_bad, bool(run.residual[1:].max() < 1e-14)
+(721, True)
+"""
+from __future__ import annotations
+
+import ctypes
+import weakref
+
+import casadi as ca
+import numpy as np
+
+from .cbuild import Backend, Library, ptr, rows
+
+RESIDUAL = 1e-10  # as the careful path's ACCEPT: max |g| / L
+STEP = 1e-12  # the next Newton step (radians, or lengths / L): the error left in q
+JAC_CHANGE = 0.9  # sum |entries of D^-1 (J_prev^-1 J - I) D| (below 1 keeps det's sign)
+CORRECTION = 0.25  # ||D^-1 (q - q_pred)||_1: Newton may not wander far from the prediction
+MAX_EVALS = 5  # residual evaluations per pose: at the prediction and after up to 4 steps
+CHUNK = 256  # poses per call on the uncompiled (virtual machine) path
+INFO = ("residual", "step", "jac_change", "correction", "evaluations")
+
+
+# --- the casadi functions: prediction, Newton evaluation, acceptance measures ---
+
+
+def _kernel_functions(sym, qf: ca.Function | None) -> list[ca.Function]:
+    """kP (predict), kE (at q: Newton step, J, tangent, residual and step size, quantities)
+    and kC (Jacobian change, correction). Outputs dense, so that C can index them."""
+    nq, nu = sym.nq, sym.nu
+    q, qp, J, J0 = ca.SX.sym("q", nq), ca.SX.sym("qp", nq), ca.SX.sym("J", nq, nq), ca.SX.sym("J0", nq, nq)
+    T0, u0, u = ca.SX.sym("T0", nq, nu), ca.SX.sym("u0", nu), ca.SX.sym("u", nu)
+    p, L, ud, udd = ca.SX.sym("p", sym.np), ca.SX.sym("L"), ca.SX.sym("ud", nu), ca.SX.sym("udd", nu)
+    D = ca.if_else(ca.DM(sym.is_length.astype(float)), L, 1)  # the scale of each unknown
+    g, Jq, Ju = ca.Function("G", [sym.q, sym.u, sym.p], [sym.g, sym.Jq, sym.Ju])(q, u, p)
+    sol = ca.solve(Jq, ca.horzcat(g, Ju))  # one factorisation: Newton step and tangent
+    rs = ca.vertcat(ca.mmax(ca.fabs(g)) / L, ca.norm_1(sol[:, 0] / D))  # a sum keeps NaNs
+    y = ca.densify(qf(q, u, p, ud, udd)) if qf is not None else ca.SX(0, 1)
+    M = (ca.solve(J0, J) - ca.DM.eye(nq)) * ca.repmat(D.T, nq, 1) / ca.repmat(D, 1, nq)
+    mc = ca.vertcat(ca.sum1(ca.sum2(ca.fabs(M))), ca.norm_1((q - qp) / D))
+    d, o = ca.densify, {"cse": True}  # cse: one sin and cos per angle, shared by everything
+    return [ca.Function("kP", [q, T0, u0, u], [d(q + ca.mtimes(T0, u - u0))], o),
+            ca.Function("kE", [q, u, p, L, ud, udd], [d(sol[:, 0]), d(Jq), d(-sol[:, 1:]), rs, y], o),
+            ca.Function("kC", [J0, J, qp, q, L], [mc], o)]
+
+
+def _vm_step(kP, kE, kC, nq, nu, max_evals) -> ca.Function:
+    """One pose with a fixed number of evaluations for the virtual machine: once converged,
+    q stays put, so it ends where the compiled loop stops (the same arithmetic)."""
+    q0, J0, T0, u0 = ca.SX.sym("q0", nq), ca.SX.sym("J0", nq, nq), ca.SX.sym("T0", nq, nu), ca.SX.sym("u0", nu)
+    u, p, L, thr = ca.SX.sym("u", nu), ca.SX.sym("p", kE.size1_in(2)), ca.SX.sym("L"), ca.SX.sym("t", 4)
+    ud, udd = ca.SX.sym("ud", nu), ca.SX.sym("udd", nu)
+    q = qp = kP(q0, T0, u0, u)
+    done, evals = ca.SX(0), ca.SX(0)
+    for i in range(max_evals):
+        dq, J, T, rs, y = kE(q, u, p, L, ud, udd)
+        evals += 1 - done
+        done = ca.logic_or(done, ca.logic_and(rs[0] <= thr[0], rs[1] <= thr[1]))
+        if i < max_evals - 1:
+            q = ca.if_else(done, q, q - dq)
+    info = ca.vertcat(rs, kC(J0, J, qp, q, L), evals)
+    return ca.Function("kS", [q0, J0, T0, u0, u, p, L, thr, ud, udd], [q, J, T, u, info, y])
+
+
+# --- the C loops around them (NQ, NU, NO: sizes; state s = q, J, dq/du, u column-major) ---
+
+_SWEEP_C = """
+int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const casadi_real* L,
+                 const casadi_real* thr, casadi_int max_evals, casadi_real* s, casadi_real* Q,
+                 casadi_real* info, casadi_int ld, const casadi_real* Ud, casadi_int sud,
+                 const casadi_real* Udd, casadi_int sudd, casadi_real* vals) {
+  const casadi_real* arg[SZ_ARG]; casadi_real* res[SZ_RES]; casadi_int iw[SZ_IW]; casadi_real w[SZ_W];
+  casadi_real qp[NQ], q[NQ], dq[NQ], J[NQ*NQ], T[NQ*NU], rs[2], mc[2], y[NO > 0 ? NO : 1];
+  casadi_int k, i, it;
+  for (k = 0; k < n; ++k) {
+    const casadi_real* u = U + k*NU;
+    int conv = 0;
+    arg[0] = s; arg[1] = s + NQ + NQ*NQ; arg[2] = s + NQ + NQ*NQ + NQ*NU; arg[3] = u; res[0] = qp;
+    if (kP(arg, res, iw, w, 0)) break;
+    for (i = 0; i < NQ; ++i) q[i] = qp[i];
+    for (it = 1; ; ++it) {  /* Newton until the next step is negligible */
+      arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = L; arg[4] = Ud + k*sud; arg[5] = Udd + k*sudd;
+      res[0] = dq; res[1] = J; res[2] = T; res[3] = rs; res[4] = y;
+      if (kE(arg, res, iw, w, 0)) break;
+      if (rs[0] <= thr[0] && rs[1] <= thr[1]) { conv = 1; break; }
+      if (it >= max_evals) break;
+      for (i = 0; i < NQ; ++i) q[i] -= dq[i];
+    }
+    arg[0] = s + NQ; arg[1] = J; arg[2] = qp; arg[3] = q; arg[4] = L; res[0] = mc;
+    if (kC(arg, res, iw, w, 0)) break;
+    for (i = 0; i < NQ; ++i) Q[k*NQ + i] = q[i];
+    for (i = 0; i < NO; ++i) vals[i*ld + k] = y[i];  /* one contiguous row per quantity */
+    info[k] = rs[0]; info[ld + k] = rs[1]; info[2*ld + k] = mc[0]; info[3*ld + k] = mc[1];
+    info[4*ld + k] = (casadi_real) it;
+    if (!(conv && mc[0] <= thr[2] && mc[1] <= thr[3])) break;
+    for (i = 0; i < NQ; ++i) s[i] = q[i];
+    for (i = 0; i < NQ*NQ; ++i) s[NQ + i] = J[i];
+    for (i = 0; i < NQ*NU; ++i) s[NQ + NQ*NQ + i] = T[i];
+    for (i = 0; i < NU; ++i) s[NQ + NQ*NQ + NQ*NU + i] = u[i];
+  }
+  return (int) k;
+}
+"""
+
+_QUANT_C = """
+int kincas_quantities(casadi_int n, const casadi_real* Q, const casadi_real* U, casadi_int su,
+                      const casadi_real* p, const casadi_real* Ud, casadi_int sud,
+                      const casadi_real* Udd, casadi_int sudd, casadi_real* out, casadi_int ld) {
+  const casadi_real* arg[SZ_ARG]; casadi_real* res[SZ_RES]; casadi_int iw[SZ_IW]; casadi_real w[SZ_W];
+  casadi_real y[NO > 0 ? NO : 1];
+  casadi_int k, i;
+  for (k = 0; k < n; ++k) {
+    arg[0] = Q + k*NQ; arg[1] = U + k*su; arg[2] = p; arg[3] = Ud + k*sud; arg[4] = Udd + k*sudd;
+    res[0] = y;
+    if (kQ(arg, res, iw, w, 0)) return (int) k;
+    for (i = 0; i < NO; ++i) out[i*ld + k] = y[i];
+  }
+  return (int) n;
+}
+"""
+_I, _V = ctypes.c_longlong, ctypes.c_void_p
+
+
+# --- the sweep driver ---
+
+
+class FastRun:
+    """The arrays of one sweep, bound once; `advance` solves a stretch of it per call.
+
+    `Q` (N, nq): the unknowns, NaN where not solved; `values` (len(report), N): the reported
+    quantities; `info` (5, N): per pose attempted, the measures named in INFO; `accepted`:
+    the poses the fast pass accepted; `solved`: by either path (`FastSweeper.sweep` fills
+    it); `first_bad`: where the last `advance` stopped.
+    """
+
+    def __init__(self, sweeper: "FastSweeper", U, p, L, Ud=None, Udd=None):
+        self.sweeper, nq, nu = sweeper, sweeper.nq, sweeper.nu
+        self.U = np.ascontiguousarray(np.asarray(U, dtype=float).reshape(-1, nu))
+        self.n = n = self.U.shape[0]
+        self.Ud = rows(np.ones(nu) if Ud is None else Ud, n, nu)
+        self.Udd = rows(np.zeros(nu) if Udd is None else Udd, n, nu)
+        self.p = np.ascontiguousarray(np.asarray(p, dtype=float).ravel())
+        self.L = np.array([float(L)])
+        self.Q, self.info = np.full((n, nq), np.nan), np.full((5, n), np.nan)
+        self.values = np.full((len(sweeper.report), n), np.nan)
+        self.accepted, self.solved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+        self.thr = np.array([RESIDUAL, STEP, JAC_CHANGE, CORRECTION])
+        self.first_bad = 0
+
+    residual = property(lambda self: self.info[0], doc="max |g| / L at each pose")
+    step = property(lambda self: self.info[1], doc="the Newton step that would follow")
+    jac_change = property(lambda self: self.info[2], doc="sum |D^-1 (J_prev^-1 J - I) D|")
+    correction = property(lambda self: self.info[3], doc="||D^-1 (q - q_pred)||_1")
+    iterations = property(lambda self: np.nan_to_num(self.info[4], nan=1.0).astype(int) - 1,
+                          doc="Newton steps taken at each pose")
+
+    def advance(self, start: int, q_last, u_last) -> int:
+        """Solve poses start, start + 1, ... from the solved pose (q_last, u_last) until one
+        is rejected, and return its index (N if none was). The poses before it are accepted;
+        the rejected pose keeps its `info` (why) and NaN in `Q` and `values`."""
+        if start >= self.n:
+            return self.n
+        sw = self.sweeper
+        s = sw.state(q_last, u_last, self.p)
+        lib = sw.backend.compiled(self.n)
+        if lib is not None:
+            (Ud, sud), (Udd, sudd) = self.Ud, self.Udd
+            k = start + lib.kincas_sweep(
+                self.n - start, ptr(self.U, start * sw.nu), ptr(self.p), ptr(self.L), ptr(self.thr),
+                sw.max_evals, ptr(s), ptr(self.Q, start * sw.nq), ptr(self.info, start), self.n,
+                ptr(Ud, start * sud), sud, ptr(Udd, start * sudd), sudd, ptr(self.values, start))
+        else:
+            k = sw._vm_advance(self, start, s)
+        self.accepted[start:k] = self.solved[start:k] = True
+        if k < self.n:
+            self.Q[k] = self.values[:, k] = np.nan
+        self.first_bad = k
+        return k
+
+    def record(self, k: int, sol) -> None:
+        """Store a carefully solved pose (an object with q, residual, iterations, ok)."""
+        self.solved[k] = bool(sol.ok)
+        self.Q[k] = sol.q if sol.ok else np.nan
+        self.info[:, k] = [sol.residual, np.nan, np.nan, np.nan, sol.iterations + 1]
+
+
+class FastSweeper:
+    """Whole sweeps of one compiled model (`kincas.compile(m)`), any parameter values.
+
+    `report` lists the quantities computed with each pose (only what they need is built).
+    `run(U, p, L, q_start, u_start)` solves U[start:] from a solved pose; `sweep(U, p, L,
+    careful)` solves every pose, handing those the fast pass rejects to `careful`.
+    `backend.library.times` says how long generating, compiling and loading took.
+    """
+
+    def __init__(self, model, report=(), *, compile=None, max_evals: int = MAX_EVALS):
+        self.model, self.sym, self.report = model, model.sym, tuple(report)
+        self.nq, self.nu, self.max_evals = model.sym.nq, model.sym.nu, int(max_evals)
+        qf = model.quantity_function(self.report) if self.report else None  # names checked here
+        self.functions = _kernel_functions(self.sym, qf)
+        self._vm = None
+        self.backend = Backend(compile, self._library, "fast sweep kernel")
+
+    def _library(self) -> Library:
+        return Library("kincas_sweep", self.functions, _SWEEP_C,
+                       {"NQ": self.nq, "NU": self.nu, "NO": len(self.report)},
+                       {"kincas_sweep": [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V]})
+
+    def state(self, q, u, p) -> np.ndarray:
+        """(q, J, dq/du, u) at a solved pose, J and dq/du column-major as casadi keeps them."""
+        _, J, Ju = (np.asarray(a) for a in self.sym.f_tangent(q, u, p))
+        try:
+            T = np.linalg.solve(J, -Ju)
+        except np.linalg.LinAlgError:  # a singular start: the next pose fails the branch test
+            T = np.full_like(Ju, np.nan)
+        return np.concatenate([np.ravel(q), J.ravel(order="F"), T.ravel(order="F"), np.ravel(u)])
+
+    def run(self, U, p, L, q_start, u_start, start: int = 0, Ud=None, Udd=None) -> FastRun:
+        """Poses U[start:] (an (N, nu) table) from the solved pose (q_start, u_start)."""
+        r = FastRun(self, U, p, L, Ud, Udd)
+        r.advance(start, q_start, u_start)
+        return r
+
+    def sweep(self, U, p, L, careful, Ud=None, Udd=None, progress=None) -> FastRun:
+        """Every pose of U: the fast pass wherever it is accepted, else `careful(k, q_last,
+        u_last)` -> a solution with q, residual, iterations, ok (q_last None while no pose is
+        solved), each from the last solved pose; the fast pass restarts after each."""
+        r = FastRun(self, U, p, L, Ud, Udd)
+        k, last = 0, None
+        while k < r.n:
+            if last is not None:
+                bad = r.advance(k, *last)
+                if bad > k:
+                    last = (r.Q[bad - 1], r.U[bad - 1])
+                    if progress is not None:
+                        progress(bad, r.n)
+                if (k := bad) == r.n:
+                    break
+            sol = careful(k, *(last or (None, None)))
+            r.record(k, sol)
+            if sol.ok:
+                last = (r.Q[k], r.U[k])
+            k += 1
+        slow = np.flatnonzero(r.solved & ~r.accepted)
+        if self.report and slow.size:
+            ev = evaluator_for(self.model, self.report)
+            r.values[:, slow] = ev.evaluate(r.Q[slow], r.U[slow], r.p, _take(r.Ud, slow), _take(r.Udd, slow))
+        if progress is not None:
+            progress(r.n, r.n)
+        return r
+
+    # --- the virtual machine: the same arithmetic, mapaccum over CHUNK poses ---
+    def _vm_advance(self, r: FastRun, start: int, s: np.ndarray) -> int:
+        nq, nu, no = self.nq, self.nu, len(self.report)
+        if self._vm is None:
+            kS = _vm_step(*self.functions, nq, nu, self.max_evals)
+            acc = kS.mapaccum("acc", CHUNK, [0, 1, 2, 3], [0, 1, 2, 3], {})
+            x = [ca.MX.sym(c, *kS.size_in(i)) for i, c in enumerate("qJTu")]
+            U, Ud, Udd = (ca.MX.sym(c, nu, CHUNK) for c in ("U", "Ud", "Udd"))
+            p, L, t = ca.MX.sym("p", kS.size1_in(5)), ca.MX.sym("L"), ca.MX.sym("t", 4)
+            rep = lambda a: ca.repmat(a, 1, CHUNK)
+            F = ca.Function("chunk", [*x, U, p, L, t, Ud, Udd], acc(*x, U, rep(p), rep(L), rep(t), Ud, Udd))
+            buf, call = F.buffer()
+            scratch = [np.zeros((CHUNK, m)) for m in (nq, nq * nq, nq * nu, nu, 5, no, nu, nu, nu)]
+            for i, a in enumerate(scratch[:6]):
+                buf.set_res(i, memoryview(a))
+            self._vm = (F, buf, call, scratch)  # buf holds raw pointers: keep it referenced
+        _, buf, call, (Qc, Jc, Tc, Uo, Ic, Yc, Uc, Udc, Uddc) = self._vm
+        parts = np.split(s.copy(), np.cumsum([nq, nq * nq, nq * nu]))
+        k = start
+        while k < r.n:
+            m = min(CHUNK, r.n - k)
+            for c, (a, st) in ((Uc, (r.U, 1)), (Udc, r.Ud), (Uddc, r.Udd)):
+                c[:m], c[m:] = (a[k:k + m] if st else a), (a[k + m - 1] if st else a)  # pad
+            for i, a in enumerate([*parts, Uc, r.p, r.L, r.thr, Udc, Uddc]):
+                buf.set_arg(i, memoryview(a))
+            call()
+            ok = np.all(Ic[:m, :4] <= r.thr, axis=1)
+            j = m if ok.all() else int(np.argmin(ok))
+            e = min(j + 1, m)
+            r.Q[k:k + e], r.info[:, k:k + e], r.values[:, k:k + e] = Qc[:e], Ic[:e].T, Yc[:e].T
+            if j < m:
+                return k + j
+            parts = [Qc[m - 1].copy(), Jc[m - 1].copy(), Tc[m - 1].copy(), Uo[m - 1].copy()]
+            k += m
+        return r.n
+
+
+def _take(table, idx):
+    a, stride = table
+    return a if stride == 0 else a[idx]
+
+
+# --- the reported quantities at given poses ---
+
+
+class QuantityEvaluator:
+    """Named quantities at N solved poses, only what they need built: a C loop over the
+    compiled quantity function (cached like the sweep kernel), else casadi's `map` over
+    chunks of CHUNK poses, bound to numpy buffers.
+
+    >>> import numpy as np, kincas
+    >>> m = kincas.Mechanism(ground={"A": (0, 0)}, links=[kincas.Link.bar("crank", "A", "B", 2)],
+    ...     inputs=[kincas.Input.angle("crank")])
+    >>> ev = QuantityEvaluator(kincas.compile(m), ["B.y", "B.vx"], compile=False)
+    >>> ev.evaluate(np.zeros((2, 0)), np.array([[0.0], [np.pi / 2]]), [], Ud=[3.0]).round(12)
+    array([[ 0.,  2.],
+           [-0., -6.]])
+    """
+
+    def __init__(self, model, names, *, compile=None):
+        self.names, self.nq, self.nu = tuple(names), model.sym.nq, model.sym.nu
+        f = model.quantity_function(self.names)
+        ins = f.sx_in()
+        self.f = ca.Function("kQ", ins, [ca.densify(f(*ins))], {"cse": True})
+        self.no = self.f.size1_out(0)
+        self._vm = None
+        self.backend = Backend(compile, self._library, "quantity evaluator")
+
+    def _library(self) -> Library:
+        return Library("kincas_quantities", [self.f], _QUANT_C, {"NQ": self.nq, "NO": self.no},
+                       {"kincas_quantities": [_I, _V, _V, _I, _V, _V, _I, _V, _I, _V, _I]})
+
+    def evaluate(self, Q, U, p, Ud=None, Udd=None, ok=None) -> np.ndarray:
+        """(len(names), N) values at the poses (Q (N, nq), U (N, nu) tables; rates Ud and
+        accelerations Udd tables or one row, default 1 and 0); NaN where `ok` is False."""
+        U = np.asarray(U, dtype=float).reshape(-1, self.nu)
+        n = U.shape[0]
+        Q = np.ascontiguousarray(np.asarray(Q, dtype=float).reshape(n, self.nq))
+        U, su = rows(U, n, self.nu)
+        Ud, sud = rows(np.ones(self.nu) if Ud is None else Ud, n, self.nu)
+        Udd, sudd = rows(np.zeros(self.nu) if Udd is None else Udd, n, self.nu)
+        p = np.ascontiguousarray(np.asarray(p, dtype=float).ravel())
+        out = np.empty((self.no, n))
+        lib = self.backend.compiled(n) if n and self.no else None
+        if lib is not None:
+            lib.kincas_quantities(n, ptr(Q), ptr(U), su, ptr(p), ptr(Ud), sud, ptr(Udd), sudd,
+                                  ptr(out), n)
+        elif n and self.no:
+            self._vm_evaluate(Q, (U, su), p, (Ud, sud), (Udd, sudd), out)
+        if ok is not None:
+            out[:, ~np.asarray(ok, dtype=bool)] = np.nan
+        return out
+
+    def _vm_evaluate(self, Q, U, p, Ud, Udd, out):
+        if self._vm is None:
+            F = self.f.map("qmap", "serial", CHUNK, [2], [])  # p is the same for every pose
+            buf, call = F.buffer()
+            scratch = [np.zeros((CHUNK, m)) for m in (self.nq, self.nu, self.nu, self.nu, self.no)]
+            buf.set_res(0, memoryview(scratch[-1]))
+            self._vm = (F, buf, call, scratch)  # buf holds raw pointers: keep it referenced
+        _, buf, call, (Qc, Uc, Udc, Uddc, Oc) = self._vm
+        n = Q.shape[0]
+        for k in range(0, n, CHUNK):
+            m = min(CHUNK, n - k)
+            for c, (a, st) in ((Qc, (Q, 1)), (Uc, U), (Udc, Ud), (Uddc, Udd)):
+                c[:m], c[m:] = (a[k:k + m] if st else a), (a[k + m - 1] if st else a)  # pad
+            for i, a in enumerate((Qc, Uc, p, Udc, Uddc)):
+                buf.set_arg(i, memoryview(a))
+            call()
+            out[:, k:k + m] = Oc[:m].T
+
+
+# --- one sweeper per compiled model and report ---
+
+_MEMO: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def sweeper_for(model, report=()) -> FastSweeper:
+    """The `FastSweeper` of a compiled model and report (kept as long as the model is)."""
+    memo = _MEMO.setdefault(model, {})
+    if ("sweep", tuple(report)) not in memo:
+        memo[("sweep", tuple(report))] = FastSweeper(model, report)
+    return memo[("sweep", tuple(report))]
+
+
+def evaluator_for(model, names) -> QuantityEvaluator:
+    """The `QuantityEvaluator` of a compiled model for these quantity names."""
+    memo = _MEMO.setdefault(model, {})
+    if ("eval", tuple(names)) not in memo:
+        memo[("eval", tuple(names))] = QuantityEvaluator(model, names)
+    return memo[("eval", tuple(names))]
