@@ -188,7 +188,7 @@ def _fail(message: str):
 
 def check_outputs(args, mechanism=None) -> None:
     """Fail early (one line, exit 2) when a picture is asked for and matplotlib is missing,
-    or when --paths or --pose name what does not exist."""
+    or when --paths names a point that does not exist."""
     from .plot import require_matplotlib
     for flag, attr in (("--plot", "plot"), ("--animate", "animate"), ("--plot-quantities", "plot_quantities")):
         if getattr(args, attr, None):
@@ -230,6 +230,8 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
                 job(path)
             except OSError as e:
                 _fail(f"cannot write {path}: {e.strerror or e}")
+            except ValueError as e:  # a file type matplotlib or Pillow cannot write
+                _fail(f"cannot write {path}: {str(e).splitlines()[0] if str(e) else type(e).__name__}")
 
 
 def _caption(scene, sweep, inputs, i) -> str:

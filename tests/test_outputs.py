@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import copy
 import csv
+import importlib.util
 import io
 import math
 import subprocess
@@ -99,6 +100,9 @@ def test_unwritable_file_is_one_line_and_status_2(capsys, tmp_path):
                            tmp_path / "no" / "such" / "dir.csv")
     assert code == 2
     assert err.count("\n") == 1 and err.startswith("kincas: cannot write ")
+    if importlib.util.find_spec("matplotlib"):  # a picture in a format nothing writes
+        code, _, err = run_cli(capsys, "solve", EXAMPLES / "slider_crank.toml", "--plot", tmp_path / "x.xyz")
+        assert code == 2 and err.count("\n") == 1 and "'xyz' is not supported" in err
 
 
 # --- pictures from the command line ---
