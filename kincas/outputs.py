@@ -1,5 +1,6 @@
-"""A sweep's outputs as files: CSV tables, plots of the quantities against the input, and the
-`kincas solve` flags that write them (--csv, --plot, --animate, --plot-quantities).
+"""A sweep's outputs as files: CSV tables, plots of the quantities against the input, GIF
+animations, and the `kincas solve` flags that write them (--csv, --plot, --animate,
+--plot-quantities).
 
 Values are written in the scene's units (degrees where the scene says so); without a scene,
 as the sweep holds them (radians). A pose that was not solved has empty cells.
@@ -23,6 +24,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from .model import Mechanism
 from .results import Sweep
 
 FLAG_STYLE = {"limit": ("#d62728", "limit of motion"), "change point": ("#9467bd", "change point"),
@@ -177,6 +179,43 @@ def plot_quantities(sweep: Sweep, names=None, *, scene=None, fig=None):
     return fig
 
 
+# --- animations ---
+
+
+def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, fps: int = 20,
+            captions=None, units: str = "", dpi: int = 80, size=(6.4, 4.8)) -> int:
+    """Write an animated GIF of the sweep's solved poses (at most `frames` of them, evenly
+    spread); returns the number of frames written. `captions[i]` titles pose i.
+
+    >>> import os, tempfile, numpy as np, kincas
+    >>> m = kincas.Mechanism(ground={"O": (0, 0)},
+    ...     links=[kincas.Link.bar("crank", "O", "A", 1), kincas.Link.bar("rod", "A", "B", 3)],
+    ...     slides=[kincas.Slide("B", "ground")], inputs=[kincas.Input.angle("crank")],
+    ...     guess={"B": (4, 0)})
+    >>> sw = kincas.sweep(m, {"crank.angle": np.linspace(0, 2 * np.pi, 25)})
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     animate(m, sw, os.path.join(d, "slider.gif"), frames=4, size=(2, 1.5), dpi=40)
+    4
+    """
+    from .plot import Drawing, caption, check_paths, geometry, new_figure, require_matplotlib
+    require_matplotlib("kincas.outputs.animate")
+    from matplotlib.animation import PillowWriter
+    ok = np.flatnonzero(sweep.ok) if sweep.ok.any() else np.array([0])
+    pick = ok[np.unique(np.round(np.linspace(0, ok.size - 1, min(frames, ok.size))).astype(int))]
+    fig = new_figure(size)
+    d = Drawing(fig.subplots(), m, geometry(m, sweep), check_paths(m, paths), True, units)
+    cap = captions if captions is not None else [caption(sweep, i) for i in range(len(sweep))]
+    d.update(int(pick[0]), cap[pick[0]])
+    fig.canvas.draw()  # lay the figure out once; every frame keeps that layout
+    fig.set_layout_engine("none")
+    writer = PillowWriter(fps=fps)
+    with writer.saving(fig, str(path), dpi):
+        for i in pick:  # one drawing per frame
+            d.update(int(i), cap[i])
+            writer.grab_frame()
+    return len(pick)
+
+
 # --- the command line's output flags ---
 
 
@@ -248,10 +287,9 @@ def _save_drawing(path, m, sweep, pose, paths, captions, length):
     from .plot import default_pose, draw, new_figure
     fig = new_figure()
     i = default_pose(sweep) if pose is None else pose % len(sweep)
-    draw(m, sweep, i, ax=fig.subplots(), paths=paths, caption=captions[i], units=length)
+    draw(m, sweep, i, ax=fig.subplots(), paths=paths, title=captions[i], units=length)
     fig.savefig(path, dpi=100)
 
 
 def _animate(path, m, sweep, paths, captions, length):
-    from .plot import animate
     animate(m, sweep, path, paths=paths, captions=captions, units=length)

@@ -1,10 +1,9 @@
-"""Pictures of a mechanism: the drawing at a pose with the paths of its points over a sweep,
-and animations of the sweep (plots of quantities: `kincas.outputs.plot_quantities`).
+"""Pictures of a mechanism: the drawing at a pose with the paths of its points over a sweep
+(animations of a sweep and plots of its quantities are in `kincas.outputs`).
 
-matplotlib is an optional extra (`pip install "kincas[plot]"`): this module imports it only
-when a picture is drawn, so `import kincas.plot` works without it. Positions come from the
-solved unknowns `sweep.q` through the compiled model, so a drawing shows exactly the poses
-that were solved; poses whose status is not "ok" are left out of paths and animations.
+matplotlib is an optional extra (`pip install "kincas[plot]"`), imported only to draw.
+Positions come from the solved unknowns `sweep.q` through the compiled model, so a drawing
+shows exactly the poses that were solved; poses not "ok" are left out of paths.
 
 >>> import numpy as np, kincas
 >>> from matplotlib.figure import Figure
@@ -127,21 +126,18 @@ def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
 
 def _hull(pts: np.ndarray) -> list[int]:
     """Indices of the convex hull of 2-D points, counter-clockwise (Andrew's monotone chain)."""
-    order = sorted(range(len(pts)), key=lambda i: (pts[i][0], pts[i][1]))
-
-    def cross(o, a, b):
+    def turn(o, a, b):  # z of (a - o) x (b - o): positive when o -> a -> b turns left
         return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
 
-    def chain(idx):
+    def chain(idx):  # keep only left turns
         out: list[int] = []
         for i in idx:
-            while len(out) >= 2 and cross(pts[out[-2]], pts[out[-1]], pts[i]) <= 0:
+            while len(out) >= 2 and turn(pts[out[-2]], pts[out[-1]], pts[i]) <= 0:
                 out.pop()
             out.append(i)
         return out
-
-    lower, upper = chain(order), chain(order[::-1])
-    return lower[:-1] + upper[:-1]
+    order = sorted(range(len(pts)), key=lambda i: tuple(pts[i]))
+    return chain(order)[:-1] + chain(order[::-1])[:-1]
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -161,7 +157,7 @@ def _rectangle(centre, d, length, width) -> np.ndarray:
 INK, PAPER = "#222222", "white"
 
 
-class _Drawing:
+class Drawing:
     """Every artist of a mechanism drawing; `update(i)` moves them to pose i."""
 
     def __init__(self, ax, m: Mechanism, geo: Geometry, paths, labels: bool, units: str = ""):
@@ -220,10 +216,8 @@ class _Drawing:
             h = 2.5 * r
             ax.add_patch(Polygon([(x, y), (x - 0.7 * h, y - h), (x + 0.7 * h, y - h)], closed=True,
                                  fc="#dddddd", ec=INK, lw=1.0, zorder=1.5))
-            base = y - h
-            ticks.append([(x - 1.1 * h, base), (x + 1.1 * h, base)])
-            for t in np.linspace(-1.1 * h, 0.8 * h, 6):
-                ticks.append([(x + t, base), (x + t + 0.3 * h, base - 0.35 * h)])
+            ticks += [[(x - 1.1 * h, y - h), (x + 1.1 * h, y - h)]] + [
+                [(x + t, y - h), (x + t + 0.3 * h, y - 1.35 * h)] for t in np.linspace(-1.1 * h, 0.8 * h, 6)]
         if ticks:
             ax.add_collection(LineCollection(ticks, colors=INK, linewidths=0.8, zorder=1.5))
 
@@ -350,7 +344,8 @@ class _Drawing:
 # --- public drawing functions ---
 
 
-def _caption(sweep: Sweep, i: int) -> str:
+def caption(sweep: Sweep, i: int) -> str:
+    """The inputs at pose i, as a title (with the status when it was not solved)."""
     text = ", ".join(f"{k} = {v[i]:.4g}" for k, v in sweep.inputs.items())
     return text + ("" if sweep.status[i] == "ok" else f" ({sweep.status[i]})")
 
@@ -362,7 +357,7 @@ def default_pose(sweep: Sweep | np.ndarray) -> int:
 
 
 def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=None,
-         labels: bool = True, caption: str | None = None, units: str = ""):
+         labels: bool = True, title: str | None = None, units: str = ""):
     """Draw `m` at pose `pose` of `sweep` (default: the first solved) with the paths of
     `paths` (default: every moving point) over the sweep; returns the matplotlib Axes.
 
@@ -373,40 +368,26 @@ def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=
     if ax is None:
         import matplotlib.pyplot as plt
         ax = plt.subplots(figsize=(6.4, 4.8))[1]
-    paths = _check_paths(m, paths)
+    paths = check_paths(m, paths)
     i = default_pose(sweep) if pose is None else int(pose) % max(len(sweep), 1)  # -1: the last
-    d = _Drawing(ax, m, geometry(m, sweep), paths, labels, units)
-    d.update(i, _caption(sweep, i) if caption is None else caption)
+    d = Drawing(ax, m, geometry(m, sweep), paths, labels, units)
+    d.update(i, caption(sweep, i) if title is None else title)
     return ax
 
 
-def _check_paths(m: Mechanism, paths) -> list[str]:
+def check_paths(m: Mechanism, paths) -> list[str]:
+    """The points whose paths are drawn: `paths`, checked, or every moving point (None).
+
+    >>> import kincas
+    >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("c", "O", "A", 1)],
+    ...                      inputs=[kincas.Input.angle("c")])
+    >>> check_paths(m, None), check_paths(m, ["O"])
+    (['A'], ['O'])
+    """
     bad = [p for p in paths or () if p not in m.moving_points + m.ground_points]
     if bad:
         raise ValueError(f"paths: unknown point(s) {bad} (points: {m.ground_points + m.moving_points})")
     return list(m.moving_points if paths is None else paths)
-
-
-def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, fps: int = 20,
-            captions=None, units: str = "", dpi: int = 80, size=(6.4, 4.8)) -> int:
-    """Write an animated GIF of the sweep's solved poses (at most `frames` of them, evenly
-    spread); returns the number of frames written. `captions[i]` titles pose i."""
-    require_matplotlib("kincas.plot.animate")
-    from matplotlib.animation import PillowWriter
-    ok = np.flatnonzero(sweep.ok) if sweep.ok.any() else np.array([0])
-    pick = ok[np.unique(np.round(np.linspace(0, ok.size - 1, min(frames, ok.size))).astype(int))]
-    fig = new_figure(size)
-    d = _Drawing(fig.subplots(), m, geometry(m, sweep), _check_paths(m, paths), True, units)
-    cap = captions if captions is not None else [_caption(sweep, i) for i in range(len(sweep))]
-    d.update(int(pick[0]), cap[pick[0]])
-    fig.canvas.draw()  # lay the figure out once; every frame keeps that layout
-    fig.set_layout_engine("none")
-    writer = PillowWriter(fps=fps)
-    with writer.saving(fig, str(path), dpi):
-        for i in pick:  # one drawing per frame
-            d.update(int(i), cap[i])
-            writer.grab_frame()
-    return len(pick)
 
 
 def new_figure(size=(6.4, 4.8)):
