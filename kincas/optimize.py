@@ -1,0 +1,216 @@
+"""Optimisation of parameters (link lengths, ground points, ...) by IPOPT, with exact
+derivatives through the kinematics.
+
+Simultaneous formulation: the decision variables are the varied parameters *and* the pose
+q_k at every sample input u_k; the loop-closure residuals g(q_k, u_k, p) = 0 are equality
+constraints. The objective and the constraints are written with quantity names (see
+`kincas.expressions`), so they are smooth functions of (q_k, u_k, p) whose first and second
+derivatives CasADi builds exactly; nothing is differenced and no pose is solved inside the
+optimiser's loop. Each pose starts from a sweep of the initial design, which fixes the
+assembly branch. `max(E)` and `min(E)` over the input's range add a sample whose input is
+free too, held at a stationary point by dE/du = E_q dq/du + E_u = 0, dq/du = -g_q^-1 g_u.
+
+IPOPT's answer is then checked, not trusted: every pose is polished by Newton's method at the
+optimised parameters; the sign of det(g_q) at each sample must be the initial design's (the
+same branch); the optimised mechanism is swept from the first sample through all the others
+(it must get from one to the next without leaving its branch); every extreme is compared with
+that sweep; every constraint is evaluated again. A design that fails any of these is
+reported with the reason (`ok` False), never as optimal.
+
+>>> import numpy as np, kincas
+>>> m = kincas.Mechanism(parameters={"a": 1.0, "b": 3.5, "c": 3.0},
+...     ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", "b"),
+...            kincas.Link.bar("rocker", "D", "C", "c")],
+...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+>>> r = optimize(m, {"crank.angle": [np.pi / 2]}, vary={"c": (2.0, 4.0)},
+...              minimize="sum((C.y - 2.5)^2)")
+>>> r.ok, r.status, round(r.parameters["c"], 6), round(float(np.sqrt(10 - 8 * np.sqrt(10) + 22.25)), 6)
+(True, 'Solve_Succeeded', 2.636623, 2.636623)
+
+(At crank angle 90 deg, B = (0, 1); C.y = 2.5 puts C at (sqrt(3.5^2 - 1.5^2), 2.5) = (sqrt(10), 2.5),
+so the rocker from D = (4, 0) is c = sqrt((sqrt(10) - 4)^2 + 2.5^2).)
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .model import Mechanism
+from .simultaneous import Constraint, OptimizeResult, Problem
+
+__all__ = ["optimize", "Constraint", "OptimizeResult", "cli_arguments", "cli_run"]
+
+
+def optimize(m: Mechanism, samples, vary: dict, minimize: str, constraints=(), *, data=None,
+             rates=None, accelerations=None, deg: bool = False, check_path: bool = True,
+             max_iter: int = 1000, tol: float = 1e-12) -> OptimizeResult:
+    """Vary the parameters `vary` (name -> (low, high)) to minimise `minimize` subject to
+    `constraints` (Constraint, dict {expr, min, max} or tuple (expr, min, max)), with the
+    mechanism posed at the `samples` inputs (key -> array, as for `kincas.sweep`).
+
+    `data` gives named arrays, one value per sample, for the expressions. `deg`: quantities,
+    data and trigonometric functions in the expressions use degrees for angles (the scene
+    convention); radians otherwise."""
+    from .solve import compile, sweep
+
+    model = compile(m)
+    prob = Problem(m, model, vary, data, deg)
+    objective = prob.parse(minimize, "minimize")
+    cons = [prob.parse_constraint(c, i) for i, c in enumerate(constraints)]
+    sw0 = sweep(m, samples, rates=rates, accelerations=accelerations, report=[])
+    prob.set_samples(sw0, sweep)
+    f = prob.evaluate(objective, "minimize", objective=True)[1]
+    rows = [(c, prob.evaluate(e, c.expr)) for c, e in cons]
+    return prob.solve(f, rows, check_path, max_iter, tol)
+
+
+# --- scenes: the [optimize] section ---
+
+FIELDS = {"vary", "minimize", "constraints", "data", "samples", "check_path", "max_iter"}
+
+
+def read_section(sc) -> dict:
+    """The scene's `[optimize]` section as keywords of optimize(); SceneError naming the
+    field. Samples, data and bounds are in the scene's units (degrees where it says so)."""
+    import math
+
+    from .errors import SceneError
+
+    t = sc.study.raw.get("optimize")
+    if not isinstance(t, dict):
+        raise SceneError("[optimize]: missing or not a table (give at least vary = { PARAMETER "
+                         "= [low, high] } and minimize = \"EXPRESSION\")")
+    problems = [f"[optimize]: unknown field {k!r} (expected one of {sorted(FIELDS)})"
+                for k in t if k not in FIELDS]
+    problems += [f"[optimize] {k}: missing" for k in ("vary", "minimize") if k not in t]
+    kw = {"vary": t.get("vary"), "minimize": t.get("minimize"), "data": t.get("data"),
+          "constraints": t.get("constraints", []), "deg": sc.study.deg}
+    if not isinstance(kw["constraints"], list) or not all(isinstance(c, dict) for c in kw["constraints"]):
+        problems.append("[optimize] constraints: expected a list of { expr = \"...\", min = a, "
+                        "max = b } (or [[optimize.constraints]] blocks)")
+    if kw["data"] is not None and not isinstance(kw["data"], dict):
+        problems.append("[optimize] data: expected a table of name = [values, one per sample]")
+    if not isinstance(t.get("check_path", True), bool):
+        problems.append("[optimize] check_path: expected true or false")
+    mi = t.get("max_iter", 1000)
+    if isinstance(mi, bool) or not isinstance(mi, int) or mi < 1:
+        problems.append(f"[optimize] max_iter: expected a whole number >= 1, got {mi!r}")
+    kw.update(check_path=t.get("check_path", True), max_iter=mi)
+    if isinstance(kw["vary"], dict):
+        kw["vary"] = {k: tuple(v) if isinstance(v, list) else v for k, v in kw["vary"].items()}
+    samples = dict(sc.study.inputs)
+    if "samples" in t:
+        m = sc.mechanism
+        if len(m.inputs) != 1:
+            problems.append("[optimize] samples: only for a mechanism with one input (else the "
+                            "samples are the [[inputs]] values)")
+        else:
+            s, k = t["samples"], (math.pi / 180 if m.inputs[0].is_angle and sc.study.deg else 1.0)
+            if isinstance(s, dict) and set(s) == {"from", "to", "steps"} and all(
+                    isinstance(s[x], (int, float)) and not isinstance(s[x], bool) for x in s) \
+                    and isinstance(s["steps"], int) and s["steps"] >= 1:
+                samples = {m.inputs[0].key: np.linspace(s["from"], s["to"], s["steps"]) * k}
+            elif isinstance(s, list) and s and all(
+                    isinstance(x, (int, float)) and not isinstance(x, bool) for x in s):
+                samples = {m.inputs[0].key: np.array(s, dtype=float) * k}
+            else:
+                problems.append("[optimize] samples: expected { from = a, to = b, steps = n } "
+                                "or a list of input values")
+    if problems:
+        raise SceneError(problems)
+    kw["samples"] = samples
+    return kw
+
+
+def run_scene(sc) -> OptimizeResult:
+    """Optimise as the scene's [optimize] section says (SceneError for a bad section)."""
+    from .errors import ModelError, SceneError
+
+    kw = read_section(sc)
+    try:
+        return optimize(sc.mechanism, kw.pop("samples"), rates=sc.study.rates,
+                        accelerations=sc.study.accelerations, **kw)
+    except ModelError as e:
+        raise SceneError([f"[optimize] {p}" for p in e.problems]) from None
+
+
+# --- the command line: kincas optimize SCENE.toml ---
+
+
+def cli_arguments(parser) -> None:
+    """Arguments of `kincas optimize`."""
+    parser.add_argument("scene", help="the scene file (TOML) with an [optimize] section")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def cli_run(args) -> int:
+    """Run `kincas optimize`: 0 for an optimal design that passed every check, 3 otherwise."""
+    import json
+    import sys
+
+    from .scene import load
+
+    sc = load(args.scene)
+    r = run_scene(sc)
+    doc = report(sc, r)
+    if args.json:
+        json.dump(doc, sys.stdout, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        _print(sc, r, doc)
+    return 0 if r.ok else 3
+
+
+def report(sc, r: OptimizeResult) -> dict:
+    """The result as the JSON object of `kincas optimize --json`, in the scene's units."""
+    import math
+
+    from .cli import _list
+    from .symbolic import is_angular
+
+    deg = sc.study.deg
+    user = lambda n, v: np.degrees(v) if deg and is_angular(n) else np.asarray(v, float)
+    bounds = sc.study.raw["optimize"]["vary"]
+    key = sc.mechanism.inputs[0].key
+    num = lambda v: float(v) if math.isfinite(v) else None
+    return {
+        "title": sc.study.title, "units": sc.study.units, "ok": r.ok, "converged": r.converged,
+        "status": r.status, "message": r.message, "problems": r.problems,
+        "iterations": r.iterations, "objective": num(r.objective),
+        "initial_objective": num(r.initial_objective),
+        "parameters": r.parameters, "varied": r.varied,
+        "initial": {p: sc.mechanism.parameter(p) for p in r.varied},
+        "bounds": {p: list(bounds[p]) for p in r.varied},
+        "samples": {k: _list(user(k, v)) for k, v in r.samples.items()},
+        "values": {n: _list(user(n, v)) for n, v in r.values.items()},
+        "constraints": [{**{k: c[k] for k in ("expr", "min", "max", "satisfied")},
+                         "value": _list(np.atleast_1d(c["value"]))} for c in r.constraints],
+        "extremes": [{"kind": e["kind"], "expr": e["expr"], "value": num(e["value"]),
+                      "input": {key: num(float(user(key, e["input"])))}} for e in r.extremes],
+    }
+
+
+def _print(sc, r: OptimizeResult, doc: dict):
+    print(f"{sc.study.title or 'kincas'}: optimisation by IPOPT ({r.status}, "
+          f"{r.iterations} iterations)")
+    print(r.message)
+    for p in r.problems[1:]:
+        print(f"  also: {p}")
+    print(f"objective: {r.initial_objective:.8g} (initial design) -> {r.objective:.8g}")
+    print(f"{'parameter':>12}  {'initial':>14}  {'optimised':>14}  {'low':>10}  {'high':>10}")
+    for p, v in r.varied.items():
+        lo, hi = doc["bounds"][p]
+        print(f"{p:>12}  {doc['initial'][p]:>14.8g}  {v:>14.8g}  {lo:>10.6g}  {hi:>10.6g}")
+    for c in doc["constraints"]:
+        v = [x for x in c["value"] if x is not None]
+        shown = f"{v[0]:.8g}" if len(v) == 1 else f"from {min(v):.8g} to {max(v):.8g} over the samples"
+        lo, hi = c["min"], c["max"]
+        want = (f"= {lo:g}" if lo == hi else f">= {lo:g}" if hi is None else f"<= {hi:g}"
+                if lo is None else f"in [{lo:g}, {hi:g}]")
+        print(f"constraint {c['expr']} {want}: {shown}, {'holds' if c['satisfied'] else 'VIOLATED'}")
+    for e in doc["extremes"]:
+        (k, u), = e["input"].items()
+        print(f"{e['kind']}({e['expr']}) = {e['value']:.8g} at {k} = {u:.6g}")
+    print("\n[parameters]   # the optimised design" + ("" if r.ok else " (NOT optimal, see above)"))
+    for p, v in r.parameters.items():
+        print(f"{p} = {v:.12g}")
