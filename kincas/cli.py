@@ -30,7 +30,7 @@ COMMANDS = {
 }
 
 
-def _parser() -> argparse.ArgumentParser:
+def _parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="kincas", description="Kinematics of planar closed-chain mechanisms.")
     ap.add_argument("--version", action="store_true", help="print the version and exit")
     sub = ap.add_subparsers(dest="command")
@@ -42,16 +42,12 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--animate", metavar="OUT.gif", help="animate the sweep")
     s.add_argument("--plot-quantities", metavar="OUT.png", help="plot the reported quantities against the input")
     s.add_argument("--no-progress", action="store_true", help="no progress bar, even on a terminal")
+    chosen = next((a for a in (argv or []) if not a.startswith("-")), None)
     for name, (module, text) in COMMANDS.items():
-        try:
-            mod = importlib.import_module(module)
-        except ModuleNotFoundError as e:
-            if e.name != module:
-                raise
-            continue
-        if not hasattr(mod, "cli_run"):
-            continue
         c = sub.add_parser(name, help=text)
+        if name != chosen:  # only the command being run is imported
+            continue
+        mod = importlib.import_module(module)
         mod.cli_arguments(c)
         c.set_defaults(run=mod.cli_run)
     return ap
@@ -59,7 +55,8 @@ def _parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
-    ap = _parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    ap = _parser(argv)
     args = ap.parse_args(argv)
     if args.version:
         print(f"kincas {__version__}")

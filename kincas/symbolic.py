@@ -190,11 +190,11 @@ class Symbolic:
         out = ca.vertcat(*raw) if raw else ca.SX(0, 1)
         orders = self._needs(out, qd_s, qdd_s)
         if orders >= 1:  # only build the linear solves that the report needs
-            qd = -ca.solve(self.Jq, ca.mtimes(self.Ju, ud))
+            qd = ca.densify(-ca.solve(self.Jq, ca.mtimes(self.Ju, ud)))  # dense even with no input
             qdd = ca.SX.zeros(self.nq)
             if orders >= 2:
                 gam = ca.jtimes(ca.jtimes(self.g, z, zd), z, zd)
-                qdd = ca.substitute(-ca.solve(self.Jq, ca.mtimes(self.Ju, udd) + gam), qd_s, qd)
+                qdd = ca.densify(ca.substitute(-ca.solve(self.Jq, ca.mtimes(self.Ju, udd) + gam), qd_s, qd))
             out = ca.substitute(ca.substitute(out, qdd_s, qdd), qd_s, qd)
         rows = [out[i] for i in range(out.numel())]
         sens = [(i, b) for i, (k, _, b) in enumerate(parsed) if k == "sens"]

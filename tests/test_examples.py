@@ -159,8 +159,17 @@ def mobility(scene: dict) -> int:
 # ----------------------------------------------------------------------------- the closed forms
 # and the example files, without kincas
 
+# Checked by other files: chains no dyad method solves (tests/test_class3.py) and
+# optimisation studies (tests/test_optimize.py).
+NO_CLOSED_FORM = {"assur_triad", "stephenson3", "eightbar"}
+
+
+def _checked_elsewhere(stem: str) -> bool:
+    return stem in NO_CLOSED_FORM or stem.startswith(("synthesis_", "optimize_"))
+
+
 def test_every_example_has_a_closed_form():
-    assert sorted(p.stem for p in SHIPPED) == sorted(KINDS)
+    assert sorted(p.stem for p in SHIPPED if not _checked_elsewhere(p.stem)) == sorted(KINDS)
 
 
 @pytest.mark.parametrize("path", SHIPPED, ids=lambda p: p.stem)
