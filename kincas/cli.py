@@ -17,6 +17,7 @@ import sys
 
 from . import __version__
 from .errors import KincasError
+from .model import Param
 
 EXIT_OK, EXIT_SCENE, EXIT_UNSOLVED = 0, 2, 3
 
@@ -41,6 +42,8 @@ def _parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
     s.add_argument("--plot", metavar="OUT.png", help="draw the mechanism with the paths of its points")
     s.add_argument("--animate", metavar="OUT.gif", help="animate the sweep")
     s.add_argument("--plot-quantities", metavar="OUT.png", help="plot the reported quantities against the input")
+    s.add_argument("--paths", metavar="P,Q", help="points whose paths --plot and --animate draw (default: every moving point)")
+    s.add_argument("--pose", type=int, metavar="I", help="the pose --plot draws, by index (default: the first solved; -1: the last)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar, even on a terminal")
     chosen = next((a for a in (argv or []) if not a.startswith("-")), None)
     for name, (module, text) in COMMANDS.items():
@@ -77,6 +80,10 @@ def main(argv: list[str] | None = None) -> int:
 def _solve(args) -> int:
     from .scene import load
     sc = load(args.scene)
+    wants_files = args.csv or args.plot or args.animate or args.plot_quantities
+    if wants_files:  # a missing matplotlib or a wrong --paths fails before a long solve
+        from .outputs import check_outputs
+        check_outputs(args, sc.mechanism)
     sw = sc.run(progress=progress_for(args))
     inputs, values = sc.user_inputs(sw), sc.user_values(sw)
     if args.json:
@@ -89,7 +96,7 @@ def _solve(args) -> int:
         sys.stdout.write("\n")
     else:
         _table(sc, sw, inputs, values)
-    if args.csv or args.plot or args.animate or args.plot_quantities:
+    if wants_files:
         from .outputs import write_outputs
         write_outputs(sc, sw, args)
     return EXIT_OK if all(s == "ok" for s in sw.status) else EXIT_UNSOLVED
@@ -124,8 +131,10 @@ def _unit(sc, name: str) -> str:
     kind, obj, attr = parse_quantity(name)
     if kind == "sens":
         return f"{_unit(sc, obj) or '1'} per {attr}"
-    if name in sc.mechanism.param_values:
-        return ""
+    if name in sc.mechanism.param_values:  # a driven parameter: a length, or an angle
+        angular = any(isinstance(sl.angle, Param) and sl.angle.name == name and sl.angle.scale != 1
+                      for sl in sc.mechanism.slides)
+        return A if angular else L
     base = A if is_angular(name) or attr == "angle" else L
     order = {"vx": 1, "vy": 1, "omega": 1, "v": 1, "ax": 2, "ay": 2, "alpha": 2, "a": 2}.get(attr, 0)
     return base + ("" if order == 0 else f"/{T}" if order == 1 else f"/{T}^2")
