@@ -18,7 +18,7 @@ The pass stops at the first pose that fails (every later pose would start from i
 caller re-solves that pose carefully and restarts the pass after it (`FastRun.advance`: a
 call, not a recompilation; `FastSweeper.sweep` runs that loop). The reported quantities are
 computed in the same pass, sharing the trigonometry of the last Newton evaluation. Compiled
-(see `kincas.cbuild`): the casadi functions are code-generated and driven by a small C loop,
+(see `kincas.compiled`): the casadi functions are code-generated and driven by a small C loop,
 the library cached on disk. Without a compiler, or with KINCAS_NO_COMPILE=1, the same
 arithmetic runs in casadi's virtual machine, `mapaccum` over chunks of CHUNK poses.
 
@@ -40,14 +40,13 @@ import weakref
 import casadi as ca
 import numpy as np
 
-from .cbuild import Backend, Library, ptr, rows
+from .compiled import CHUNK, Backend, Library, QuantityEvaluator, ptr, rows
 
 RESIDUAL = 1e-10  # as the careful path's ACCEPT: max |g| / L
 STEP = 1e-12  # the next Newton step (radians, or lengths / L): the error left in q
 JAC_CHANGE = 0.9  # sum |entries of D^-1 (J_prev^-1 J - I) D| (below 1 keeps det's sign)
 CORRECTION = 0.25  # ||D^-1 (q - q_pred)||_1: Newton may not wander far from the prediction
 MAX_EVALS = 5  # residual evaluations per pose: at the prediction and after up to 4 steps
-CHUNK = 256  # poses per call on the uncompiled (virtual machine) path
 INFO = ("residual", "step", "jac_change", "correction", "evaluations")
 
 
@@ -98,7 +97,7 @@ _SWEEP_C = """
 int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const casadi_real* L,
                  const casadi_real* thr, casadi_int max_evals, casadi_real* s, casadi_real* Q,
                  casadi_real* info, casadi_int ld, const casadi_real* Ud, casadi_int sud,
-                 const casadi_real* Udd, casadi_int sudd, casadi_real* vals) {
+                 const casadi_real* Udd, casadi_int sudd, casadi_real* vals, casadi_real* Jout) {
   const casadi_real* arg[SZ_ARG]; casadi_real* res[SZ_RES]; casadi_int iw[SZ_IW]; casadi_real w[SZ_W];
   casadi_real qp[NQ], q[NQ], dq[NQ], J[NQ*NQ], T[NQ*NU], rs[2], mc[2], y[NO > 0 ? NO : 1];
   casadi_int k, i, it;
@@ -120,6 +119,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     if (kC(arg, res, iw, w, 0)) break;
     for (i = 0; i < NQ; ++i) Q[k*NQ + i] = q[i];
     for (i = 0; i < NO; ++i) vals[i*ld + k] = y[i];  /* one contiguous row per quantity */
+    if (Jout) for (i = 0; i < NQ*NQ; ++i) Jout[k*NQ*NQ + i] = J[i];
     info[k] = rs[0]; info[ld + k] = rs[1]; info[2*ld + k] = mc[0]; info[3*ld + k] = mc[1];
     info[4*ld + k] = (casadi_real) it;
     if (!(conv && mc[0] <= thr[2] && mc[1] <= thr[3])) break;
@@ -132,22 +132,6 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
 }
 """
 
-_QUANT_C = """
-int kincas_quantities(casadi_int n, const casadi_real* Q, const casadi_real* U, casadi_int su,
-                      const casadi_real* p, const casadi_real* Ud, casadi_int sud,
-                      const casadi_real* Udd, casadi_int sudd, casadi_real* out, casadi_int ld) {
-  const casadi_real* arg[SZ_ARG]; casadi_real* res[SZ_RES]; casadi_int iw[SZ_IW]; casadi_real w[SZ_W];
-  casadi_real y[NO > 0 ? NO : 1];
-  casadi_int k, i;
-  for (k = 0; k < n; ++k) {
-    arg[0] = Q + k*NQ; arg[1] = U + k*su; arg[2] = p; arg[3] = Ud + k*sud; arg[4] = Udd + k*sudd;
-    res[0] = y;
-    if (kQ(arg, res, iw, w, 0)) return (int) k;
-    for (i = 0; i < NO; ++i) out[i*ld + k] = y[i];
-  }
-  return (int) n;
-}
-"""
 _I, _V = ctypes.c_longlong, ctypes.c_void_p
 
 
@@ -160,10 +144,12 @@ class FastRun:
     `Q` (N, nq): the unknowns, NaN where not solved; `values` (len(report), N): the reported
     quantities; `info` (5, N): per pose attempted, the measures named in INFO; `accepted`:
     the poses the fast pass accepted; `solved`: by either path (`FastSweeper.sweep` fills
-    it); `first_bad`: where the last `advance` stopped.
+    it); `first_bad`: where the last `advance` stopped. The arrays are not initialised
+    (filling 100,000 rows with NaN costs more than solving them): rows that no `advance` or
+    `record` reached are NaN only after `run` or `sweep` returns.
     """
 
-    def __init__(self, sweeper: "FastSweeper", U, p, L, Ud=None, Udd=None):
+    def __init__(self, sweeper: "FastSweeper", U, p, L, Ud=None, Udd=None, jacobians=False):
         self.sweeper, nq, nu = sweeper, sweeper.nq, sweeper.nu
         self.U = np.ascontiguousarray(np.asarray(U, dtype=float).reshape(-1, nu))
         self.n = n = self.U.shape[0]
@@ -171,8 +157,9 @@ class FastRun:
         self.Udd = rows(np.zeros(nu) if Udd is None else Udd, n, nu)
         self.p = np.ascontiguousarray(np.asarray(p, dtype=float).ravel())
         self.L = np.array([float(L)])
-        self.Q, self.info = np.full((n, nq), np.nan), np.full((5, n), np.nan)
-        self.values = np.full((len(sweeper.report), n), np.nan)
+        self.Q, self.info = np.empty((n, nq)), np.empty((5, n))
+        self.values = np.empty((len(sweeper.report), n))
+        self.J = np.empty((n, nq * nq)) if jacobians else None  # g_q per pose, column-major
         self.accepted, self.solved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
         self.thr = np.array([RESIDUAL, STEP, JAC_CHANGE, CORRECTION])
         self.first_bad = 0
@@ -183,6 +170,12 @@ class FastRun:
     correction = property(lambda self: self.info[3], doc="||D^-1 (q - q_pred)||_1")
     iterations = property(lambda self: np.nan_to_num(self.info[4], nan=1.0).astype(int) - 1,
                           doc="Newton steps taken at each pose")
+
+    @property
+    def jacobian(self) -> np.ndarray:
+        """g_q at each pose, (N, nq, nq) (with `jacobians=True`; NaN where not solved)."""
+        nq = self.sweeper.nq
+        return self.J.reshape(-1, nq, nq).transpose(0, 2, 1)
 
     def advance(self, start: int, q_last, u_last) -> int:
         """Solve poses start, start + 1, ... from the solved pose (q_last, u_last) until one
@@ -198,19 +191,27 @@ class FastRun:
             k = start + lib.kincas_sweep(
                 self.n - start, ptr(self.U, start * sw.nu), ptr(self.p), ptr(self.L), ptr(self.thr),
                 sw.max_evals, ptr(s), ptr(self.Q, start * sw.nq), ptr(self.info, start), self.n,
-                ptr(Ud, start * sud), sud, ptr(Udd, start * sudd), sudd, ptr(self.values, start))
+                ptr(Ud, start * sud), sud, ptr(Udd, start * sudd), sudd, ptr(self.values, start),
+                None if self.J is None else ptr(self.J, start * sw.nq * sw.nq))
         else:
             k = sw._vm_advance(self, start, s)
         self.accepted[start:k] = self.solved[start:k] = True
         if k < self.n:
             self.Q[k] = self.values[:, k] = np.nan
+            if self.J is not None:
+                self.J[k] = np.nan
         self.first_bad = k
         return k
 
     def record(self, k: int, sol) -> None:
         """Store a carefully solved pose (an object with q, residual, iterations, ok)."""
         self.solved[k] = bool(sol.ok)
-        self.Q[k] = sol.q if sol.ok else np.nan
+        self.Q[k], self.values[:, k] = (sol.q if sol.ok else np.nan), np.nan  # values: see sweep
+        if self.J is not None:
+            J = getattr(sol, "J", None)
+            if sol.ok and J is None:
+                J = np.asarray(self.sweeper.sym.f_resjac(sol.q, self.U[k], self.p)[1])
+            self.J[k] = np.ravel(J, order="F") if sol.ok else np.nan
         self.info[:, k] = [sol.residual, np.nan, np.nan, np.nan, sol.iterations + 1]
 
 
@@ -234,7 +235,7 @@ class FastSweeper:
     def _library(self) -> Library:
         return Library("kincas_sweep", self.functions, _SWEEP_C,
                        {"NQ": self.nq, "NU": self.nu, "NO": len(self.report)},
-                       {"kincas_sweep": [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V]})
+                       {"kincas_sweep": [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V, _V]})
 
     def state(self, q, u, p) -> np.ndarray:
         """(q, J, dq/du, u) at a solved pose, J and dq/du column-major as casadi keeps them."""
@@ -245,31 +246,35 @@ class FastSweeper:
             T = np.full_like(Ju, np.nan)
         return np.concatenate([np.ravel(q), J.ravel(order="F"), T.ravel(order="F"), np.ravel(u)])
 
-    def run(self, U, p, L, q_start, u_start, start: int = 0, Ud=None, Udd=None) -> FastRun:
+    def run(self, U, p, L, q_start, u_start, start: int = 0, Ud=None, Udd=None,
+            jacobians=False) -> FastRun:
         """Poses U[start:] (an (N, nu) table) from the solved pose (q_start, u_start)."""
-        r = FastRun(self, U, p, L, Ud, Udd)
-        r.advance(start, q_start, u_start)
+        r = FastRun(self, U, p, L, Ud, Udd, jacobians)
+        k = r.advance(start, q_start, u_start)
+        for a in (r.Q, r.info.T, r.values.T) + (() if r.J is None else (r.J,)):  # not reached
+            a[:start], a[k + 1:] = np.nan, np.nan
         return r
 
-    def sweep(self, U, p, L, careful, Ud=None, Udd=None, progress=None) -> FastRun:
-        """Every pose of U: the fast pass wherever it is accepted, else `careful(k, q_last,
-        u_last)` -> a solution with q, residual, iterations, ok (q_last None while no pose is
-        solved), each from the last solved pose; the fast pass restarts after each."""
-        r = FastRun(self, U, p, L, Ud, Udd)
+    def sweep(self, U, p, L, careful, Ud=None, Udd=None, progress=None, jacobians=False) -> FastRun:
+        """Every pose of U: the fast pass wherever it is accepted, else `careful(k, j, q_j)`
+        -> a solution with q, residual, iterations, ok, where j is the last solved pose and
+        q_j its unknowns (None, None while none is); the fast pass restarts after each.
+        Between two consecutive fast poses det g_q keeps its sign (see the module's text)."""
+        r = FastRun(self, U, p, L, Ud, Udd, jacobians)
         k, last = 0, None
         while k < r.n:
             if last is not None:
-                bad = r.advance(k, *last)
+                bad = r.advance(k, r.Q[last], r.U[last])
                 if bad > k:
-                    last = (r.Q[bad - 1], r.U[bad - 1])
+                    last = bad - 1
                     if progress is not None:
                         progress(bad, r.n)
                 if (k := bad) == r.n:
                     break
-            sol = careful(k, *(last or (None, None)))
+            sol = careful(k, last, None if last is None else r.Q[last])
             r.record(k, sol)
             if sol.ok:
-                last = (r.Q[k], r.U[k])
+                last = k
             k += 1
         slow = np.flatnonzero(r.solved & ~r.accepted)
         if self.report and slow.size:
@@ -309,6 +314,8 @@ class FastSweeper:
             j = m if ok.all() else int(np.argmin(ok))
             e = min(j + 1, m)
             r.Q[k:k + e], r.info[:, k:k + e], r.values[:, k:k + e] = Qc[:e], Ic[:e].T, Yc[:e].T
+            if r.J is not None:
+                r.J[k:k + e] = Jc[:e]
             if j < m:
                 return k + j
             parts = [Qc[m - 1].copy(), Jc[m - 1].copy(), Tc[m - 1].copy(), Uo[m - 1].copy()]
@@ -319,76 +326,6 @@ class FastSweeper:
 def _take(table, idx):
     a, stride = table
     return a if stride == 0 else a[idx]
-
-
-# --- the reported quantities at given poses ---
-
-
-class QuantityEvaluator:
-    """Named quantities at N solved poses, only what they need built: a C loop over the
-    compiled quantity function (cached like the sweep kernel), else casadi's `map` over
-    chunks of CHUNK poses, bound to numpy buffers.
-
-    >>> import numpy as np, kincas
-    >>> m = kincas.Mechanism(ground={"A": (0, 0)}, links=[kincas.Link.bar("crank", "A", "B", 2)],
-    ...     inputs=[kincas.Input.angle("crank")])
-    >>> ev = QuantityEvaluator(kincas.compile(m), ["B.y", "B.vx"], compile=False)
-    >>> ev.evaluate(np.zeros((2, 0)), np.array([[0.0], [np.pi / 2]]), [], Ud=[3.0]).round(12)
-    array([[ 0.,  2.],
-           [-0., -6.]])
-    """
-
-    def __init__(self, model, names, *, compile=None):
-        self.names, self.nq, self.nu = tuple(names), model.sym.nq, model.sym.nu
-        f = model.quantity_function(self.names)
-        ins = f.sx_in()
-        self.f = ca.Function("kQ", ins, [ca.densify(f(*ins))], {"cse": True})
-        self.no = self.f.size1_out(0)
-        self._vm = None
-        self.backend = Backend(compile, self._library, "quantity evaluator")
-
-    def _library(self) -> Library:
-        return Library("kincas_quantities", [self.f], _QUANT_C, {"NQ": self.nq, "NO": self.no},
-                       {"kincas_quantities": [_I, _V, _V, _I, _V, _V, _I, _V, _I, _V, _I]})
-
-    def evaluate(self, Q, U, p, Ud=None, Udd=None, ok=None) -> np.ndarray:
-        """(len(names), N) values at the poses (Q (N, nq), U (N, nu) tables; rates Ud and
-        accelerations Udd tables or one row, default 1 and 0); NaN where `ok` is False."""
-        U = np.asarray(U, dtype=float).reshape(-1, self.nu)
-        n = U.shape[0]
-        Q = np.ascontiguousarray(np.asarray(Q, dtype=float).reshape(n, self.nq))
-        U, su = rows(U, n, self.nu)
-        Ud, sud = rows(np.ones(self.nu) if Ud is None else Ud, n, self.nu)
-        Udd, sudd = rows(np.zeros(self.nu) if Udd is None else Udd, n, self.nu)
-        p = np.ascontiguousarray(np.asarray(p, dtype=float).ravel())
-        out = np.empty((self.no, n))
-        lib = self.backend.compiled(n) if n and self.no else None
-        if lib is not None:
-            lib.kincas_quantities(n, ptr(Q), ptr(U), su, ptr(p), ptr(Ud), sud, ptr(Udd), sudd,
-                                  ptr(out), n)
-        elif n and self.no:
-            self._vm_evaluate(Q, (U, su), p, (Ud, sud), (Udd, sudd), out)
-        if ok is not None:
-            out[:, ~np.asarray(ok, dtype=bool)] = np.nan
-        return out
-
-    def _vm_evaluate(self, Q, U, p, Ud, Udd, out):
-        if self._vm is None:
-            F = self.f.map("qmap", "serial", CHUNK, [2], [])  # p is the same for every pose
-            buf, call = F.buffer()
-            scratch = [np.zeros((CHUNK, m)) for m in (self.nq, self.nu, self.nu, self.nu, self.no)]
-            buf.set_res(0, memoryview(scratch[-1]))
-            self._vm = (F, buf, call, scratch)  # buf holds raw pointers: keep it referenced
-        _, buf, call, (Qc, Uc, Udc, Uddc, Oc) = self._vm
-        n = Q.shape[0]
-        for k in range(0, n, CHUNK):
-            m = min(CHUNK, n - k)
-            for c, (a, st) in ((Qc, (Q, 1)), (Uc, U), (Udc, Ud), (Uddc, Udd)):
-                c[:m], c[m:] = (a[k:k + m] if st else a), (a[k + m - 1] if st else a)  # pad
-            for i, a in enumerate((Qc, Uc, p, Udc, Uddc)):
-                buf.set_arg(i, memoryview(a))
-            call()
-            out[:, k:k + m] = Oc[:m].T
 
 
 # --- one sweeper per compiled model and report ---

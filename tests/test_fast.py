@@ -278,9 +278,9 @@ def test_non_grashof_driven_past_its_toggle_and_back():
     sign = lambda q, u: np.sign(np.linalg.det(model.jac(q, u, p)))
     calls, ref = [], []
 
-    def careful(k, q_last, u_last):  # Newton from the last solved pose, branch by det's sign
+    def careful(k, j, q_j):  # Newton from the last solved pose j, branch by det's sign
         calls.append(k)
-        start = model.initial_q(U[k], p, dict(m.guess), L) if q_last is None else q_last
+        start = model.initial_q(U[k], p, dict(m.guess), L) if j is None else q_j
         sol = model.newton(start, U[k], p, L)
         if sol.ok and not ref:
             ref.append(sign(sol.q, U[k]))
@@ -290,7 +290,7 @@ def test_non_grashof_driven_past_its_toggle_and_back():
                 sol = Solution(sol.q, sol.residual, sol.iterations, False)
         return sol
 
-    run = FastSweeper(model, ["C.x", "C.y"], compile=True).sweep(U, p, L, careful)
+    run = FastSweeper(model, ["C.x", "C.y"], compile=True).sweep(U, p, L, careful, jacobians=True)
     acc = run.accepted
     assert not np.any(acc & impossible) and not np.any(run.solved & impossible)
     err = np.hypot(run.values[0] - cf["C.x"], run.values[1] - cf["C.y"])
@@ -300,3 +300,9 @@ def test_non_grashof_driven_past_its_toggle_and_back():
     # the fast pass did most of the work, on every stretch between the impossible ones
     assert acc.sum() >= (~impossible).sum() - 12 and len(calls) <= impossible.sum() + 12
     check_residuals(model, run, p, L)
+    # g_q at every pose, from the kernel or the careful path: one branch, one sign of det g_q
+    J = run.jacobian
+    assert np.isnan(J[~run.solved]).all()
+    for k in np.flatnonzero(run.solved)[::50]:
+        np.testing.assert_allclose(J[k], model.jac(run.Q[k], U[k], p), rtol=0, atol=1e-12)
+    assert len(set(np.sign(np.linalg.det(J[run.solved])))) == 1

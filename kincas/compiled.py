@@ -1,11 +1,12 @@
-"""CasADi functions compiled with a C driver into a shared library, cached on disk.
+"""CasADi functions looped over many poses in compiled C, the library cached on disk.
 
 `Library` code-generates casadi functions together with a hand-written C loop that calls
 them, compiles the whole with the C compiler ($CC, else gcc or cc) and keeps the result in
 the cache directory under a hash of its source, the compiler and casadi's version: a second
 process, or a second run, loads it without compiling. `Backend` decides when compiling is
 worth it and falls back to casadi's virtual machine, with a warning, when it fails: a missing
-compiler never fails a user's solve.
+compiler never fails a user's solve. `QuantityEvaluator` is the simplest such loop: reported
+quantities at N given poses (`kincas.fast` builds the sweep itself the same way).
 
 >>> import casadi as ca
 >>> x = ca.SX.sym("x")
@@ -28,9 +29,13 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
+CHUNK = 256  # poses per call on the uncompiled (virtual machine) paths
 COMPILE_MIN_POSES = 50_000  # compile=None compiles for fewer poses only if already cached
 _FLAGS = ["-O3", "-shared", "-fPIC", "-Wl,-Bsymbolic"]  # own symbols bind inside each library
 _LIBS: dict[str, ctypes.CDLL] = {}  # loaded libraries by path (the path holds the hash)
+
+
+# --- building and caching ---
 
 
 def cache_dir() -> Path:
@@ -161,3 +166,91 @@ def rows(a, n: int, width: int) -> tuple[np.ndarray, int]:
     if width == 0 or a.strides[0] == 0:
         return np.ascontiguousarray(a[0] if n else np.zeros(width)), 0
     return np.ascontiguousarray(a), width
+
+
+# --- the reported quantities at given poses ---
+
+_QUANT_C = """
+int kincas_quantities(casadi_int n, const casadi_real* Q, const casadi_real* U, casadi_int su,
+                      const casadi_real* p, const casadi_real* Ud, casadi_int sud,
+                      const casadi_real* Udd, casadi_int sudd, casadi_real* out, casadi_int ld) {
+  const casadi_real* arg[SZ_ARG]; casadi_real* res[SZ_RES]; casadi_int iw[SZ_IW]; casadi_real w[SZ_W];
+  casadi_real y[NO > 0 ? NO : 1];
+  casadi_int k, i;
+  for (k = 0; k < n; ++k) {
+    arg[0] = Q + k*NQ; arg[1] = U + k*su; arg[2] = p; arg[3] = Ud + k*sud; arg[4] = Udd + k*sudd;
+    res[0] = y;
+    if (kQ(arg, res, iw, w, 0)) return (int) k;
+    for (i = 0; i < NO; ++i) out[i*ld + k] = y[i];
+  }
+  return (int) n;
+}
+"""
+_I, _V = ctypes.c_longlong, ctypes.c_void_p
+
+
+class QuantityEvaluator:
+    """Named quantities at N solved poses, only what they need built: a C loop over the
+    compiled quantity function (cached like the sweep kernel), else casadi's `map` over
+    chunks of CHUNK poses, bound to numpy buffers.
+
+    >>> import numpy as np, kincas
+    >>> m = kincas.Mechanism(ground={"A": (0, 0)}, links=[kincas.Link.bar("crank", "A", "B", 2)],
+    ...     inputs=[kincas.Input.angle("crank")])
+    >>> ev = QuantityEvaluator(kincas.compile(m), ["B.y", "B.vx"], compile=False)
+    >>> ev.evaluate(np.zeros((2, 0)), np.array([[0.0], [np.pi / 2]]), [], Ud=[3.0]).round(12)
+    array([[ 0.,  2.],
+           [-0., -6.]])
+    """
+
+    def __init__(self, model, names, *, compile=None):
+        self.names, self.nq, self.nu = tuple(names), model.sym.nq, model.sym.nu
+        f = model.quantity_function(self.names)
+        ins = f.sx_in()
+        self.f = ca.Function("kQ", ins, [ca.densify(f(*ins))], {"cse": True})
+        self.no = self.f.size1_out(0)
+        self._vm = None
+        self.backend = Backend(compile, self._library, "quantity evaluator")
+
+    def _library(self) -> Library:
+        return Library("kincas_quantities", [self.f], _QUANT_C, {"NQ": self.nq, "NO": self.no},
+                       {"kincas_quantities": [_I, _V, _V, _I, _V, _V, _I, _V, _I, _V, _I]})
+
+    def evaluate(self, Q, U, p, Ud=None, Udd=None, ok=None) -> np.ndarray:
+        """(len(names), N) values at the poses (Q (N, nq), U (N, nu) tables; rates Ud and
+        accelerations Udd tables or one row, default 1 and 0); NaN where `ok` is False."""
+        U = np.asarray(U, dtype=float).reshape(-1, self.nu)
+        n = U.shape[0]
+        Q = np.ascontiguousarray(np.asarray(Q, dtype=float).reshape(n, self.nq))
+        U, su = rows(U, n, self.nu)
+        Ud, sud = rows(np.ones(self.nu) if Ud is None else Ud, n, self.nu)
+        Udd, sudd = rows(np.zeros(self.nu) if Udd is None else Udd, n, self.nu)
+        p = np.ascontiguousarray(np.asarray(p, dtype=float).ravel())
+        out = np.empty((self.no, n))
+        lib = self.backend.compiled(n) if n and self.no else None
+        if lib is not None:
+            lib.kincas_quantities(n, ptr(Q), ptr(U), su, ptr(p), ptr(Ud), sud, ptr(Udd), sudd,
+                                  ptr(out), n)
+        elif n and self.no:
+            self._vm_evaluate(Q, (U, su), p, (Ud, sud), (Udd, sudd), out)
+        if ok is not None:
+            out[:, ~np.asarray(ok, dtype=bool)] = np.nan
+        return out
+
+    def _vm_evaluate(self, Q, U, p, Ud, Udd, out):
+        if self._vm is None:
+            F = self.f.map("qmap", "serial", CHUNK, [2], [])  # p is the same for every pose
+            buf, call = F.buffer()
+            scratch = [np.zeros((CHUNK, m)) for m in (self.nq, self.nu, self.nu, self.nu, self.no)]
+            buf.set_res(0, memoryview(scratch[-1]))
+            self._vm = (F, buf, call, scratch)  # buf holds raw pointers: keep it referenced
+        _, buf, call, (Qc, Uc, Udc, Uddc, Oc) = self._vm
+        n = Q.shape[0]
+        for k in range(0, n, CHUNK):
+            m = min(CHUNK, n - k)
+            for c, (a, st) in ((Qc, (Q, 1)), (Uc, U), (Udc, Ud), (Uddc, Udd)):
+                c[:m], c[m:] = (a[k:k + m] if st else a), (a[k + m - 1] if st else a)  # pad
+            for i, a in enumerate((Qc, Uc, p, Udc, Uddc)):
+                buf.set_arg(i, memoryview(a))
+            call()
+            out[:, k:k + m] = Oc[:m].T
