@@ -42,9 +42,12 @@ def install_requirements(skip: bool) -> dict:
     from peers import module_available
     for req in filter(None, lines):
         name = req.split("[")[0].split("=")[0].split(">")[0].split("<")[0].strip()
-        mod = PEER_PACKAGES.get(name, name.replace("-", "_"))
-        if module_available(mod) is None or skip:
-            out[req] = module_available(mod)
+        extras = req.split("[")[1].split("]")[0].split(",") if "[" in req else []
+        mods = [PEER_PACKAGES.get(name, name.replace("-", "_"))] + [PEER_PACKAGES[e] for e in extras
+                                                                     if e in PEER_PACKAGES]
+        missing = next(filter(None, map(module_available, mods)), None)
+        if missing is None or skip:
+            out[req] = missing
             continue
         p = subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--disable-pip-version-check", req],
                            capture_output=True, text=True, timeout=900)
@@ -167,21 +170,36 @@ def study_growth(cfg, log) -> dict:
     return out
 
 
-def other_benchmarks(quick: bool, timeout: float, log) -> list[tuple[str, str, str]]:
-    """Run the other bench_*.py scripts beside this file: [(script, status, their output)]."""
+def other_benchmarks(quick: bool, deadline: float, log) -> list[tuple[str, str, str]]:
+    """Run the other bench_*.py scripts beside this file, sharing the time left before
+    `deadline` (a perf_counter value): [(script, status, report)]. The report is the markdown
+    a script wrote beside itself (results_*.md, written during its run), else its output."""
     out = []
-    for path in sorted(HERE.glob("bench_*.py")):
-        cmd = [sys.executable, str(path)] + (["--quick"] if quick else [])
+    scripts = sorted(HERE.glob("bench_*.py"))
+    for i, path in enumerate(scripts):
+        takes_quick = "--quick" in path.read_text(encoding="utf-8", errors="replace")
+        cmd = [sys.executable, str(path)] + (["--quick"] if quick and takes_quick else [])
+        timeout = max(30.0, (deadline - time.perf_counter()) / (len(scripts) - i))
+        before = {f: f.stat().st_mtime_ns for f in HERE.glob("results_*.md")}
         t0 = time.perf_counter()
         try:
             p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=str(ROOT))
             status = f"exit {p.returncode} after {time.perf_counter() - t0:.0f} s"
-            text = p.stdout if p.returncode == 0 else (p.stdout + "\n" + p.stderr)[-4000:]
+            written = [f for f in sorted(HERE.glob("results_*.md")) if before.get(f) != f.stat().st_mtime_ns]
+            if p.returncode == 0 and written:
+                text = "\n\n".join(_demote(f.read_text(encoding="utf-8")) for f in written)
+            else:
+                text = p.stdout if p.returncode == 0 else "```\n" + (p.stdout + "\n" + p.stderr)[-4000:] + "\n```"
         except subprocess.TimeoutExpired:
-            status, text = f"stopped after {timeout:.0f} s (time limit)", ""
+            status, text = f"stopped after {timeout:.0f} s (its share of the time limit)", ""
         log(f"  {path.name}: {status}")
         out.append((path.name, status, text))
     return out
+
+
+def _demote(md_text: str) -> str:
+    """Headings three levels down, so that a script's report nests under its own heading."""
+    return "\n".join("###" + ln if ln.startswith("#") else ln for ln in md_text.splitlines())
 
 
 # --- the whole run ---
@@ -189,9 +207,9 @@ def other_benchmarks(quick: bool, timeout: float, log) -> list[tuple[str, str, s
 
 CONFIG = {
     "full": {"n": 720, "repeats": 5, "n_stiff": 360, "chain": [1, 2, 5, 10, 20, 40], "chain_poses": 100,
-             "others_timeout": 200.0},
+             "budget": 570.0},
     "quick": {"n": 72, "repeats": 3, "n_stiff": 72, "chain": [1, 4, 10], "chain_poses": 30,
-              "others_timeout": 60.0},
+              "budget": 120.0},
 }
 
 
@@ -216,7 +234,8 @@ def main(argv=None) -> int:
     stab = study_stability(cfg, log)
     log("4. growth ...")
     growth = study_growth(cfg, log)
-    others = [] if args.no_others else other_benchmarks(args.quick, cfg["others_timeout"], log)
+    deadline = t_start + cfg["budget"]  # the other scripts share what is left of it
+    others = [] if args.no_others else other_benchmarks(args.quick, deadline, log)
     from peers.report import write_report
     out = Path(args.out)
     write_report(out, quick=args.quick, cfg=cfg, installs=installs, machine=machine(), main=main_res,

@@ -1,8 +1,8 @@
 """kincas's own methods and settings, each as a timed tool, through its public API only.
 
 - `sweep[...]`: one `kincas.sweep` call for the whole sweep, with each option set that this
-  kincas accepts (`method`, `compile`; an option its `sweep` does not have is reported as
-  missing, not faked);
+  kincas accepts (`method`, `compile` or `jit`; an option its `sweep` does not have is
+  reported as missing, not faked);
 - `solve per pose`: one `kincas.solve` call per pose, its guess the previous pose's points;
 - `newton per pose, tol T`: `kincas.compile(m).newton` from the previous pose's unknowns,
   velocities for all poses in one `model.quantities` call at the end; the tolerance is
@@ -25,25 +25,25 @@ import numpy as np
 from . import Run
 
 IPOPT_STRIDE = 8
-# (label, keyword arguments for kincas.sweep): kept when this kincas's sweep takes them
-SWEEP_VARIANTS = [
-    ("sweep (default)", {}),
-    ("sweep, method=careful", {"method": "careful"}),
-    ("sweep, method=fast, compiled", {"method": "fast", "compile": True}),
-    ("sweep, method=fast, not compiled", {"method": "fast", "compile": False}),
-]
 TOLS = (1e-6, 1e-9, 1e-13)
 
 
 def sweep_variants() -> tuple[list, list]:
-    """([(label, kwargs)] this kincas supports, [(label, why not)])."""
+    """([(label, kwargs for kincas.sweep)] this kincas takes, [(label, why not)]): the default,
+    then `method` = "careful" and "fast", and the fast method with its compile switch on and
+    off (named `compile` or `jit`), each only if this kincas's `sweep` has the option."""
     import kincas
     params = inspect.signature(kincas.sweep).parameters
-    ok, missing = [], []
-    for label, kw in SWEEP_VARIANTS:
-        absent = [k for k in kw if k not in params]
-        (missing if absent else ok).append((label, f"kincas.sweep has no {', '.join(absent)!s} option"
-                                            if absent else kw))
+    ok, missing = [("sweep (default)", {})], []
+    if "method" not in params:
+        missing.append(("sweep, method=careful / fast", "kincas.sweep has no `method` option"))
+        return ok, missing
+    ok += [("sweep, method=careful", {"method": "careful"}), ("sweep, method=fast", {"method": "fast"})]
+    switch = next((k for k in ("compile", "jit") if k in params), None)
+    if switch is None:
+        missing.append(("sweep, method=fast, compiled / not", "kincas.sweep has no `compile` or `jit` option"))
+    else:
+        ok += [(f"sweep, method=fast, {switch}={v}", {"method": "fast", switch: v}) for v in (True, False)]
     return ok, missing
 
 

@@ -84,8 +84,8 @@ def errors(case, run, P, V, rows=slice(None)) -> tuple[float, float]:
 def distance(case, run, P) -> np.ndarray:
     """Per pose, the largest distance / L between the tool's and P's compared points."""
     d = np.zeros(run.n)
-    for p in case.outputs:
-        d = np.fmax(d, np.linalg.norm(run.P[p] - P[p], axis=1))
+    for p in case.outputs:  # np.maximum, not fmax: a point that is NaN on either side is no match
+        d = np.maximum(d, np.linalg.norm(run.P[p] - P[p], axis=1))
     return d / case.size
 
 

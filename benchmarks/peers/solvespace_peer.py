@@ -1,12 +1,11 @@
 """python-solvespace (SolveSpace's geometric constraint solver), in its documented solve loop.
 
-The sketch is built once: ground points (and a "hand" point that carries the input angle)
-in group 1, which the solver holds fixed; moving points in group 2, started at the case's
-guess. Constraints: `distance` for every pair of points on a link (a triangle's three sides),
-`coincident(point, line)` for every slide, and for the input the crank's tip on the line from
-the pivot through the hand point, with the crank's length (the way Pyslvs drives an input
-link by a dragged hand point). Each pose moves the hand with `set_params` and calls `solve()`:
-the solver starts from the previous pose's parameters, a warm start. A pose counts as solved
+The sketch is built once: ground points and the crank's tip (dragged: the input places it,
+as a user drags a driving point) in group 1, which the solver holds fixed; the other moving
+points in group 2, started at the case's guess. Constraints: `distance` for every pair of
+points on a link (a triangle's three sides) and `coincident(point, line)` for every slide.
+Each pose moves the tip with `set_params` and calls `solve()`: the solver starts from the
+previous pose's parameters, a warm start. A pose counts as solved
 when `solve()` returns `ResultFlag.OKAY`; after a failure the last solved parameters are put
 back. SolveSpace computes positions only: there are no velocities.
 
@@ -49,7 +48,7 @@ def prepare(case):
         s.dragged(ent[g], wp)
     ox, oy = case.ground[o]
     t0 = float(case.theta[0])
-    hand = s.add_point_2d(ox + math.cos(t0), oy + math.sin(t0), wp)
+    hand = ent[tip] = s.add_point_2d(ox + r * math.cos(t0), oy + r * math.sin(t0), wp)
     s.dragged(hand, wp)
     lines = {}
     for p, t, ang in case.slides:
@@ -57,17 +56,16 @@ def prepare(case):
         s.dragged(far, wp)
         lines[p] = (t, far)
     s.set_group(2)
-    for p in case.moving:
+    free = [p for p in case.moving if p != tip]
+    for p in free:
         ent[p] = s.add_point_2d(*case.guess[p], wp)
-    s.distance(ent[o], ent[tip], r, wp)
-    s.coincident(ent[tip], s.add_line_2d(ent[o], hand, wp), wp)
     for p, q, l in pairs(case):
         s.distance(ent[p], ent[q], l, wp)
     for p, (t, far) in lines.items():
         s.coincident(ent[p], s.add_line_2d(ent[t], far, wp), wp)
-    start = {p: s.params(ent[p].params) for p in case.moving}
+    start = {p: s.params(ent[p].params) for p in free}
     theta, outs, okay = case.theta, case.outputs, ResultFlag.OKAY
-    hands = np.stack([ox + np.cos(theta), oy + np.sin(theta)], axis=1).tolist()
+    hands = np.stack([ox + r * np.cos(theta), oy + r * np.sin(theta)], axis=1).tolist()
 
     def run():
         for p, v in start.items():
@@ -82,7 +80,7 @@ def prepare(case):
                 ok[k] = True
                 for p in outs:
                     P[p][k] = s.params(ent[p].params)
-                last = {p: s.params(ent[p].params) for p in case.moving}
+                last = {p: s.params(ent[p].params) for p in free}
             else:  # start the next pose from the last solved one
                 for p, v in last.items():
                     s.set_params(ent[p].params, v)
