@@ -166,16 +166,19 @@ def study_growth(cfg, log) -> dict:
             t = time_tool(lambda: prep(case), cfg["repeats"], budget=10.0)
             res[lb] = {"t": t, "err": errors(case, t.run, P, V) if t.error is None else (float("nan"),) * 2}
         log(f"  chain {n:3d}: compile {res['compile']:.2f} s, " + ", ".join(
-            f"{lb.split(',')[0]} {res[lb]['t'].median * 1e6:.1f}" for lb, _ in tools))
+            f"{lb} {res[lb]['t'].median * 1e6:.1f}" for lb, _ in tools))
     return out
 
 
 def other_benchmarks(quick: bool, deadline: float, log) -> list[tuple[str, str, str]]:
     """Run the other bench_*.py scripts beside this file, sharing the time left before
     `deadline` (a perf_counter value): [(script, status, report)]. The report is the markdown
-    a script wrote beside itself (results_*.md, written during its run), else its output."""
+    a script wrote beside itself (results_*.md, written during its run), else its output.
+    In a quick run the scripts' own result files are restored afterwards."""
     out = []
     scripts = sorted(HERE.glob("bench_*.py"))
+    # a quick run's reports are smoke: the scripts' own result files are put back afterwards
+    saved = {f: f.read_bytes() for f in HERE.glob("results_*.md")} if quick else {}
     for i, path in enumerate(scripts):
         takes_quick = "--quick" in path.read_text(encoding="utf-8", errors="replace")
         cmd = [sys.executable, str(path)] + (["--quick"] if quick and takes_quick else [])
@@ -194,6 +197,12 @@ def other_benchmarks(quick: bool, deadline: float, log) -> list[tuple[str, str, 
             status, text = f"stopped after {timeout:.0f} s (its share of the time limit)", ""
         log(f"  {path.name}: {status}")
         out.append((path.name, status, text))
+    if quick:
+        for f in HERE.glob("results_*.md"):
+            if f in saved:
+                f.write_bytes(saved[f])
+            else:
+                f.unlink()
     return out
 
 
