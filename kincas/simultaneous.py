@@ -24,6 +24,7 @@ from .results import Sweep, wrap_angle
 REFINE = 400  # poses of the checking sweep between the first and the last sample, at least
 SAME_POSE = 1e-7  # relative: a pose reached by the checking sweep equals the optimised one
 CON_TOL = 1e-6  # relative violation allowed of a constraint after polishing
+EXTREME_MOVED = "the checking sweep reaches"  # the words of that problem, for a new round
 
 
 @dataclass
@@ -62,6 +63,7 @@ class OptimizeResult:
     iterations: int
     problems: list[str] = field(default_factory=list)
     sweep: Sweep | None = None
+    info: dict = field(default_factory=dict)
 
 
 def _as_constraint(c, i) -> Constraint:
@@ -437,7 +439,7 @@ class Problem:
             slack = 1e-6 * max(float(np.ptp(v)), abs(value), 1e-300)
             if (v[j] > value + slack) if fn == "max" else (v[j] < value - slack):
                 problems.append(f"{fn}({e['text']}): the optimiser tracked {value:.6g} at input "
-                                f"{e['u']:.6g}, but the checking sweep reaches {v[j]:.6g} at "
+                                f"{e['u']:.6g}, but {EXTREME_MOVED} {v[j]:.6g} at "
                                 f"input {U[ok[j], 0]:.6g}")
         return out
 

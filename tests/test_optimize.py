@@ -216,6 +216,25 @@ def test_per_sample_constraint_holds_at_every_sample():
     assert np.allclose(v, 90.0 - np.degrees(np.abs(phi)), atol=1e-8)
 
 
+def test_an_extreme_that_moves_is_tracked_again_where_it_went():
+    # E = B.y - t B.x = a (sin th - t cos th) over crank angles 0..120 deg: for t = 1 its
+    # maximum is at the end of the range (120 deg); for t = -1 it is inside, at 45 deg,
+    # a sqrt(1 + t^2). The optimiser moves t from 1 to -1, so the extreme it tracked at the
+    # end is no longer the maximum: a second round must find it inside.
+    m = Mechanism(parameters={"a": 1.0, "t": 1.0}, ground={"A": (0, 0), "D": (4, 0)},
+                  links=[Link.bar("crank", "A", "B", "a"), Link.bar("coupler", "B", "C", 3.5),
+                         Link.bar("rocker", "D", "C", 3)],
+                  inputs=[Input.angle("crank")], guess={"C": (3.6, 2.9)})
+    r = optimize(m, {"crank.angle": np.radians([0.0, 60.0, 120.0])}, vary={"t": (-2.0, 2.0)},
+                 minimize="(t + 1)^2", constraints=[("max(B.y - t * B.x)", None, 10.0)])
+    assert r.ok and r.info["rounds"] == 2
+    assert r.varied["t"] == pytest.approx(-1.0, abs=1e-9)
+    (e,) = r.extremes
+    assert e["value"] == pytest.approx(math.sqrt(2.0), rel=1e-12)
+    assert e["input"] == pytest.approx(math.pi / 4, abs=1e-9)
+    assert r.mechanism.parameter("t") == pytest.approx(-1.0, abs=1e-9)
+
+
 # --- designs that must not be called optimal ---
 
 
