@@ -33,14 +33,71 @@ so the rocker from D = (4, 0) is c = sqrt((sqrt(10) - 4)^2 + 2.5^2).)
 """
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
 from .model import Mechanism
-from .simultaneous import EXTREME_MOVED, Constraint, OptimizeResult, Problem
+from .errors import ModelError
+from .results import Sweep
+from .simultaneous import EXTREME_MOVED, Problem
 
 MAX_ROUNDS = 3  # IPOPT runs when extremes moved away from where they were tracked
 
 __all__ = ["optimize", "Constraint", "OptimizeResult", "cli_arguments", "cli_run"]
+
+
+@dataclass
+class Constraint:
+    """`min <= expr <= max` (either bound may be None); per sample when expr is."""
+
+    expr: str
+    min: float | None = None
+    max: float | None = None
+
+
+@dataclass
+class OptimizeResult:
+    """What the optimiser found, and whether it may be trusted (`ok`).
+
+    `converged`: IPOPT reported success; `ok`: that, and the optimised design passed every
+    check (`problems` says which failed). `mechanism` is the optimised design as a new value,
+    its guess set to its pose at the first sample (so it keeps the branch). `values` are the
+    quantities named in the expressions at the samples (radians); `constraints` gives each
+    constraint's value(s) and whether it holds; `extremes` the tracked max()/min()."""
+
+    ok: bool
+    converged: bool
+    status: str
+    message: str
+    objective: float
+    initial_objective: float
+    parameters: dict[str, float]
+    varied: dict[str, float]
+    mechanism: Mechanism
+    samples: dict[str, np.ndarray]
+    q: np.ndarray
+    values: dict[str, np.ndarray]
+    constraints: list[dict]
+    extremes: list[dict]
+    iterations: int
+    problems: list[str] = field(default_factory=list)
+    sweep: Sweep | None = None
+    info: dict = field(default_factory=dict)
+
+
+def _as_constraint(c, i) -> Constraint:
+    if isinstance(c, Constraint):
+        return c
+    if isinstance(c, dict):
+        bad = set(c) - {"expr", "min", "max"}
+        if bad or "expr" not in c:
+            raise ModelError(f"constraints[{i + 1}]: expected {{expr, min, max}}, got {sorted(c)}")
+        return Constraint(c["expr"], c.get("min"), c.get("max"))
+    if isinstance(c, (tuple, list)) and len(c) == 3:
+        return Constraint(*c)
+    raise ModelError(f"constraints[{i + 1}]: expected (expr, min, max), got {c!r}")
+
 
 
 def optimize(m: Mechanism, samples, vary: dict, minimize: str, constraints=(), *, data=None,
@@ -77,12 +134,12 @@ def _once(m, samples, vary, minimize, constraints, data, rates, accelerations, d
     model = compile(m)
     prob = Problem(m, model, vary, data, deg)
     objective = prob.parse(minimize, "minimize")
-    cons = [prob.parse_constraint(c, i) for i, c in enumerate(constraints)]
+    cons = [prob.parse_constraint(_as_constraint(c, i), i) for i, c in enumerate(constraints)]
     sw0 = sweep(m, samples, rates=rates, accelerations=accelerations, report=[])
     prob.set_samples(sw0, sweep)
     f = prob.evaluate(objective, "minimize", objective=True)[1]
     rows = [(c, prob.evaluate(e, c.expr)) for c, e in cons]
-    return prob.solve(f, rows, check_path, max_iter, tol)
+    return OptimizeResult(**prob.solve(f, rows, check_path, max_iter, tol))
 
 
 # --- scenes: the [optimize] section ---

@@ -12,7 +12,6 @@ constraints. Everything is one CasADi SX graph, so IPOPT gets exact gradients an
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -25,58 +24,6 @@ REFINE = 400  # poses of the checking sweep between the first and the last sampl
 SAME_POSE = 1e-7  # relative: a pose reached by the checking sweep equals the optimised one
 CON_TOL = 1e-6  # relative violation allowed of a constraint after polishing
 EXTREME_MOVED = "the checking sweep reaches"  # the words of that problem, for a new round
-
-
-@dataclass
-class Constraint:
-    """`min <= expr <= max` (either bound may be None); per sample when expr is."""
-
-    expr: str
-    min: float | None = None
-    max: float | None = None
-
-
-@dataclass
-class OptimizeResult:
-    """What the optimiser found, and whether it may be trusted (`ok`).
-
-    `converged`: IPOPT reported success; `ok`: that, and the optimised design passed every
-    check (`problems` says which failed). `mechanism` is the optimised design as a new value,
-    its guess set to its pose at the first sample (so it keeps the branch). `values` are the
-    quantities named in the expressions at the samples (radians); `constraints` gives each
-    constraint's value(s) and whether it holds; `extremes` the tracked max()/min()."""
-
-    ok: bool
-    converged: bool
-    status: str
-    message: str
-    objective: float
-    initial_objective: float
-    parameters: dict[str, float]
-    varied: dict[str, float]
-    mechanism: Mechanism
-    samples: dict[str, np.ndarray]
-    q: np.ndarray
-    values: dict[str, np.ndarray]
-    constraints: list[dict]
-    extremes: list[dict]
-    iterations: int
-    problems: list[str] = field(default_factory=list)
-    sweep: Sweep | None = None
-    info: dict = field(default_factory=dict)
-
-
-def _as_constraint(c, i) -> Constraint:
-    if isinstance(c, Constraint):
-        return c
-    if isinstance(c, dict):
-        bad = set(c) - {"expr", "min", "max"}
-        if bad or "expr" not in c:
-            raise ModelError(f"constraints[{i + 1}]: expected {{expr, min, max}}, got {sorted(c)}")
-        return Constraint(c["expr"], c.get("min"), c.get("max"))
-    if isinstance(c, (tuple, list)) and len(c) == 3:
-        return Constraint(*c)
-    raise ModelError(f"constraints[{i + 1}]: expected (expr, min, max), got {c!r}")
 
 
 # --- the problem: parsing, the NLP, the checks ---
@@ -147,7 +94,6 @@ class Problem:
         return e
 
     def parse_constraint(self, c, i):
-        c = _as_constraint(c, i)
         where = f"constraints[{i + 1}]"
         for k in ("min", "max"):
             v = getattr(c, k)
@@ -292,7 +238,7 @@ class Problem:
         return value
 
     # --- IPOPT ---
-    def solve(self, f, rows, check_path, max_iter, tol) -> OptimizeResult:
+    def solve(self, f, rows, check_path, max_iter, tol) -> dict:
         ca, sym, K = self.ca, self.sym, self.K
         ext = list(self.extremes.values())
         X = ca.vertcat(self.xp, ca.vec(self.Qv), *[v for e in ext for v in e["x"]])
@@ -334,7 +280,7 @@ class Problem:
         return self.check(np.asarray(out["x"]).ravel(), fg, f0, rows, stats, check_path)
 
     # --- the checks: a design is optimal only if it really is one ---
-    def check(self, x, fg, f0, rows, stats, check_path) -> OptimizeResult:
+    def check(self, x, fg, f0, rows, stats, check_path) -> dict:
         sym, K, model, nv = self.sym, self.K, self.model, len(self.vary)
         problems = []
         # IPOPT may relax a bound by a few 1e-9: the design is clipped into its bounds
@@ -385,7 +331,7 @@ class Problem:
         ok = success and not problems
         msg = ("converged; the optimised design assembles at every sample on the initial branch"
                if ok else f"IPOPT: {status}" if not success else "not optimal: " + problems[0])
-        return OptimizeResult(
+        return dict(
             ok=ok, converged=success, status=status, message=msg, objective=float(fval[0]),
             initial_objective=f0, parameters=mech.param_values, varied=varied, mechanism=mech,
             samples={k: self.U[:, j].copy() for j, k in enumerate(self.keys)}, q=Q,
