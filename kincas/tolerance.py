@@ -32,6 +32,7 @@ import json
 import math
 import sys
 import tomllib
+import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -227,15 +228,15 @@ def _monte_carlo(m: Mechanism, sw, report, to, dp):
     return mc, shift, failed, retried
 
 
-_FUNCS: dict = {}
+_FUNCS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # model -> {report: F}
 
 
 def _sample_function(model, report: tuple[str, ...]):
     """F(q0, u, p0, dp, u', u'') -> (q, |g|max, g_q, quantities): first-order predictor from
     the nominal pose, then NEWTON_STEPS Newton steps, all as one CasADi expression graph."""
-    key = (id(model), report)
-    if key in _FUNCS:
-        return _FUNCS[key]
+    cache = _FUNCS.setdefault(model, {})
+    if report in cache:
+        return cache[report]
     import casadi as ca
 
     sym = model.sym
@@ -257,9 +258,7 @@ def _sample_function(model, report: tuple[str, ...]):
         q, J, r = ca.SX(0, 1), ca.SX(0, 0), ca.SX(0)
     vals = model.quantity_function(report)(q, u, p, ud, udd)
     F = ca.Function("tolerance_sample", [q0, u, p0, dp, ud, udd], [q, r, ca.vec(J), vals])
-    if len(_FUNCS) > 32:
-        _FUNCS.clear()
-    _FUNCS[key] = F
+    cache[report] = F
     return F
 
 
