@@ -36,7 +36,7 @@ from .model import GROUND, Input, Link, Mechanism, Param, Slide
 from .results import Sweep
 
 SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
-            "output", "optimize"}
+            "output", "optimize", "tolerance"}
 
 
 @dataclass
@@ -209,7 +209,7 @@ class _Reader:
         if report is None:
             from .symbolic import default_report
             report = default_report(m)
-        self.check_quantities(m, report + sens)
+        self.check_quantities(m, report, sens)
         study = Study(title=title if isinstance(title, str) else "", units=self.units,
                       inputs=values, rates=rates, accelerations=accs, report=report,
                       sensitivity=sens, written=written, raw=doc)
@@ -328,8 +328,19 @@ class _Reader:
                 sens = [f"d({q})/d({p})" for q in of for p in to]
         return report, sens
 
-    def check_quantities(self, m: Mechanism, names: list[str]):
+    def check_quantities(self, m: Mechanism, report: list[str], sens: list[str]):
         from .solve import compile
-        bad = compile(m).sym.check_names(names)
+        from .symbolic import parse_quantity
+        sym = compile(m).sym
+        bad = sym.check_names(report)
+        # each `of` name and each `to` name once, under the field they were written in
+        of = list(dict.fromkeys(parse_quantity(n)[1] for n in sens))
+        bad += sym.check_names(of, "[output] sensitivity: of")
+        driven = {i.target for i in m.inputs if i.kind == "parameter"}
+        for p in dict.fromkeys(parse_quantity(n)[2] for n in sens):
+            if p not in m.param_values:
+                bad.append(f"[output] sensitivity: to: unknown parameter {p!r}")
+            elif p in driven:
+                bad.append(f"[output] sensitivity: to: {p!r} is driven by an input (use its rate instead)")
         if bad:
             raise SceneError(bad)

@@ -31,10 +31,8 @@ from __future__ import annotations
 import json
 import math
 import sys
-import tomllib
 import weakref
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -265,26 +263,6 @@ def _sample_function(model, report: tuple[str, ...]):
 # --- scenes: the [tolerance] section ---
 
 
-def load_scene(path, section: str):
-    """Read a scene that carries an extension section. Until the scene reader lists the
-    section among its known ones, it is taken out before reading and put back in `raw`."""
-    from . import scene as _scene
-
-    if section in _scene.SECTIONS:
-        return _scene.load(path)
-    try:
-        doc = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except OSError as e:
-        raise SceneError(f"scene: cannot read {str(path)!r}: {e.strerror or e}") from None
-    except tomllib.TOMLDecodeError as e:
-        raise SceneError(f"scene: not valid TOML: {e}") from None
-    own = doc.pop(section, None)
-    sc = _scene._Reader(doc).scene()
-    if own is not None:
-        sc.study.raw[section] = own
-    return sc
-
-
 def read_section(sc) -> dict:
     """The `[tolerance]` section as analyse()'s keywords; SceneError naming the field."""
     from .solve import compile
@@ -335,7 +313,9 @@ def cli_run(args) -> int:
     from .cli import _list, _unit, progress_for
     from .symbolic import is_angular
 
-    sc = load_scene(args.scene, "tolerance")
+    from .scene import load
+
+    sc = load(args.scene)
     kw = read_section(sc)
     for k in ("samples", "seed"):
         if getattr(args, k) is not None:

@@ -258,4 +258,4 @@ def test_bad_sensitivity_names_are_scene_errors(capsys, tmp_path):
     text = slider_scene("deg", 10.0).replace('to = ["beta", "e"]', 'to = ["beta", "nope"]')
     code, doc, err = run_json(capsys, tmp_path, text)
     assert code == 2 and doc is None
-    assert "[output]" in err and "nope" in err and "Traceback" not in err
+    assert "[output] sensitivity: to" in err and "nope" in err and "Traceback" not in err
