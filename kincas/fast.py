@@ -2,9 +2,10 @@
 
 The careful path (`kincas.solve`) spends about 70 us per pose in Python. Here one call solves
 a whole stretch of a sweep: pose k is predicted from the last solved pose along the exact
-tangent, q_pred = q_prev + dq/du (u_k - u_prev) with dq/du = -g_q^-1 g_u, then corrected by
-Newton, q <- q - g_q^-1 g, until the next step would be negligible. A pose is *accepted* only
-when it is verified in the same pass:
+tangent, q_pred = q_prev + dq/du (u_k - u_prev) with dq/du = -g_q^-1 g_u, plus a second-order
+term from how the tangent changed since the pose before, then corrected by Newton,
+q <- q - g_q^-1 g, until the next step would be negligible (on a dense sweep the prediction
+usually is already). A pose is *accepted* only when it is verified in the same pass:
 
 - residual: max |g| / L <= RESIDUAL (the careful path's acceptance);
 - converged: the Newton step that would follow, |g_q^-1 g| (radians, lengths / L) <= STEP;
@@ -29,7 +30,7 @@ arithmetic runs in casadi's virtual machine, `mapaccum` over chunks of CHUNK pos
 >>> model, U = kincas.compile(m), np.linspace(0, 2 * np.pi, 721)[:, None]
 >>> q0 = model.newton(model.initial_q(U[0], [], {"C": (3.6, 2.9)}, 5), U[0], [], 5).q
 >>> run = FastSweeper(model, compile=False).run(U, [], 5.0, q0, U[0], start=1)
->>> run.first_bad, bool(run.residual[1:].max() < 1e-14)
+>>> run.first_bad, bool(run.residual[1:].max() < 1e-13)
 (721, True)
 """
 from __future__ import annotations
@@ -43,7 +44,7 @@ import numpy as np
 from .compiled import CHUNK, Backend, Library, QuantityEvaluator, ptr, rows
 
 RESIDUAL = 1e-10  # as the careful path's ACCEPT: max |g| / L
-STEP = 1e-12  # the next Newton step (radians, or lengths / L): the error left in q
+STEP = 1e-13  # the next Newton step (radians, or lengths / L): the error left in q
 JAC_CHANGE = 0.9  # sum |entries of D^-1 (J_prev^-1 J - I) D| (below 1 keeps det's sign)
 CORRECTION = 0.25  # ||D^-1 (q - q_pred)||_1: Newton may not wander far from the prediction
 MAX_EVALS = 5  # residual evaluations per pose: at the prediction and after up to 4 steps
@@ -55,10 +56,19 @@ INFO = ("residual", "step", "jac_change", "correction", "evaluations")
 
 def _kernel_functions(sym, qf: ca.Function | None) -> list[ca.Function]:
     """kP (predict), kE (at q: Newton step, J, tangent, residual and step size, quantities)
-    and kC (Jacobian change, correction). Outputs dense, so that C can index them."""
+    and kC (Jacobian change, correction). Outputs dense, so that C can index them.
+
+    The prediction is of second order: with the tangents T0 at the last pose (input u0) and
+    T1 at the one before (u1), dT = T0 - T1 ~ H[u0 - u1, .] for the second derivative H of
+    q(u), so along a step u - u0 = l (u0 - u1), H[u - u0, u - u0] ~ l dT (u - u0); its error
+    is O(h^3) on a straight sweep and still O(h^2) where the sweep turns."""
     nq, nu = sym.nq, sym.nu
     q, qp, J, J0 = ca.SX.sym("q", nq), ca.SX.sym("qp", nq), ca.SX.sym("J", nq, nq), ca.SX.sym("J0", nq, nq)
     T0, u0, u = ca.SX.sym("T0", nq, nu), ca.SX.sym("u0", nu), ca.SX.sym("u", nu)
+    T1, u1 = ca.SX.sym("T1", nq, nu), ca.SX.sym("u1", nu)
+    du, dup = u - u0, u0 - u1
+    lam = ca.if_else(ca.dot(dup, dup) > 0, ca.dot(du, dup) / ca.dot(dup, dup), 0)
+    pred = q + ca.mtimes(T0, du) + 0.5 * lam * ca.mtimes(T0 - T1, du)
     p, L, ud, udd = ca.SX.sym("p", sym.np), ca.SX.sym("L"), ca.SX.sym("ud", nu), ca.SX.sym("udd", nu)
     D = ca.if_else(ca.DM(sym.is_length.astype(float)), L, 1)  # the scale of each unknown
     g, Jq, Ju = ca.Function("G", [sym.q, sym.u, sym.p], [sym.g, sym.Jq, sym.Ju])(q, u, p)
@@ -68,7 +78,7 @@ def _kernel_functions(sym, qf: ca.Function | None) -> list[ca.Function]:
     M = (ca.solve(J0, J) - ca.DM.eye(nq)) * ca.repmat(D.T, nq, 1) / ca.repmat(D, 1, nq)
     mc = ca.vertcat(ca.sum1(ca.sum2(ca.fabs(M))), ca.norm_1((q - qp) / D))
     d, o = ca.densify, {"cse": True}  # cse: one sin and cos per angle, shared by everything
-    return [ca.Function("kP", [q, T0, u0, u], [d(q + ca.mtimes(T0, u - u0))], o),
+    return [ca.Function("kP", [q, T0, u0, u, T1, u1], [d(pred)], o),
             ca.Function("kE", [q, u, p, L, ud, udd], [d(sol[:, 0]), d(Jq), d(-sol[:, 1:]), rs, y], o),
             ca.Function("kC", [J0, J, qp, q, L], [mc], o)]
 
@@ -78,8 +88,8 @@ def _vm_step(kP, kE, kC, nq, nu, max_evals) -> ca.Function:
     q stays put, so it ends where the compiled loop stops (the same arithmetic)."""
     q0, J0, T0, u0 = ca.SX.sym("q0", nq), ca.SX.sym("J0", nq, nq), ca.SX.sym("T0", nq, nu), ca.SX.sym("u0", nu)
     u, p, L, thr = ca.SX.sym("u", nu), ca.SX.sym("p", kE.size1_in(2)), ca.SX.sym("L"), ca.SX.sym("t", 4)
-    ud, udd = ca.SX.sym("ud", nu), ca.SX.sym("udd", nu)
-    q = qp = kP(q0, T0, u0, u)
+    ud, udd, T1, u1 = ca.SX.sym("ud", nu), ca.SX.sym("udd", nu), ca.SX.sym("T1", nq, nu), ca.SX.sym("u1", nu)
+    q = qp = kP(q0, T0, u0, u, T1, u1)
     done, evals = ca.SX(0), ca.SX(0)
     for i in range(max_evals):
         dq, J, T, rs, y = kE(q, u, p, L, ud, udd)
@@ -88,10 +98,11 @@ def _vm_step(kP, kE, kC, nq, nu, max_evals) -> ca.Function:
         if i < max_evals - 1:
             q = ca.if_else(done, q, q - dq)
     info = ca.vertcat(rs, kC(J0, J, qp, q, L), evals)
-    return ca.Function("kS", [q0, J0, T0, u0, u, p, L, thr, ud, udd], [q, J, T, u, info, y])
+    return ca.Function("kS", [q0, J0, T0, u0, T1, u1, u, p, L, thr, ud, udd], [q, J, T, u, T0, u0, info, y])
 
 
-# --- the C loops around them (NQ, NU, NO: sizes; state s = q, J, dq/du, u column-major) ---
+# --- the C loop around them (NQ, NU, NO: sizes; state s = q, J, T = dq/du, u at the last
+# pose, then T and u at the one before; matrices column-major) ---
 
 _SWEEP_C = """
 int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const casadi_real* L,
@@ -104,7 +115,8 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
   for (k = 0; k < n; ++k) {
     const casadi_real* u = U + k*NU;
     int conv = 0;
-    arg[0] = s; arg[1] = s + NQ + NQ*NQ; arg[2] = s + NQ + NQ*NQ + NQ*NU; arg[3] = u; res[0] = qp;
+    arg[0] = s; arg[1] = s + NQ + NQ*NQ; arg[2] = s + NQ + NQ*NQ + NQ*NU; arg[3] = u;
+    arg[4] = s + NQ + NQ*NQ + NQ*NU + NU; arg[5] = s + NQ + NQ*NQ + 2*NQ*NU + NU; res[0] = qp;
     if (kP(arg, res, iw, w, 0)) break;
     for (i = 0; i < NQ; ++i) q[i] = qp[i];
     for (it = 1; ; ++it) {  /* Newton until the next step is negligible */
@@ -123,6 +135,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     info[k] = rs[0]; info[ld + k] = rs[1]; info[2*ld + k] = mc[0]; info[3*ld + k] = mc[1];
     info[4*ld + k] = (casadi_real) it;
     if (!(conv && mc[0] <= thr[2] && mc[1] <= thr[3])) break;
+    for (i = 0; i < NQ*NU + NU; ++i) s[NQ + NQ*NQ + NQ*NU + NU + i] = s[NQ + NQ*NQ + i];
     for (i = 0; i < NQ; ++i) s[i] = q[i];
     for (i = 0; i < NQ*NQ; ++i) s[NQ + i] = J[i];
     for (i = 0; i < NQ*NU; ++i) s[NQ + NQ*NQ + i] = T[i];
@@ -238,13 +251,15 @@ class FastSweeper:
                        {"kincas_sweep": [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V, _V]})
 
     def state(self, q, u, p) -> np.ndarray:
-        """(q, J, dq/du, u) at a solved pose, J and dq/du column-major as casadi keeps them."""
+        """(q, J, T = dq/du, u, T, u) at a solved pose, matrices column-major as in casadi
+        (the second T, u stand for the pose before: the first prediction is linear)."""
         _, J, Ju = (np.asarray(a) for a in self.sym.f_tangent(q, u, p))
         try:
             T = np.linalg.solve(J, -Ju)
         except np.linalg.LinAlgError:  # a singular start: the next pose fails the branch test
             T = np.full_like(Ju, np.nan)
-        return np.concatenate([np.ravel(q), J.ravel(order="F"), T.ravel(order="F"), np.ravel(u)])
+        T, u = T.ravel(order="F"), np.ravel(u)
+        return np.concatenate([np.ravel(q), J.ravel(order="F"), T, u, T, u])
 
     def run(self, U, p, L, q_start, u_start, start: int = 0, Ud=None, Udd=None,
             jacobians=False) -> FastRun:
@@ -289,19 +304,19 @@ class FastSweeper:
         nq, nu, no = self.nq, self.nu, len(self.report)
         if self._vm is None:
             kS = _vm_step(*self.functions, nq, nu, self.max_evals)
-            acc = kS.mapaccum("acc", CHUNK, [0, 1, 2, 3], [0, 1, 2, 3], {})
-            x = [ca.MX.sym(c, *kS.size_in(i)) for i, c in enumerate("qJTu")]
+            acc = kS.mapaccum("acc", CHUNK, [0, 1, 2, 3, 4, 5], [0, 1, 2, 3, 4, 5], {})
+            x = [ca.MX.sym(f"x{i}", *kS.size_in(i)) for i in range(6)]
             U, Ud, Udd = (ca.MX.sym(c, nu, CHUNK) for c in ("U", "Ud", "Udd"))
-            p, L, t = ca.MX.sym("p", kS.size1_in(5)), ca.MX.sym("L"), ca.MX.sym("t", 4)
+            p, L, t = ca.MX.sym("p", kS.size1_in(7)), ca.MX.sym("L"), ca.MX.sym("t", 4)
             rep = lambda a: ca.repmat(a, 1, CHUNK)
             F = ca.Function("chunk", [*x, U, p, L, t, Ud, Udd], acc(*x, U, rep(p), rep(L), rep(t), Ud, Udd))
             buf, call = F.buffer()
-            scratch = [np.zeros((CHUNK, m)) for m in (nq, nq * nq, nq * nu, nu, 5, no, nu, nu, nu)]
-            for i, a in enumerate(scratch[:6]):
+            scratch = [np.zeros((CHUNK, m)) for m in (nq, nq * nq, nq * nu, nu, nq * nu, nu, 5, no, nu, nu, nu)]
+            for i, a in enumerate(scratch[:8]):
                 buf.set_res(i, memoryview(a))
             self._vm = (F, buf, call, scratch)  # buf holds raw pointers: keep it referenced
-        _, buf, call, (Qc, Jc, Tc, Uo, Ic, Yc, Uc, Udc, Uddc) = self._vm
-        parts = np.split(s.copy(), np.cumsum([nq, nq * nq, nq * nu]))
+        _, buf, call, (Qc, Jc, Tc, Uo, T1c, U1c, Ic, Yc, Uc, Udc, Uddc) = self._vm
+        parts = np.split(s.copy(), np.cumsum([nq, nq * nq, nq * nu, nu, nq * nu]))
         k = start
         while k < r.n:
             m = min(CHUNK, r.n - k)
@@ -318,7 +333,7 @@ class FastSweeper:
                 r.J[k:k + e] = Jc[:e]
             if j < m:
                 return k + j
-            parts = [Qc[m - 1].copy(), Jc[m - 1].copy(), Tc[m - 1].copy(), Uo[m - 1].copy()]
+            parts = [a[m - 1].copy() for a in (Qc, Jc, Tc, Uo, T1c, U1c)]
             k += m
         return r.n
 
