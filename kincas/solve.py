@@ -323,6 +323,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     res, its = np.full(n, np.nan), np.zeros(n, dtype=int)
     status, events = [NO_ASSEMBLY] * n, []
     last = None  # (q, u, sign of det g_q) of the last solved pose: every pose continues from it
+    prev = None  # (q, u) of the pose solved just before `last`, for the secant predictor
     for k in range(n):
         u = U[k]
         if progress is not None and k % 256 == 0:
@@ -330,7 +331,9 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         if last is None:
             sol = _first(model, u, p, L, g)
         else:
-            sol = _continue(model, last[0], last[1], u, p, L, depth=8 if status[k - 1] == "ok" else 0)
+            fresh = status[k - 1] == "ok"
+            sol = _continue(model, last[0], last[1], u, p, L, depth=8 if fresh else 0,
+                            prev=prev if fresh else None)
             if sol is None:
                 sol = _recover(model, m, last, u, p, L)
         res[k], its[k] = sol.residual, sol.iterations
@@ -340,6 +343,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         if last is not None and status[k - 1] != "ok":  # back in range: say on which branch
             events.append({"kind": "resume", "pose": int(k),
                            "branch": "same" if sign == last[2] or 0 in (sign, last[2]) else "other"})
+        prev = (last[0], last[1]) if last is not None and status[k - 1] == "ok" else None
         Q[k], status[k], last = sol.q, "ok", (sol.q, u, sign)
     if progress is not None:
         progress(n, n)
@@ -392,24 +396,53 @@ def _scaled_norm(model: Model, dq, L) -> float:
     return float(np.abs(dq / np.where(model.sym.is_length, L, 1.0)).max(initial=0.0))
 
 
-def _continue(model: Model, q0, u0, u1, p, L, depth: int) -> Solution | None:
-    """Predict along the exact tangent, correct with Newton. The step is halved when the
-    corrector fails or needs many iterations, lands far from the prediction, or the sign of
-    det(g_q) flips (the sign tells the assembly branch apart)."""
-    pred = q0 + model.tangent(q0, u0, p) @ (u1 - u0)
+def _continue(model: Model, q0, u0, u1, p, L, depth: int, prev=None) -> Solution | None:
+    """Predict, correct with Newton. The step is halved when the corrector fails or needs
+    many iterations, lands far from the prediction, or the sign of det(g_q) flips (the sign
+    tells the assembly branch apart).
+
+    The predictor is the exact tangent dq/du, except where g_q is nearly singular: there the
+    tangent is undefined (at a change point two branches cross), and the secant through
+    the previous pose `prev` = (q, u) carries the branch straight through.
+    """
+    J0 = model.jac(q0, u0, p)
+    pred = _secant(q0, u0, u1, prev) if prev is not None and _ill(model, J0, L) else None
+    if pred is None:
+        pred = q0 + model.tangent(q0, u0, p) @ (u1 - u0)
     sol = model.newton(pred, u1, p, L)
     if sol.ok and depth == 0:
         return sol
     if sol.ok:
         moved = _scaled_norm(model, pred - q0, L)
-        far = _scaled_norm(model, sol.q - pred, L) > max(0.05, 0.5 * moved)
-        if sol.iterations <= 8 and not far and _same_branch(model, q0, u0, sol, p, L):
+        far = _scaled_norm(model, sol.q - pred, L) > max(0.02, 0.5 * moved)
+        if sol.iterations <= 8 and not far and _same_branch(model, J0, sol, L):
             return sol
     if depth == 0:
         return None
     um = 0.5 * (u0 + u1)
-    mid = _continue(model, q0, u0, um, p, L, depth - 1)
-    return None if mid is None else _continue(model, mid.q, um, u1, p, L, depth - 1)
+    mid = _continue(model, q0, u0, um, p, L, depth - 1, prev)
+    return None if mid is None else _continue(model, mid.q, um, u1, p, L, depth - 1, (q0, u0))
+
+
+def _ill(model: Model, J, L) -> bool:
+    """Whether g_q is too close to singular for its tangent to be trusted."""
+    if J.size == 0:
+        return False
+    s = np.linalg.svd(J * np.where(model.sym.is_length, 1.0, 1.0 / L), compute_uv=False)
+    return s[-1] < 1e-2 * s[0]
+
+
+def _secant(q0, u0, u1, prev):
+    """q0 + (q0 - q_prev) t, when the new step continues the previous one's direction."""
+    qp, up = prev
+    d0, d1 = u0 - up, u1 - u0
+    n0 = float(d0 @ d0)
+    if n0 == 0.0:
+        return None
+    t = float(d1 @ d0) / n0
+    if np.linalg.norm(d1 - t * d0) > 1e-9 * np.linalg.norm(d1):
+        return None  # the inputs turned: no straight line to follow
+    return q0 + (q0 - qp) * t
 
 
 def _scaled_det(model: Model, J, L) -> float:
@@ -422,8 +455,8 @@ def _det_sign(model: Model, sol: Solution, L) -> int:
     return 0 if abs(d) < 1e-8 else int(np.sign(d))
 
 
-def _same_branch(model: Model, q0, u0, sol: Solution, p, L) -> bool:
-    d0 = _scaled_det(model, model.jac(q0, u0, p), L)
+def _same_branch(model: Model, J0, sol: Solution, L) -> bool:
+    d0 = _scaled_det(model, J0, L)
     d1 = _scaled_det(model, sol.J, L)
     return np.sign(d0) == np.sign(d1) or min(abs(d0), abs(d1)) < 1e-8
 

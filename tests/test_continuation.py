@@ -116,6 +116,20 @@ def test_parallelogram_through_its_change_points_stays_a_parallelogram():
     assert flagged == {0, 180}
 
 
+def test_parallelogram_from_an_imprecise_guess_keeps_its_branch():
+    # A guess a little off the assembly leaves Newton's answer 1e-13 off the exact
+    # parallelogram; at the change point the tangent is then undefined, and only a predictor
+    # that carries the branch straight through (the secant) keeps it.
+    th = np.radians(30 + np.arange(360.0))
+    m = fourbar(1, 4, 1, 4, (4.868186613007911, 0.5033658839392315))
+    sw = kincas.sweep(m.with_guess(B=(0.8700254037844387, 0.5)), {"crank.angle": th},
+                      report=["C.x", "C.y"])
+    residuals_ok(sw)
+    assert np.all(sw.ok)
+    assert np.hypot(sw["C.x"] - 4 - np.cos(th), sw["C.y"] - np.sin(th)).max() < 1e-9
+    assert [e["kind"] for e in sw.events] == ["change point", "change point"]
+
+
 def test_triple_rocker_over_a_full_turn_stops_at_its_limits_and_resumes():
     a, b, c, d = 1, 1.9, 3, 4  # non-Grashof: the crank rocks between +-151.19 deg
     lim = math.acos((a * a + d * d - (b + c) ** 2) / (2 * a * d))
