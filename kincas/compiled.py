@@ -19,6 +19,7 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import os
+import re
 import shutil
 import subprocess
 import tempfile
@@ -78,7 +79,8 @@ class Library:
         work = {"SZ_ARG": [f.sz_arg() for f in functions], "SZ_RES": [f.sz_res() for f in functions],
                 "SZ_IW": [f.sz_iw() for f in functions], "SZ_W": [f.sz_w() for f in functions]}
         defines = {**{k: max([1, *v]) for k, v in work.items()}, **defines}
-        self.source = cg.dump() + "".join(f"#define {k} {v}\n" for k, v in defines.items()) + driver
+        self.source = (_PRELUDE + pair_sincos(cg.dump())
+                       + "".join(f"#define {k} {v}\n" for k, v in defines.items()) + driver)
         self.cc = os.environ.get("CC") or shutil.which("gcc") or shutil.which("cc")
         key = hashlib.sha256("\n".join([self.source, str(self.cc), *_FLAGS, ca.__version__]).encode())
         self.path = cache_dir() / f"{tag}-{key.hexdigest()[:24]}.so"
@@ -116,6 +118,50 @@ class Library:
                 raise RuntimeError(f"{self.cc} failed: {done.stderr.strip()[-400:]}")
             os.replace(out, self.path)  # atomic: other processes see all of it or nothing
         self.times["compile"] = time.perf_counter() - t0
+
+
+# --- sine and cosine of an angle in one call ---
+
+_PRELUDE = """#define _GNU_SOURCE
+#include <math.h>
+#ifdef __GLIBC__
+#define kincas_sincos(x, s, c) sincos(x, s, c)
+#else
+#define kincas_sincos(x, s, c) (*(s) = sin(x), *(c) = cos(x))
+#endif
+"""
+_TRIG = re.compile(r"^(\s*)(a\w+)=(sin|cos)\((a\w+)\);$")
+
+
+def pair_sincos(source: str) -> str:
+    r"""Casadi's generated `x=sin(a); ... y=cos(a);` as one sincos call (glibc's, which gives
+    the same values): each angle's sine and cosine cost one call. Most of a sweep's time is
+    this trigonometry, and once the casadi functions are inlined into the C loop the
+    compiler stops pairing them itself. A pair is joined only within one block and while
+    `a` is not reassigned between; anything else is left as it is.
+
+    >>> print(pair_sincos("  a1=sin(a0);\n  a2=(a1*a0);\n  a3=cos(a0);"))
+      casadi_real kt0; kincas_sincos(a0, &a1, &kt0);
+      a2=(a1*a0);
+      a3=kt0;
+    """
+    lines, n = source.split("\n"), 0
+    for i, line in enumerate(lines):
+        m = _TRIG.match(line)
+        if not m or m[2] == m[4]:  # x=sin(x): the angle is overwritten here
+            continue
+        indent, target, f, a = m.groups()
+        for j in range(i + 1, len(lines)):
+            mj = _TRIG.match(lines[j])
+            if mj and mj[4] == a and mj[3] != f:
+                s, c = (target, f"kt{n}") if f == "sin" else (f"kt{n}", target)
+                lines[i] = f"{indent}casadi_real kt{n}; kincas_sincos({a}, &{s}, &{c});"
+                lines[j] = f"{mj[1]}{mj[2]}=kt{n};"
+                n += 1
+                break
+            if "{" in lines[j] or "}" in lines[j] or re.match(rf"^\s*{a}=", lines[j]):
+                break
+    return "\n".join(lines)
 
 
 class Backend:
