@@ -103,8 +103,8 @@ def interleaved(fns: dict, repeats: int) -> dict:
 def careful_for(model, p, L, m, U):
     g = {k: (m.value(x), m.value(y)) for k, (x, y) in m.guess}
 
-    def careful(k, j, q_j):  # what kincas.sweep does for a pose the fast pass rejects
-        q0 = model.initial_q(U[k], p, g, L) if j is None else q_j
+    def careful(k, j, run):  # what kincas.sweep does for a pose the fast pass rejects
+        q0 = model.initial_q(U[k], p, g, L) if j is None else run.Q[j]
         return model.newton(q0, U[k], p, L)
     return careful
 
@@ -236,7 +236,7 @@ model = kincas.compile(m)
 p, L = np.array([v for _, v in m.parameters]), m.size()
 U = np.stack([st.inputs[i.key] for i in m.inputs], axis=1)
 g = {{k: (m.value(x), m.value(y)) for k, (x, y) in m.guess}}
-careful = lambda k, j, q: model.newton(model.initial_q(U[k], p, g, L) if j is None else q, U[k], p, L)
+careful = lambda k, j, r: model.newton(model.initial_q(U[k], p, g, L) if j is None else r.Q[j], U[k], p, L)
 run = sweeper_for(model, sc.quantities).sweep(U, p, L, careful, Ud=[st.rates[i.key] for i in m.inputs])
 ang = lambda k, v: np.degrees(v) if k.endswith((".angle", ".omega")) else v
 json.dump({{"title": st.title, "units": st.units, "inputs": {{k: _list(np.degrees(U[:, 0])) for k in st.inputs}},

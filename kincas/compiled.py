@@ -205,6 +205,16 @@ def ptr(a: np.ndarray, offset: int = 0) -> int:
     return a.ctypes.data + 8 * offset
 
 
+def table(a, width: int) -> np.ndarray:
+    """An (n, width) float64 table from a table, or from a flat array when width is 1.
+
+    >>> table([1.0, 2.0], 1).shape, table(np.zeros((3, 0)), 0).shape
+    ((2, 1), (3, 0))
+    """
+    a = np.asarray(a, dtype=float)
+    return a if a.ndim == 2 and a.shape[1] == width else a.reshape(-1, width)
+
+
 def rows(a, n: int, width: int) -> tuple[np.ndarray, int]:
     """(array, row stride in elements) of an (n, width) float64 table given as a table or
     as one row for every pose (stride 0): no copy unless the table is not C-contiguous.
@@ -213,10 +223,12 @@ def rows(a, n: int, width: int) -> tuple[np.ndarray, int]:
     (0, 2)
     """
     a = np.asarray(a, dtype=float)
+    if width == 0:
+        return np.zeros(0), 0
     if a.ndim == 1 and a.shape[0] == width:
         return np.ascontiguousarray(a), 0
     a = np.broadcast_to(a.reshape(-1, width), (n, width))
-    if width == 0 or a.strides[0] == 0:
+    if a.strides[0] == 0:
         return np.ascontiguousarray(a[0] if n else np.zeros(width)), 0
     return np.ascontiguousarray(a), width
 
@@ -272,9 +284,9 @@ class QuantityEvaluator:
     def evaluate(self, Q, U, p, Ud=None, Udd=None, ok=None) -> np.ndarray:
         """(len(names), N) values at the poses (Q (N, nq), U (N, nu) tables; rates Ud and
         accelerations Udd tables or one row, default 1 and 0); NaN where `ok` is False."""
-        U = np.asarray(U, dtype=float).reshape(-1, self.nu)
+        U = table(U, self.nu)
         n = U.shape[0]
-        Q = np.ascontiguousarray(np.asarray(Q, dtype=float).reshape(n, self.nq))
+        Q = np.ascontiguousarray(np.broadcast_to(table(Q, self.nq), (n, self.nq)))
         U, su = rows(U, n, self.nu)
         Ud, sud = rows(np.ones(self.nu) if Ud is None else Ud, n, self.nu)
         Udd, sudd = rows(np.zeros(self.nu) if Udd is None else Udd, n, self.nu)

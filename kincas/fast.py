@@ -41,7 +41,7 @@ import weakref
 import casadi as ca
 import numpy as np
 
-from .compiled import CHUNK, Backend, Library, QuantityEvaluator, ptr, rows
+from .compiled import CHUNK, Backend, Library, QuantityEvaluator, ptr, rows, table
 
 RESIDUAL = 1e-10  # as the careful path's ACCEPT: max |g| / L
 STEP = 1e-13  # the next Newton step (radians, or lengths / L): the error left in q
@@ -49,6 +49,7 @@ JAC_CHANGE = 0.9  # sum |entries of D^-1 (J_prev^-1 J - I) D| (below 1 keeps det
 CORRECTION = 0.25  # ||D^-1 (q - q_pred)||_1: Newton may not wander far from the prediction
 MAX_EVALS = 5  # residual evaluations per pose: at the prediction and after up to 4 steps
 INFO = ("residual", "step", "jac_change", "correction", "evaluations")
+BLOCK = 65536  # poses per call when a progress callback wants news
 
 
 # --- the casadi functions: prediction, Newton evaluation, acceptance measures ---
@@ -164,7 +165,7 @@ class FastRun:
 
     def __init__(self, sweeper: "FastSweeper", U, p, L, Ud=None, Udd=None, jacobians=False):
         self.sweeper, nq, nu = sweeper, sweeper.nq, sweeper.nu
-        self.U = np.ascontiguousarray(np.asarray(U, dtype=float).reshape(-1, nu))
+        self.U = np.ascontiguousarray(table(U, nu))
         self.n = n = self.U.shape[0]
         self.Ud = rows(np.ones(nu) if Ud is None else Ud, n, nu)
         self.Udd = rows(np.zeros(nu) if Udd is None else Udd, n, nu)
@@ -175,7 +176,7 @@ class FastRun:
         self.J = np.empty((n, nq * nq)) if jacobians else None  # g_q per pose, column-major
         self.accepted, self.solved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
         self.thr = np.array([RESIDUAL, STEP, JAC_CHANGE, CORRECTION])
-        self.first_bad = 0
+        self.first_bad, self._s = 0, None
 
     residual = property(lambda self: self.info[0], doc="max |g| / L at each pose")
     step = property(lambda self: self.info[1], doc="the Newton step that would follow")
@@ -190,26 +191,29 @@ class FastRun:
         nq = self.sweeper.nq
         return self.J.reshape(-1, nq, nq).transpose(0, 2, 1)
 
-    def advance(self, start: int, q_last, u_last) -> int:
-        """Solve poses start, start + 1, ... from the solved pose (q_last, u_last) until one
-        is rejected, and return its index (N if none was). The poses before it are accepted;
-        the rejected pose keeps its `info` (why) and NaN in `Q` and `values`."""
-        if start >= self.n:
-            return self.n
-        sw = self.sweeper
-        s = sw.state(q_last, u_last, self.p)
+    def advance(self, start: int, q_last, u_last, stop: int | None = None) -> int:
+        """Solve poses start, start + 1, ... (before `stop`, default N) from the solved pose
+        (q_last, u_last) until one is rejected, and return its index (`stop` if none was).
+        The poses before it are accepted; the rejected pose keeps its `info` (why) and NaN in
+        `Q` and `values`. q_last None: go on from where the last call stopped, unrejected."""
+        sw, stop = self.sweeper, self.n if stop is None else min(stop, self.n)
+        if start >= stop or not (sw.nq and sw.nu):  # nothing to predict: all careful
+            return min(start, stop)
+        if q_last is not None or self._s is None:
+            self._s = sw.state(q_last, u_last, self.p)
+        s = self._s  # the C loop leaves the last accepted pose's state in it
         lib = sw.backend.compiled(self.n)
         if lib is not None:
             (Ud, sud), (Udd, sudd) = self.Ud, self.Udd
             k = start + lib.kincas_sweep(
-                self.n - start, ptr(self.U, start * sw.nu), ptr(self.p), ptr(self.L), ptr(self.thr),
+                stop - start, ptr(self.U, start * sw.nu), ptr(self.p), ptr(self.L), ptr(self.thr),
                 sw.max_evals, ptr(s), ptr(self.Q, start * sw.nq), ptr(self.info, start), self.n,
                 ptr(Ud, start * sud), sud, ptr(Udd, start * sudd), sudd, ptr(self.values, start),
                 None if self.J is None else ptr(self.J, start * sw.nq * sw.nq))
         else:
-            k = sw._vm_advance(self, start, s)
+            k = sw._vm_advance(self, start, stop, s)
         self.accepted[start:k] = self.solved[start:k] = True
-        if k < self.n:
+        if k < stop:
             self.Q[k] = self.values[:, k] = np.nan
             if self.J is not None:
                 self.J[k] = np.nan
@@ -240,10 +244,17 @@ class FastSweeper:
     def __init__(self, model, report=(), *, compile=None, max_evals: int = MAX_EVALS):
         self.model, self.sym, self.report = model, model.sym, tuple(report)
         self.nq, self.nu, self.max_evals = model.sym.nq, model.sym.nu, int(max_evals)
-        qf = model.quantity_function(self.report) if self.report else None  # names checked here
-        self.functions = _kernel_functions(self.sym, qf)
+        self._qf = model.quantity_function(self.report) if self.report else None  # names checked
+        self._functions = None
         self._vm = None
         self.backend = Backend(compile, self._library, "fast sweep kernel")
+
+    @property
+    def functions(self) -> list[ca.Function]:
+        """kP, kE, kC (built when first needed)."""
+        if self._functions is None:
+            self._functions = _kernel_functions(self.sym, self._qf)
+        return self._functions
 
     def _library(self) -> Library:
         return Library("kincas_sweep", self.functions, _SWEEP_C,
@@ -271,26 +282,32 @@ class FastSweeper:
         return r
 
     def sweep(self, U, p, L, careful, Ud=None, Udd=None, progress=None, jacobians=False) -> FastRun:
-        """Every pose of U: the fast pass wherever it is accepted, else `careful(k, j, q_j)`
-        -> a solution with q, residual, iterations, ok, where j is the last solved pose and
-        q_j its unknowns (None, None while none is); the fast pass restarts after each.
-        Between two consecutive fast poses det g_q keeps its sign (see the module's text)."""
+        """Every pose of U: the fast pass wherever it is accepted, else `careful(k, j, run)`
+        -> a solution with q, residual, iterations, ok, where j is the last solved pose (None
+        while none is; its unknowns are run.Q[j]); the fast pass restarts after each. Between
+        two consecutive fast poses det g_q keeps its sign (see the module's text). With no
+        unknowns or no inputs, every pose goes to `careful`."""
         r = FastRun(self, U, p, L, Ud, Udd, jacobians)
-        k, last = 0, None
+        k, last, going = 0, None, False  # going: the last block ended with no rejection
+
+        def tick(a, b):  # news at every 256th pose passed, as the careful path gives it
+            if progress is not None and b // 256 > a // 256:
+                progress(b - b % 256, r.n)
+        if progress is not None:
+            progress(0, r.n)
         while k < r.n:
-            if last is not None:
-                bad = r.advance(k, r.Q[last], r.U[last])
-                if bad > k:
-                    last = bad - 1
-                    if progress is not None:
-                        progress(bad, r.n)
-                if (k := bad) == r.n:
-                    break
-            sol = careful(k, last, None if last is None else r.Q[last])
+            if last is not None and self.nq and self.nu:
+                stop = r.n if progress is None else k + BLOCK
+                bad = r.advance(k, *((None, None) if going else (r.Q[last], r.U[last])), stop)
+                last, going = (bad - 1 if bad > k else last), bad == min(stop, r.n)
+                tick(k, bad)
+                k = bad
+                if going or k == r.n:
+                    continue
+            sol = careful(k, last, r)
             r.record(k, sol)
-            if sol.ok:
-                last = k
-            k += 1
+            last, k, going = (k if sol.ok else last), k + 1, False
+            tick(k - 1, k)
         slow = np.flatnonzero(r.solved & ~r.accepted)
         if self.report and slow.size:
             ev = evaluator_for(self.model, self.report)
@@ -300,7 +317,7 @@ class FastSweeper:
         return r
 
     # --- the virtual machine: the same arithmetic, mapaccum over CHUNK poses ---
-    def _vm_advance(self, r: FastRun, start: int, s: np.ndarray) -> int:
+    def _vm_advance(self, r: FastRun, start: int, stop: int, s: np.ndarray) -> int:
         nq, nu, no = self.nq, self.nu, len(self.report)
         if self._vm is None:
             kS = _vm_step(*self.functions, nq, nu, self.max_evals)
@@ -318,8 +335,8 @@ class FastSweeper:
         _, buf, call, (Qc, Jc, Tc, Uo, T1c, U1c, Ic, Yc, Uc, Udc, Uddc) = self._vm
         parts = np.split(s.copy(), np.cumsum([nq, nq * nq, nq * nu, nu, nq * nu]))
         k = start
-        while k < r.n:
-            m = min(CHUNK, r.n - k)
+        while k < stop:
+            m = min(CHUNK, stop - k)
             for c, (a, st) in ((Uc, (r.U, 1)), (Udc, r.Ud), (Uddc, r.Udd)):
                 c[:m], c[m:] = (a[k:k + m] if st else a), (a[k + m - 1] if st else a)  # pad
             for i, a in enumerate([*parts, Uc, r.p, r.L, r.thr, Udc, Uddc]):
@@ -335,7 +352,8 @@ class FastSweeper:
                 return k + j
             parts = [a[m - 1].copy() for a in (Qc, Jc, Tc, Uo, T1c, U1c)]
             k += m
-        return r.n
+        s[:] = np.concatenate(parts)  # where the compiled loop leaves it too
+        return stop
 
 
 def _take(table, idx):

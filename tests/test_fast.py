@@ -193,6 +193,40 @@ def test_quantity_evaluator_compiled_and_uncompiled_with_mask():
         assert np.nanmax(np.abs(out[1] - cf["C.vy"])) <= 2e-12 * L
 
 
+def test_no_unknowns_every_pose_goes_to_the_careful_path():
+    m = Mechanism(ground={"A": (0, 0)}, links=[Link.bar("crank", "A", "B", 2.0)],
+                  inputs=[Input.angle("crank")])
+    model = kincas.compile(m)
+    th = np.linspace(0, 3, 7)
+    calls = []
+
+    def careful(k, j, run):
+        calls.append((k, j))
+        return model.newton(np.zeros(0), th[k:k + 1], [], 2.0)
+
+    run = FastSweeper(model, ["B.y", "B.vx"]).sweep(th[:, None], [], 2.0, careful, Ud=[3.0])
+    assert calls == [(k, k - 1 if k else None) for k in range(7)] and run.solved.all()
+    np.testing.assert_allclose(run.values, [2 * np.sin(th), -6 * np.sin(th)], rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_progress_in_blocks_gives_the_same_poses(fourbar_sweepers, compiled, monkeypatch):
+    import kincas.fast
+    monkeypatch.setattr(kincas.fast, "BLOCK", 300)  # blocks of 300 poses, state carried over
+    th = np.linspace(0, 2 * np.pi, 2000)
+    U = th[:, None]
+    model, p, L, q0 = first_pose(fourbar(), U)
+    careful = lambda k, j, run: model.newton(q0 if j is None else run.Q[j], U[k], p, L)
+    fs, news = fourbar_sweepers[compiled], []
+    a = fs.sweep(U, p, L, careful)
+    b = fs.sweep(U, p, L, careful, progress=lambda done, total: news.append((done, total)))
+    np.testing.assert_array_equal(a.Q, b.Q)
+    assert b.accepted[1:].all() and news[0] == (0, 2000) and news[-1] == (2000, 2000)
+    mid = [d for d, _ in news[1:-1]]  # every 256th pose passed, at most one call per block
+    assert all(d % 256 == 0 for d in mid) and mid == sorted(set(mid)) and mid[-1] == 1792
+    assert len(mid) >= 2000 // 300
+
+
 # --- compilation: the disk cache, the policy, the fallback ---
 
 
@@ -281,9 +315,9 @@ def test_non_grashof_driven_past_its_toggle_and_back():
     sign = lambda q, u: np.sign(np.linalg.det(model.jac(q, u, p)))
     calls, ref = [], []
 
-    def careful(k, j, q_j):  # Newton from the last solved pose j, branch by det's sign
+    def careful(k, j, run):  # Newton from the last solved pose j, branch by det's sign
         calls.append(k)
-        start = model.initial_q(U[k], p, dict(m.guess), L) if j is None else q_j
+        start = model.initial_q(U[k], p, dict(m.guess), L) if j is None else run.Q[j]
         sol = model.newton(start, U[k], p, L)
         if sol.ok and not ref:
             ref.append(sign(sol.q, U[k]))
