@@ -31,6 +31,7 @@ import casadi as ca
 import numpy as np
 
 CHUNK = 256  # poses per call on the uncompiled (virtual machine) paths
+MAX_CACHED = 200  # libraries kept in the cache directory; the least recently used go first
 COMPILE_MIN_POSES = 50_000  # compile=None compiles for fewer poses only if already cached
 # -Bsymbolic: each library's own symbols bind inside it; -fno-semantic-interposition lets the
 # compiler inline the casadi functions into the C loop (about 15 % of a sweep's time); errno is
@@ -93,6 +94,9 @@ class Library:
         if str(self.path) not in _LIBS:
             if not self.path.exists():
                 self._compile()
+                _prune(self.path.parent)
+            else:
+                os.utime(self.path)  # recently used: pruned last
             t0 = time.perf_counter()
             lib = ctypes.CDLL(str(self.path))
             for name, args in self.signatures.items():
@@ -162,6 +166,17 @@ def pair_sincos(source: str) -> str:
             if "{" in lines[j] or "}" in lines[j] or re.match(rf"^\s*{a}=", lines[j]):
                 break
     return "\n".join(lines)
+
+
+def _prune(folder: Path) -> None:
+    """Remove the least recently used libraries beyond MAX_CACHED (a loaded one may go: its
+    file stays open until the process ends)."""
+    try:
+        libs = sorted(folder.glob("kincas_*.so"), key=lambda f: f.stat().st_mtime)
+        for f in libs[:max(0, len(libs) - MAX_CACHED)]:
+            f.unlink(missing_ok=True)
+    except OSError:  # another process pruned first: nothing lost
+        pass
 
 
 class Backend:

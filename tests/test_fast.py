@@ -252,6 +252,19 @@ print(json.dumps({{"cached": fs.backend.library.cached, "compile": fs.backend.li
     assert got == {"cached": True, "compile": 0.0, "path": str(lib.path), "ok": True}
 
 
+def test_the_cache_keeps_the_most_recently_used_libraries(tmp_path, monkeypatch):
+    import kincas.compiled
+    monkeypatch.setenv("KINCAS_CACHE", str(tmp_path))
+    monkeypatch.setattr(kincas.compiled, "MAX_CACHED", 2)
+    old = [tmp_path / f"kincas_sweep-old{i}.so" for i in range(3)]
+    for i, f in enumerate(old):
+        f.write_bytes(b"")
+        os.utime(f, (1000 + i, 1000 + i))
+    fs = FastSweeper(kincas.compile(fourbar(b=3.55)), ["C.x"], compile=True)
+    assert fs.backend.compiled(10) is not None
+    assert sorted(f.name for f in tmp_path.glob("*.so")) == sorted([old[2].name, fs.backend.library.path.name])
+
+
 def test_auto_policy_does_not_compile_a_short_sweep_unless_cached(fourbar_sweepers, tmp_path, monkeypatch):
     monkeypatch.setenv("KINCAS_CACHE", str(tmp_path))
     model = kincas.compile(fourbar())
