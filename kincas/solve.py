@@ -24,6 +24,7 @@ import casadi as ca
 import numpy as np
 
 from .errors import ModelError
+from .fast import sweeper_for
 from .model import Mechanism
 from .results import Pose, Sweep
 from .symbolic import Symbolic, default_report
@@ -319,39 +320,34 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     p = np.array([v for _, v in m.parameters], dtype=float)
     L = m.size()
     g = {k: (m.value(x), m.value(y)) for k, (x, y) in {**dict(m.guess), **dict(guess or {})}.items()}
-    Q = np.full((n, model.nq), np.nan)
-    res, its = np.full(n, np.nan), np.zeros(n, dtype=int)
-    status, events = [NO_ASSEMBLY] * n, []
-    last = None  # (q, u, sign of det g_q) of the last solved pose: every pose continues from it
-    prev = None  # (q, u) of the pose solved just before `last`, for the secant predictor
-    for k in range(n):
+    events = []
+
+    def careful(k, j, run):
+        """Pose k, which the fast pass did not accept, from the last solved pose j."""
         u = U[k]
-        if progress is not None and k % 256 == 0:
-            progress(k, n)
-        if last is None:
-            sol = _first(model, u, p, L, g)
-        else:
-            fresh = status[k - 1] == "ok"
-            sol = _continue(model, last[0], last[1], u, p, L, depth=8 if fresh else 0,
-                            prev=prev if fresh else None)
-            if sol is None:
-                sol = _recover(model, m, last, u, p, L)
-        res[k], its[k] = sol.residual, sol.iterations
-        if not sol.ok:
-            continue
-        sign = _det_sign(model, sol, L)
-        if last is not None and status[k - 1] != "ok":  # back in range: say on which branch
+        if j is None:
+            return _first(model, u, p, L, g)
+        fresh = j == k - 1
+        prev = (run.Q[j - 1], U[j - 1]) if fresh and j >= 1 and run.solved[j - 1] else None
+        sol = _continue(model, run.Q[j], U[j], u, p, L, depth=8 if fresh else 0, prev=prev)
+        if sol is None:
+            sol = _recover(model, m, (run.Q[j], U[j]), u, p, L)
+        if sol.ok and not fresh:  # back in range: say on which branch
+            before = Solution(run.Q[j], 0.0, 0, True, model.jac(run.Q[j], U[j], p))
+            sign, before = _det_sign(model, sol, L), _det_sign(model, before, L)
             events.append({"kind": "resume", "pose": int(k),
-                           "branch": "same" if sign == last[2] or 0 in (sign, last[2]) else "other"})
-        prev = (last[0], last[1]) if last is not None and status[k - 1] == "ok" else None
-        Q[k], status[k], last = sol.q, "ok", (sol.q, u, sign)
-    if progress is not None:
-        progress(n, n)
-    ok = np.array([s == "ok" for s in status])
+                           "branch": "same" if sign == before or 0 in (sign, before) else "other"})
+        return sol
+
+    # The fast pass (compiled, checked pose by pose) solves what it can; every pose it does
+    # not accept goes to the careful path above, and the fast pass restarts after it.
+    run = sweeper_for(model, tuple(report)).sweep(U, p, L, careful, Ud=Ud, Udd=Udd,
+                                                  progress=progress, jacobians=True)
+    ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
+    status = ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
-    events += _singular_events(model, m, U, Q, ok, p, L, flags)
-    values = np.full((len(report), n), np.nan)
-    values[:, ok] = model.quantities(report, Q[ok], U[ok], p, Ud[ok], Udd[ok])
+    events += _singular_events(model, m, U, Q, ok, p, L, flags, J=run.jacobian)
+    values = run.values
     keys = [i.key for i in m.inputs]
     events.sort(key=lambda e: e["pose"])
     for e in events:
@@ -464,7 +460,7 @@ def _same_branch(model: Model, J0, sol: Solution, L) -> bool:
 # --- singular positions met by a sweep ---
 
 
-def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags) -> list[dict]:
+def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, J=None) -> list[dict]:
     """Flag solved poses at or next to a singular position and locate it exactly.
 
     A limit lies between a solved pose and a neighbour with no assembly; a sign change of
@@ -474,17 +470,27 @@ def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags) -> list[
     """
     from .singular import FLAG_SIGMA, _scales, classify, locate_singular, scaled_jacobians
     n, events = len(ok), []
-    if model.nq == 0 or m.inputs == ():
+    if model.nq == 0 or m.inputs == () or n == 0:
         return events
     idx = np.flatnonzero(ok)
-    J, Ju = model.jacobians_at(Q[idx], U[idx], p)  # one mapped call for every solved pose
+    if J is None:
+        J, Ju = model.jacobians_at(Q[idx], U[idx], p)  # one mapped call for every solved pose
+    else:  # g_q per pose from the sweep; g_u only where a pose is flagged
+        J, Ju = J[idx], None
     cq, cu = _scales(model, L)
-    J, Ju = J * cq, Ju * cu
-    dets = dict(zip(idx, np.linalg.det(J) if len(idx) else []))
+    J = J * cq
+    dets = np.zeros(n)
+    dets[idx] = np.linalg.det(J) if len(idx) else []
     sv = np.linalg.svd(J, compute_uv=False) if len(idx) else np.zeros((0, model.nq))
     for j in np.flatnonzero(sv[:, -1] <= FLAG_SIGMA * np.maximum(sv[:, 0], 1.0)):
-        flags[idx[j]] = classify(J[j], Ju[j])
-    for k in idx:
+        Gu = Ju[j] * cu if Ju is not None else scaled_jacobians(model, Q[idx[j]], U[idx[j]], p, L)[1]
+        flags[idx[j]] = classify(J[j], Gu)
+    # Only a solved pose next to an unsolved one, or before a sign change of det g_q, can hold
+    # an event: look at those alone (a sweep of 10^5 poses has a handful).
+    before = np.r_[False, ~ok[:-1]]
+    after = np.r_[~ok[1:], False]
+    change = np.r_[ok[:-1] & ok[1:] & (np.sign(dets[:-1]) != np.sign(dets[1:])), False]
+    for k in idx[before[idx] | after[idx] | change[idx]]:
         for nb in (k - 1, k + 1):
             if not 0 <= nb < n:
                 continue
