@@ -366,12 +366,14 @@ def _take(table, idx):
 _MEMO: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
-def sweeper_for(model, report=()) -> FastSweeper:
-    """The `FastSweeper` of a compiled model and report (kept as long as the model is)."""
+def sweeper_for(model, report=(), compile=None) -> FastSweeper:
+    """The `FastSweeper` of a compiled model and report (kept as long as the model is);
+    `compile`: None (compile when cached or long), True or False."""
     memo = _MEMO.setdefault(model, {})
-    if ("sweep", tuple(report)) not in memo:
-        memo[("sweep", tuple(report))] = FastSweeper(model, report)
-    return memo[("sweep", tuple(report))]
+    key = ("sweep", tuple(report), compile)
+    if key not in memo:
+        memo[key] = FastSweeper(model, report, compile=compile)
+    return memo[key]
 
 
 def evaluator_for(model, names) -> QuantityEvaluator:

@@ -55,6 +55,9 @@ def compile(m: Mechanism) -> "Model":
     return _CACHE[key]
 
 
+_model_of = compile  # for functions whose `compile` argument hides the name
+
+
 class _Call:
     """A casadi Function called through zero-copy numpy buffers: no DM conversions, about
     0.1 us of overhead instead of 10 (see shared/casadi-notes.md). Outputs are dense and
@@ -298,7 +301,7 @@ def _input_table(m: Mechanism, inputs, what: str, default: float | None) -> np.n
 
 
 def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,
-          guess=None, progress=None) -> Sweep:
+          guess=None, progress=None, method: str = "fast", compile: bool | None = None) -> Sweep:
     """Solve the mechanism at every pose of `inputs` (input key -> array), keeping the branch.
 
     `rates` and `accelerations` give each input's first and second time derivative (default 1
@@ -306,11 +309,17 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     they need is computed. `guess` overrides the mechanism's guessed points. `progress`, if
     given, is called as progress(done, total) while solving.
 
+    `method="fast"` (the default) runs a compiled pass over the poses and re-solves on the
+    careful path (continuation with step cutting) every pose that it does not accept;
+    `method="careful"` uses the careful path for every pose. `compile`: None compiles the
+    fast pass to C when a compiled library is cached or the sweep is long, True always,
+    False never (CasADi's virtual machine).
+
     Each solved pose gets a flag where it sits at or next to a singular position ("limit",
     "change point", "singular"); `Sweep.events` lists those positions with their input values
     located exactly, and where a sweep resumed after poses with no assembly, on which branch.
     """
-    model = compile(m)
+    model = _model_of(m)
     report = list(default_report(m) if report is None else report)
     model.quantity_function(tuple(report))  # unknown names fail here, before any solving
     U = _input_table(m, inputs, "inputs", None)
@@ -341,8 +350,13 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 
     # The fast pass (compiled, checked pose by pose) solves what it can; every pose it does
     # not accept goes to the careful path above, and the fast pass restarts after it.
-    run = sweeper_for(model, tuple(report)).sweep(U, p, L, careful, Ud=Ud, Udd=Udd,
-                                                  progress=progress, jacobians=True)
+    if method == "fast":
+        run = sweeper_for(model, tuple(report), compile).sweep(U, p, L, careful, Ud=Ud, Udd=Udd,
+                                                               progress=progress, jacobians=True)
+    elif method == "careful":
+        run = _careful_only(model, report, U, Ud, Udd, p, careful, progress)
+    else:
+        raise ModelError(f"method: {method!r} is neither \"fast\" nor \"careful\"")
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
     status = ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
@@ -359,6 +373,32 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
                  values={nm: values[i] for i, nm in enumerate(report)},
                  q=Q, residual=res, iterations=its,
                  unknowns=[nm for nm, _ in model.sym.unknowns], size=L, events=events)
+
+
+class _CarefulRun:
+    """The arrays of a sweep solved on the careful path alone (as `FastRun` has them)."""
+
+    def __init__(self, n, nq, nr):
+        self.Q, self.solved = np.full((n, nq), np.nan), np.zeros(n, dtype=bool)
+        self.residual, self.iterations = np.full(n, np.nan), np.zeros(n, dtype=int)
+        self.values, self.jacobian = np.full((nr, n), np.nan), None
+
+
+def _careful_only(model, report, U, Ud, Udd, p, careful, progress) -> _CarefulRun:
+    n = U.shape[0]
+    run, j = _CarefulRun(n, model.nq, len(report)), None
+    for k in range(n):
+        if progress is not None and k % 256 == 0:
+            progress(k, n)
+        sol = careful(k, j, run)
+        run.residual[k], run.iterations[k] = sol.residual, sol.iterations
+        if sol.ok:
+            run.Q[k], run.solved[k], j = sol.q, True, k
+    if progress is not None:
+        progress(n, n)
+    ok = run.solved
+    run.values[:, ok] = model.quantities(report, run.Q[ok], U[ok], p, Ud[ok], Udd[ok])
+    return run
 
 
 def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,

@@ -63,13 +63,15 @@ def test_1000_to_1_link_ratio():
     assert np.abs(np.hypot(sw["C.x"] - C[0], sw["C.y"] - C[1])).max() <= 1e-12 * (a + b + c + d)
 
 
+@pytest.mark.parametrize("method", ["fast", "careful"])
 @pytest.mark.parametrize("step", [1.0, 15.0])
-def test_crank_rocker_near_its_change_point_keeps_its_branch(step):
+def test_crank_rocker_near_its_change_point_keeps_its_branch(step, method):
     a, b, c, d = 1, 4, 3, 2.0001
     th = np.radians(np.arange(0, 360 + step / 2, step))
     for sign, gy in ((+1, 3.0), (-1, -3.0)):
         C0 = closed(th[:1], a, b, c, d, sign)[:, 0]
-        sw = kincas.sweep(fourbar(a, b, c, d, (C0[0], C0[1])), {"crank.angle": th}, report=["C.x", "C.y"])
+        sw = kincas.sweep(fourbar(a, b, c, d, (C0[0], C0[1])), {"crank.angle": th},
+                          report=["C.x", "C.y"], method=method)
         residuals_ok(sw)
         assert np.all(sw.ok)
         C = closed(th, a, b, c, d, sign)
@@ -130,11 +132,13 @@ def test_parallelogram_from_an_imprecise_guess_keeps_its_branch():
     assert [e["kind"] for e in sw.events] == ["change point", "change point"]
 
 
-def test_triple_rocker_over_a_full_turn_stops_at_its_limits_and_resumes():
+@pytest.mark.parametrize("method", ["fast", "careful"])
+def test_triple_rocker_over_a_full_turn_stops_at_its_limits_and_resumes(method):
     a, b, c, d = 1, 1.9, 3, 4  # non-Grashof: the crank rocks between +-151.19 deg
     lim = math.acos((a * a + d * d - (b + c) ** 2) / (2 * a * d))
     th = np.radians(np.r_[np.arange(0, 361, 1.0), np.arange(359, -1, -1.0)])
-    sw = kincas.sweep(fourbar(a, b, c, d, (3.2, 2.5)), {"crank.angle": th}, report=["C.x", "C.y"])
+    sw = kincas.sweep(fourbar(a, b, c, d, (3.2, 2.5)), {"crank.angle": th}, report=["C.x", "C.y"],
+                      method=method)
     residuals_ok(sw)
     feasible = np.isfinite(closed(th, a, b, c, d, +1)[0])
     assert np.array_equal(sw.ok, feasible)
@@ -181,3 +185,8 @@ def test_range_of_a_driven_rocker_and_of_an_actuator():
                     inputs=[Input.parameter("len")], guess={"E": (5, 1)})
     r = input_range(act, {"len": 5.0})
     assert abs(r.low - 4.0) < 1e-9 * 4 and abs(r.high - 8.0) < 1e-9 * 8
+
+
+def test_unknown_method_is_an_error():
+    with pytest.raises(kincas.ModelError, match="method"):
+        kincas.sweep(fourbar(1, 3.5, 3, 4, (3.6, 2.9)), {"crank.angle": [0.0]}, method="quick")
