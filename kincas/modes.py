@@ -37,7 +37,6 @@ import tomllib
 import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Mapping
 
 import casadi as ca
 import numpy as np
@@ -120,25 +119,12 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
 
 
 def _input_vector(m: Mechanism, inputs) -> np.ndarray:
-    keys = [i.key for i in m.inputs]
-    if inputs is None:
-        inputs = {}
-    elif not isinstance(inputs, Mapping):
-        if len(keys) != 1:
-            raise ModelError(f"inputs: the mechanism has inputs {keys}; give a mapping")
-        inputs = {keys[0]: inputs}
-    problems = [f"inputs: {k!r} is not an input (inputs: {keys})" for k in inputs if k not in keys]
-    problems += [f"inputs: no value for input {k!r}" for k in keys if k not in inputs]
-    vals = {}
-    for k, v in inputs.items():
-        v = np.asarray(v, dtype=float)
-        if v.size != 1 or not np.isfinite(v).all():
-            problems.append(f"inputs: {k!r}: expected one finite number, got {inputs[k]!r}")
-        else:
-            vals[k] = float(v.ravel()[0])
-    if problems:
-        raise ModelError(problems)
-    return np.array([vals[k] for k in keys], dtype=float)
+    """One finite value per input (the pose at which the modes are wanted)."""
+    from .solve import _input_table
+    U = _input_table(m, {} if inputs is None and not m.inputs else inputs, "inputs", None)
+    if U.shape[0] != 1:
+        raise ModelError("inputs: expected one value per input (modes are found at one pose)")
+    return U[0]
 
 
 def _scatter(m: Mechanism, model, n: int, L: float, seed: int) -> np.ndarray:

@@ -294,6 +294,9 @@ def _input_table(m: Mechanism, inputs, what: str, default: float | None) -> np.n
     if not keys:  # a structure (no freedom): one pose
         return np.zeros((1, 0))
     cols = [np.atleast_1d(np.asarray(inputs.get(k, default), dtype=float)) for k in keys]
+    bad = [k for k, c in zip(keys, cols) if c.ndim != 1 or not np.isfinite(c).all()]
+    if bad:
+        raise ModelError([f"{what}: {k!r}: expected finite numbers (one per pose)" for k in bad])
     n = max(len(c) for c in cols)
     if any(len(c) not in (1, n) for c in cols):
         raise ModelError(f"{what}: inputs that sweep advance together, so their lengths must agree")
