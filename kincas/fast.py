@@ -48,6 +48,12 @@ STEP = 1e-13  # the next Newton step (radians, or lengths / L): the error left i
 JAC_CHANGE = 0.9  # sum |entries of D^-1 (J_prev^-1 J - I) D| (below 1 keeps det's sign)
 CORRECTION = 0.25  # ||D^-1 (q - q_pred)||_1: Newton may not wander far from the prediction
 MAX_EVALS = 5  # residual evaluations per pose: at the prediction and after up to 4 steps
+# Kernel size, in casadi instructions, beyond which compiling costs more than it saves: gcc
+# -O3 took 1.7 s at 11k instructions, 13 s at 39k and 200 s (3.5 GB) at 150k.
+COMPILE_MAX = 40_000
+# Beyond this size the virtual machine is slower than the careful path (measured on chains
+# of four-bars: equal near 7k instructions, twice as slow at 11k).
+VM_MAX = 6_000
 INFO = ("residual", "step", "jac_change", "correction", "evaluations")
 BLOCK = 65536  # poses per call when a progress callback wants news
 
@@ -76,7 +82,12 @@ def _kernel_functions(sym, qf: ca.Function | None) -> list[ca.Function]:
     sol = ca.solve(Jq, ca.horzcat(g, Ju))  # one factorisation: Newton step and tangent
     rs = ca.vertcat(ca.mmax(ca.fabs(g)) / L, ca.norm_1(sol[:, 0] / D))  # a sum keeps NaNs
     y = ca.densify(qf(q, u, p, ud, udd)) if qf is not None else ca.SX(0, 1)
-    M = (ca.solve(J0, J) - ca.DM.eye(nq)) * ca.repmat(D.T, nq, 1) / ca.repmat(D, 1, nq)
+    # J0 and J arrive dense, but have g_q's sparsity: projecting them onto it keeps the
+    # symbolic solve as sparse as g_q's structure (a chain of loops: block triangular)
+    # instead of a dense n^3 expression.
+    sp = sym.Jq.sparsity()
+    Js, J0s = ca.project(J, sp), ca.project(J0, sp)
+    M = (ca.solve(J0s, Js) - ca.DM.eye(nq)) * ca.repmat(D.T, nq, 1) / ca.repmat(D, 1, nq)
     mc = ca.vertcat(ca.sum1(ca.sum2(ca.fabs(M))), ca.norm_1((q - qp) / D))
     d, o = ca.densify, {"cse": True}  # cse: one sin and cos per angle, shared by everything
     return [ca.Function("kP", [q, T0, u0, u, T1, u1], [d(pred)], o),
@@ -248,6 +259,19 @@ class FastSweeper:
         self._functions = None
         self._vm = None
         self.backend = Backend(compile, self._library, "fast sweep kernel")
+
+    @property
+    def size(self) -> int:
+        """The kernel's size in casadi instructions (what compiling and running cost)."""
+        return sum(fn.n_instructions() for fn in self.functions)
+
+    def worth_it(self, n: int) -> bool:
+        """Whether the fast pass pays for n poses: compiled (when its size allows: a larger
+        kernel is never compiled), or small enough for the virtual machine to beat the
+        careful path."""
+        if self.size > COMPILE_MAX and self.backend.compile is not False:
+            self.backend.compile = False
+        return self.backend.compiled(n) is not None or self.size <= VM_MAX
 
     @property
     def functions(self) -> list[ca.Function]:

@@ -315,8 +315,10 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     `method="fast"` (the default) runs a compiled pass over the poses and re-solves on the
     careful path (continuation with step cutting) every pose that it does not accept;
     `method="careful"` uses the careful path for every pose. `compile`: None compiles the
-    fast pass to C when a compiled library is cached or the sweep is long, True always,
-    False never (CasADi's virtual machine).
+    fast pass to C when a compiled library is cached or the sweep is long, and leaves out the
+    fast pass where it would not pay (a large mechanism, a short sweep); True compiles it
+    (unless the kernel is too large for the compiler to be worth waiting for), False runs it
+    in CasADi's virtual machine.
 
     Each solved pose gets a flag where it sits at or next to a singular position ("limit",
     "change point", "singular"); `Sweep.events` lists those positions with their input values
@@ -353,10 +355,10 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 
     # The fast pass (compiled, checked pose by pose) solves what it can; every pose it does
     # not accept goes to the careful path above, and the fast pass restarts after it.
-    if method == "fast":
-        run = sweeper_for(model, tuple(report), compile).sweep(U, p, L, careful, Ud=Ud, Udd=Udd,
-                                                               progress=progress, jacobians=True)
-    elif method == "careful":
+    fast = sweeper_for(model, tuple(report), compile) if method == "fast" else None
+    if fast is not None and (compile is False or fast.worth_it(n)):
+        run = fast.sweep(U, p, L, careful, Ud=Ud, Udd=Udd, progress=progress, jacobians=True)
+    elif method in ("fast", "careful"):  # "fast" for a kernel too large to pay for itself
         run = _careful_only(model, report, U, Ud, Udd, p, careful, progress)
     else:
         raise ModelError(f"method: {method!r} is neither \"fast\" nor \"careful\"")
@@ -384,7 +386,7 @@ class _CarefulRun:
     def __init__(self, n, nq, nr):
         self.Q, self.solved = np.full((n, nq), np.nan), np.zeros(n, dtype=bool)
         self.residual, self.iterations = np.full(n, np.nan), np.zeros(n, dtype=int)
-        self.values, self.jacobian = np.full((nr, n), np.nan), None
+        self.values, self.jacobian = np.full((nr, n), np.nan), np.full((n, nq, nq), np.nan)
 
 
 def _careful_only(model, report, U, Ud, Udd, p, careful, progress) -> _CarefulRun:
@@ -397,6 +399,7 @@ def _careful_only(model, report, U, Ud, Udd, p, careful, progress) -> _CarefulRu
         run.residual[k], run.iterations[k] = sol.residual, sol.iterations
         if sol.ok:
             run.Q[k], run.solved[k], j = sol.q, True, k
+            run.jacobian[k] = sol.J if sol.J is not None else model.jac(sol.q, U[k], p)
     if progress is not None:
         progress(n, n)
     ok = run.solved
@@ -467,8 +470,11 @@ def _ill(model: Model, J, L) -> bool:
     """Whether g_q is too close to singular for its tangent to be trusted."""
     if J.size == 0:
         return False
-    s = np.linalg.svd(J * np.where(model.sym.is_length, 1.0, 1.0 / L), compute_uv=False)
-    return s[-1] < 1e-2 * s[0]
+    # The 1-norm condition number (an LU and an inverse) is within a factor n of the 2-norm
+    # one, and several times cheaper than singular values for large mechanisms.
+    with np.errstate(all="ignore"):
+        c = np.linalg.cond(J * np.where(model.sym.is_length, 1.0, 1.0 / L), 1)
+    return not c < 1e2 * max(1.0, np.sqrt(J.shape[0]))
 
 
 def _secant(q0, u0, u1, prev):
