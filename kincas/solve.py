@@ -346,9 +346,13 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         sol = _continue(model, run.Q[j], U[j], u, p, L, depth=8 if fresh else 0, prev=prev)
         if sol is None:
             sol = _recover(model, m, (run.Q[j], U[j]), u, p, L)
-        if sol.ok and not fresh:  # back in range: say on which branch
+        if sol.ok and not fresh:  # back in range: on the same branch if it exists; say which
             before = Solution(run.Q[j], 0.0, 0, True, model.jac(run.Q[j], U[j], p))
             sign, before = _det_sign(model, sol, L), _det_sign(model, before, L)
+            if 0 not in (sign, before) and sign != before:
+                alt = _same_branch_assembly(model, m, u, p, L, before, run.Q[j], U[j])
+                if alt is not None:
+                    sol, sign = alt, before
             events.append({"kind": "resume", "pose": int(k),
                            "branch": "same" if sign == before or 0 in (sign, before) else "other"})
         return sol
@@ -432,6 +436,24 @@ def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:
         pts = model.points(last[0], last[1], p)
         sol = model.nearest_assembly(last[0], u, p, {nm: pts[:, j] for j, nm in enumerate(m.moving_points)}, L)
     return sol
+
+
+def _same_branch_assembly(model: Model, m: Mechanism, u, p, L, sign, q_last, u_last):
+    """Back in range after a gap (a limit, where the branches meet): the assembly whose
+    det(g_q) has the given sign, nearest the last solved pose; None if there is none.
+    The assemblies come from scattered starts, as `kincas modes` finds them."""
+    from .modes import find_modes
+    try:
+        modes = find_modes(m, {i.key: float(v) for i, v in zip(m.inputs, u)}, starts=128)
+    except ModelError:
+        return None
+    last = model.points(q_last, u_last, p)
+    near = [(float(np.linalg.norm(model.points(md.q, u, p) - last)), md.q)
+            for md in modes if md.orientation == sign]
+    if not near:
+        return None
+    sol = model.newton(min(near, key=lambda t: t[0])[1], u, p, L)
+    return sol if sol.ok and _det_sign(model, sol, L) == sign else None
 
 
 def _scaled_norm(model: Model, dq, L) -> float:
