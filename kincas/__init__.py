@@ -16,7 +16,8 @@ Jacobians, sensitivities to every named parameter. Angles are radians in Python.
 from .errors import KincasError, ModelError, SceneError
 from .model import Input, Link, Mechanism, Param, Slide
 from .results import Pose, Sweep
-from .solve import compile, solve, sweep
+from .numeric import compile
+from .solve import solve, sweep
 
 __all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "solve", "sweep", "compile",
            "Pose", "Sweep", "KincasError", "ModelError", "SceneError"]

@@ -44,7 +44,7 @@ import numpy as np
 from .errors import ModelError, SceneError
 from .model import Mechanism
 from .results import wrap_angle
-from .solve import ACCEPT, MAX_STEP, TOL, compile
+from .numeric import ACCEPT, MAX_STEP, TOL, compile
 
 SAME = 1e-6  # two assemblies are one mode when every point agrees to this times the size
 CONVERGED = 1e-8  # a start whose relative residual reaches this is worth polishing

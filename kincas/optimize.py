@@ -129,7 +129,8 @@ def optimize(m: Mechanism, samples, vary: dict, minimize: str, constraints=(), *
 
 def _once(m, samples, vary, minimize, constraints, data, rates, accelerations, deg, check_path,
           max_iter, tol) -> OptimizeResult:
-    from .solve import compile, sweep
+    from .numeric import compile
+    from .solve import sweep
 
     model = compile(m)
     prob = Problem(m, model, vary, data, deg)

@@ -93,7 +93,7 @@ def _pose_function(model):
 
 def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
     """Positions of all points and the lines of all slides at every pose of `sweep`."""
-    from .solve import compile
+    from .numeric import compile
     model = compile(m)
     keys = [i.key for i in m.inputs]
     missing = [k for k in keys if k not in sweep.inputs]

@@ -329,7 +329,7 @@ class _Reader:
         return report, sens
 
     def check_quantities(self, m: Mechanism, report: list[str], sens: list[str]):
-        from .solve import compile
+        from .numeric import compile
         from .symbolic import parse_quantity
         sym = compile(m).sym
         bad = sym.check_names(report)

@@ -139,7 +139,8 @@ class Range:
 def input_range(m: Mechanism, inputs: dict, key: str | None = None, *, max_steps: int = 20000) -> Range:
     """Range of input `key` (default: the first) on the branch of the pose at `inputs`,
     the other inputs held at their values. Limits are located to rounding precision."""
-    from .solve import compile, solve
+    from .numeric import compile
+    from .solve import solve
     model = compile(m)
     keys = [i.key for i in m.inputs]
     key = key or keys[0]

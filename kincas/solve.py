@@ -1,7 +1,7 @@
 """Position solving (damped Newton, IPOPT fallback), sweeps with branch continuity.
 
 A pose is solved when its loop-closure residual is below `ACCEPT` times the mechanism's
-size; Newton aims at `TOL`. A pose that cannot be solved is data (status and NaN), never an
+size (see kincas/numeric.py). A pose that cannot be solved is data (status and NaN), never an
 exception. The guess picks the assembly branch; in a sweep each pose is predicted from the
 one before along the exact tangent dq/du = -g_q^-1 g_u, so the branch is kept.
 
@@ -16,260 +16,20 @@ one before along the exact tangent dq/du = -g_q^-1 g_u, so the branch is kept.
 """
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
 from typing import Mapping
 
-import casadi as ca
 import numpy as np
 
 from .errors import ModelError
 from .fast import sweeper_for
 from .model import Mechanism
+from .numeric import Model, Solution, compile
 from .results import Pose, Sweep
-from .symbolic import Symbolic, default_report
+from .symbolic import default_report
 
-TOL = 1e-13  # Newton's target: residual relative to the mechanism's size
-ACCEPT = 1e-10  # a pose whose relative residual is above this is not solved
-MAX_STEP = 0.5  # largest Newton step per iteration: radians, or this times the size
+_model_of = compile  # for sweep(), whose `compile` argument hides the name
+
 NO_ASSEMBLY = "no assembly"
-
-
-# --- compiled models, one per structure (parameter values stay numeric inputs) ---
-
-
-def _structure_key(m: Mechanism):
-    return (tuple(k for k, _ in m.parameters), m.ground, m.links, m.slides, m.inputs)
-
-
-_CACHE: dict = {}
-
-
-def compile(m: Mechanism) -> "Model":
-    """The compiled model of `m`'s structure (cached: changing parameters does not recompile)."""
-    key = _structure_key(m)
-    if key not in _CACHE:
-        if len(_CACHE) >= 64:
-            _CACHE.pop(next(iter(_CACHE)))
-        _CACHE[key] = Model(Symbolic(m))  # Symbolic never reads parameter values
-    return _CACHE[key]
-
-
-_model_of = compile  # for functions whose `compile` argument hides the name
-
-
-class _Call:
-    """A casadi Function called through zero-copy numpy buffers: no DM conversions, about
-    0.1 us of overhead instead of 10 (see shared/casadi-notes.md). Outputs are dense and
-    overwritten by the next call: copy what must be kept."""
-
-    def __init__(self, f: ca.Function):
-        ins = f.sx_in()
-        self.f = ca.Function(f.name() + "_dense", ins, [ca.densify(o) for o in f.call(ins)])
-        self._in = [np.zeros(self.f.nnz_in(i)) for i in range(self.f.n_in())]
-        self._flat = [np.zeros(self.f.nnz_out(i)) for i in range(self.f.n_out())]
-        self.out = [a.reshape(self.f.size_out(i), order="F") for i, a in enumerate(self._flat)]
-        self._buf, self._eval = self.f.buffer()  # keep both referenced (raw pointers inside)
-        for i, a in enumerate(self._in):
-            self._buf.set_arg(i, memoryview(a))
-        for i, a in enumerate(self._flat):
-            self._buf.set_res(i, memoryview(a))
-
-    def __call__(self, *args):
-        for a, x in zip(self._in, args):
-            a[:] = np.ravel(x, order="F")
-        self._eval()
-        return self.out
-
-
-@dataclass
-class Solution:
-    q: np.ndarray
-    residual: float
-    iterations: int
-    ok: bool
-    J: np.ndarray | None = None  # g_q at q
-
-
-class Model:
-    """Numeric evaluation of a symbolic model: residuals, Newton, IPOPT, quantities."""
-
-    def __init__(self, sym: Symbolic):
-        self.sym = sym
-        self.nq, self.nu = sym.nq, sym.nu
-        m = sym.mech
-        locs = [sym.val(c) for lk in m.links for _, xy in lk.points for c in xy]
-        self.f_local = ca.Function("local", [sym.u, sym.p], [ca.vertcat(*locs)])
-        gxy = [c for g, _ in m.ground for c in sym.points[g]]
-        self.f_ground = ca.Function("ground", [sym.u, sym.p], [ca.vertcat(*gxy) if gxy else ca.SX(0, 1)])
-        self._nlp = None
-        self._qfun: dict[tuple, ca.Function] = {}
-        self._resjac, self._tangent = _Call(sym.f_resjac), _Call(sym.f_tangent)
-        self._res = _Call(sym.f_res)
-
-    # --- residuals and Newton ---
-    def residual(self, q, u, p) -> np.ndarray:
-        return self._res(q, u, p)[0].ravel().copy()
-
-    def resjac(self, q, u, p):
-        """(g, g_q) at a pose, as fresh numpy arrays."""
-        g, J = self._resjac(q, u, p)
-        return g.ravel().copy(), J.copy()
-
-    def newton(self, q, u, p, L, max_iter=40) -> Solution:
-        """Damped Newton on g(q) = 0 with the exact Jacobian; the residual is relative to L."""
-        q = np.array(q, dtype=float)
-        g, J = self.resjac(q, u, p)
-        r = np.abs(g).max(initial=0.0) / L
-        scale = np.where(self.sym.is_length, MAX_STEP * L, MAX_STEP)
-        for it in range(max_iter):
-            if r <= TOL:
-                return Solution(q, r, it, True, J)
-            try:
-                dq = np.linalg.solve(J, -g)
-            except np.linalg.LinAlgError:
-                dq = np.linalg.lstsq(J, -g, rcond=None)[0]
-            if not np.all(np.isfinite(dq)):
-                break
-            dq /= max(1.0, np.abs(dq / scale).max())  # a trust region keeps steps on the branch
-            t = 1.0
-            while True:  # backtrack until the residual decreases
-                qn = q + t * dq
-                gn, Jn = self.resjac(qn, u, p)
-                rn = np.abs(gn).max(initial=0.0) / L
-                if rn < (1 - 1e-4 * t) * r or rn <= TOL or t < 1 / 32:
-                    break
-                t /= 2
-            if not rn < r and rn > TOL:
-                break  # no progress: stagnation at a non-solution (or at rounding level)
-            q, g, J, r = qn, gn, Jn, rn
-        return Solution(q, r, max_iter, r <= ACCEPT, J)
-
-    def tangent(self, q, u, p) -> np.ndarray:
-        """dq/du (nq x nu) at a solved pose, from the implicit function theorem."""
-        _, J, Ju = self._tangent(q, u, p)
-        try:
-            return np.linalg.solve(J, -Ju)
-        except np.linalg.LinAlgError:
-            return np.linalg.lstsq(J, -Ju, rcond=None)[0]
-
-    def jac(self, q, u, p) -> np.ndarray:
-        return self._resjac(q, u, p)[1].copy()
-
-    def jacobians_at(self, Q, U, p):
-        """g_q (N, nq, nq) and g_u (N, nq, nu) at N poses in one mapped call."""
-        n = Q.shape[0]
-        if n == 0:
-            return np.zeros((0, self.nq, self.nq)), np.zeros((0, self.nq, self.nu))
-        f = self.sym.f_tangent.map(n)
-        _, J, Ju = f(Q.T, U.T, np.repeat(np.reshape(p, (-1, 1)), n, axis=1))
-        J = np.asarray(ca.densify(J)).reshape(self.nq, n, self.nq).transpose(1, 0, 2)
-        Ju = np.asarray(ca.densify(Ju)).reshape(self.nq, n, self.nu).transpose(1, 0, 2)
-        return J, Ju
-
-    def points(self, q, u, p) -> np.ndarray:
-        """World positions of the moving points, 2 x n."""
-        return np.asarray(self.sym.f_points(q, u, p))
-
-    # --- the first pose: from the user's guess ---
-    def initial_q(self, u, p, guess: dict[str, tuple[float, float]], L: float) -> np.ndarray:
-        """Unknowns placed from guessed points, walking the spanning tree from the ground.
-
-        A link hanging on point P takes the angle that points it at another of its points
-        whose position is guessed (or already known); with none, angle 0.
-        """
-        m, sym = self.sym.mech, self.sym
-        loc_flat = np.asarray(self.f_local(u, p)).ravel()
-        loc, k = {}, 0
-        for lk in m.links:
-            for pt, _ in lk.points:
-                loc[(lk.name, pt)] = loc_flat[k:k + 2]
-                k += 2
-        gflat = np.asarray(self.f_ground(u, p)).ravel()
-        gv = {g: gflat[2 * k:2 * k + 2] for k, (g, _) in enumerate(m.ground)}
-        known = dict(gv)
-        guessed = {k: np.asarray(v, float) for k, v in guess.items()}
-        q = np.zeros(self.nq)
-        index = {name: i for i, (name, _) in enumerate(sym.unknowns)}
-        angle_in = {i.target: u[k] for k, i in enumerate(m.inputs) if i.kind == "angle"}
-        centre = np.mean(list(gv.values()), axis=0) if gv else np.zeros(2)
-        for lname, at in m.structure.order:
-            pts = [pt for pt, _ in m.link(lname).points]
-            ref = [pt for pt in pts if pt in guessed or pt in known]
-            pos = {pt: guessed.get(pt, known.get(pt)) for pt in ref}
-            if at is not None:
-                anchor = guessed.get(at, known[at])
-                others = [pt for pt in ref if pt != at]
-                th = 0.0
-                if others:
-                    d = pos[others[0]] - anchor
-                    dl = loc[(lname, others[0])] - loc[(lname, at)]
-                    th = math.atan2(d[1], d[0]) - math.atan2(dl[1], dl[0])
-                th = float(angle_in.get(lname, th))
-                c, s = math.cos(th), math.sin(th)
-                R = np.array([[c, -s], [s, c]])
-                origin = known[at] - R @ loc[(lname, at)]
-            else:
-                th = 0.0
-                if len(ref) >= 2:
-                    d, dl = pos[ref[1]] - pos[ref[0]], loc[(lname, ref[1])] - loc[(lname, ref[0])]
-                    th = math.atan2(d[1], d[0]) - math.atan2(dl[1], dl[0])
-                th = float(angle_in.get(lname, th))
-                c, s = math.cos(th), math.sin(th)
-                R = np.array([[c, -s], [s, c]])
-                origin = (pos[ref[0]] - R @ loc[(lname, ref[0])]) if ref else centre
-                q[index[f"{lname}.x"]], q[index[f"{lname}.y"]] = origin
-            if f"{lname}.angle" in index:
-                q[index[f"{lname}.angle"]] = th
-            for pt in pts:
-                known.setdefault(pt, origin + R @ loc[(lname, pt)])
-        return q
-
-    # --- IPOPT: the assembly nearest to target positions ---
-    def nearest_assembly(self, q0, u, p, targets: dict[str, np.ndarray], L) -> Solution:
-        """min sum |P - target|^2 subject to g = 0, by IPOPT (scaled by the size L)."""
-        sym, names = self.sym, list(self.sym.mech.moving_points)
-        if self._nlp is None:
-            x = ca.SX.sym("x", self.nq)
-            npt = len(names)
-            T, W = ca.SX.sym("T", 2, npt), ca.SX.sym("W", npt)
-            x0, Ls = ca.SX.sym("x0", self.nq), ca.SX.sym("L")
-            qscale = ca.if_else(ca.DM(sym.is_length.astype(float)), Ls, 1)
-            q = x * qscale
-            subst = lambda e: ca.substitute(e, sym.q, q)
-            P = subst(sym._point_matrix())
-            obj = ca.mtimes(ca.sum1((P - T) ** 2), W) / Ls ** 2 + 1e-6 * ca.sumsqr(x - x0)
-            par = ca.vertcat(sym.u, sym.p, ca.vec(T), W, x0, Ls)
-            nlp = {"x": x, "p": par, "f": obj, "g": subst(sym.g) / Ls}
-            opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
-                    "ipopt.max_iter": 200, "ipopt.tol": 1e-12, "error_on_fail": False}
-            self._nlp = (ca.nlpsol("assemble", "ipopt", nlp, opts), qscale)
-        solver, qscale = self._nlp
-        T = np.zeros((2, len(names)))
-        W = np.zeros(len(names))
-        for k, n in enumerate(names):
-            if n in targets:
-                T[:, k], W[k] = targets[n], 1.0
-        qs = np.where(sym.is_length, L, 1.0)
-        par = np.concatenate([np.ravel(u), np.ravel(p), T.ravel(order="F"), W, q0 / qs, [L]])
-        out = solver(x0=q0 / qs, p=par, lbg=0, ubg=0)
-        q = np.asarray(out["x"]).ravel() * qs
-        return self.newton(q, u, p, L)  # polish, and judge by the residual alone
-
-    # --- quantities over many poses ---
-    def quantity_function(self, names: tuple[str, ...]) -> ca.Function:
-        if names not in self._qfun:
-            self._qfun[names] = self.sym.quantity_function(list(names))
-        return self._qfun[names]
-
-    def quantities(self, names, Q, U, P, Ud, Udd) -> np.ndarray:
-        """Quantities (len(names) x N) at N solved poses, in one vectorised call."""
-        n = Q.shape[0]
-        if n == 0 or not names:
-            return np.zeros((len(names), n))
-        f = self.quantity_function(tuple(names)).map(n)
-        rep = lambda a: np.repeat(np.reshape(a, (-1, 1)), n, axis=1)
-        return np.asarray(f(Q.T, U.T, rep(P), Ud.T, Udd.T))
 
 
 # --- sweeps ---

@@ -152,7 +152,7 @@ def _check_std(m: Mechanism, std, where: str) -> list[str]:
 
 def _monte_carlo(m: Mechanism, sw, report, to, dp):
     """Monte-Carlo std and mean shift (poses x outputs), failures per pose, samples retried."""
-    from .solve import ACCEPT, compile
+    from .numeric import ACCEPT, compile
 
     model = compile(m)
     sym, nq = model.sym, model.nq
@@ -265,7 +265,7 @@ def _sample_function(model, report: tuple[str, ...]):
 
 def read_section(sc) -> dict:
     """The `[tolerance]` section as analyse()'s keywords; SceneError naming the field."""
-    from .solve import compile
+    from .numeric import compile
     from .symbolic import parse_quantity
 
     t = sc.study.raw.get("tolerance")

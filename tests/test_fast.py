@@ -14,7 +14,7 @@ import pytest
 import kincas
 from kincas import Input, Link, Mechanism, Slide
 from kincas.fast import FastRun, FastSweeper, QuantityEvaluator
-from kincas.solve import Solution
+from kincas.numeric import Solution
 
 
 @pytest.fixture(scope="module", autouse=True)
