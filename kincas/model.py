@@ -403,5 +403,9 @@ def _check_mobility(m: Mechanism) -> list[str]:
         return []
     detail = (f"{st.n_unknowns} unknown coordinates, {st.n_equations} equations"
               + (f", plus {n_param} driven parameter(s)" if n_param else ""))
+    hint = ""
+    if dof < len(m.inputs):  # fewer freedoms than expected: often a redundant constraint
+        hint = ("; kincas counts every joint as independent, so a redundant one (a third "
+                "parallel link in a parallelogram) removes a freedom: leave it out")
     return [f"[inputs]: the mechanism has {dof} degree(s) of freedom ({detail}) "
-            f"but {len(m.inputs)} input(s) drive it; give one input per degree of freedom"]
+            f"but {len(m.inputs)} input(s) drive it; give one input per degree of freedom{hint}"]
