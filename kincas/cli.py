@@ -18,7 +18,7 @@ import sys
 import numpy as np
 
 from . import __version__
-from .errors import KincasError
+from .errors import KincasError, OutputError
 from .model import Param
 
 EXIT_OK, EXIT_SCENE, EXIT_UNSOLVED = 0, 2, 3
@@ -74,6 +74,9 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # `kincas solve ... | head`: the reader left, nothing is wrong
         sys.stderr.close()
         return EXIT_OK
+    except OutputError as e:  # a file or option that cannot be honoured: one line
+        print(f"kincas: {e}", file=sys.stderr)
+        return EXIT_SCENE
     except KincasError as e:
         print(f"kincas: error in {getattr(args, 'scene', 'scene')}:\n{e}", file=sys.stderr)
         return EXIT_SCENE

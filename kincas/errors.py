@@ -29,3 +29,8 @@ class ModelError(KincasError, ValueError):
 
 class SceneError(KincasError, ValueError):
     """The scene file is malformed: the message names the section and the field."""
+
+
+class OutputError(KincasError):
+    """A file or option on the command line cannot be honoured (an unwritable path, a
+    missing optional extra): the command says so in one line."""

@@ -19,11 +19,11 @@ from __future__ import annotations
 
 import csv
 import math
-import sys
 from types import SimpleNamespace
 
 import numpy as np
 
+from .errors import OutputError
 from .model import Mechanism
 from .results import Sweep
 
@@ -220,9 +220,8 @@ def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, 
 
 
 def _fail(message: str):
-    """One line on standard error, exit status 2 (a wrong invocation, like a wrong scene)."""
-    print(f"kincas: {message}", file=sys.stderr)
-    raise SystemExit(2)
+    """A wrong invocation, like a wrong scene: `kincas` prints it in one line, exit status 2."""
+    raise OutputError(message)
 
 
 def check_outputs(args, mechanism=None) -> None:
