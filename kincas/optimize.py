@@ -40,11 +40,13 @@ import numpy as np
 from .model import Mechanism
 from .errors import ModelError
 from .results import Sweep
+from .curve import Curve, constrain as curve_constrain, distances as curve_distances
+from .curve import objective as curve_objective, start as curve_start
 from .simultaneous import EXTREME_MOVED, Problem
 
 MAX_ROUNDS = 3  # IPOPT runs when extremes moved away from where they were tracked
 
-__all__ = ["optimize", "Constraint", "OptimizeResult", "cli_arguments", "cli_run"]
+__all__ = ["optimize", "Curve", "Constraint", "OptimizeResult", "cli_arguments", "cli_run"]
 
 
 @dataclass
@@ -100,12 +102,17 @@ def _as_constraint(c, i) -> Constraint:
 
 
 
-def optimize(m: Mechanism, samples, vary: dict, minimize: str, constraints=(), *, data=None,
+def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, constraints=(), *, data=None,
              rates=None, accelerations=None, deg: bool = False, check_path: bool = True,
              max_iter: int = 1000, tol: float = 1e-12) -> OptimizeResult:
     """Vary the parameters `vary` (name -> (low, high)) to minimise `minimize` subject to
     `constraints` (Constraint, dict {expr, min, max} or tuple (expr, min, max)), with the
     mechanism posed at the `samples` inputs (key -> array, as for `kincas.sweep`).
+
+    `samples` may instead be a `Curve` (see `kincas.curve`): targets for a point without
+    prescribed inputs. Then the input at each target is a variable too (`samples` of the
+    result gives the fitted ones), the objective is the sum of squared distances from the
+    point to the targets, plus `minimize` if given, and `data` has one value per target.
 
     `data` gives named arrays, one value per sample, for the expressions. `deg`: quantities,
     data and trigonometric functions in the expressions use degrees for angles (the scene
@@ -134,13 +141,27 @@ def _once(m, samples, vary, minimize, constraints, data, rates, accelerations, d
 
     model = compile(m)
     prob = Problem(m, model, vary, data, deg)
-    objective = prob.parse(minimize, "minimize")
+    curve = samples if isinstance(samples, Curve) else None
+    if minimize is None and curve is None:
+        raise ModelError("minimize: missing (an expression; optional only with a curve)")
+    objective = None if minimize is None else prob.parse(minimize, "minimize")
     cons = [prob.parse_constraint(_as_constraint(c, i), i) for i, c in enumerate(constraints)]
-    sw0 = sweep(m, samples, rates=rates, accelerations=accelerations, report=[])
-    prob.set_samples(sw0, sweep)
-    f = prob.evaluate(objective, "minimize", objective=True)[1]
+    if curve is None:
+        sw0 = sweep(m, samples, rates=rates, accelerations=accelerations, report=[])
+        prob.set_samples(sw0, sweep)
+    else:  # the inputs at the targets are variables too, started at the projections
+        sw0, shape = curve_start(m, curve, sweep, rates, accelerations)
+        prob.set_samples(sw0, sweep)
+        curve_constrain(prob, *shape)
+        prob.used += [n for n in (f"{curve.point}.x", f"{curve.point}.y") if n not in prob.used]
+    f = 0 if objective is None else prob.evaluate(objective, "minimize", objective=True)[1]
+    if curve is not None:
+        f = f + curve_objective(prob, curve)
     rows = [(c, prob.evaluate(e, c.expr)) for c, e in cons]
-    return OptimizeResult(**prob.solve(f, rows, check_path, max_iter, tol))
+    r = OptimizeResult(**prob.solve(f, rows, check_path, max_iter, tol))
+    if curve is not None:
+        r.info["distances"] = curve_distances(r.sweep, curve, prob.at)
+    return r
 
 
 # --- scenes: the [optimize] section ---

@@ -81,6 +81,7 @@ class Problem:
         self.qs = np.where(self.sym.is_length, self.L, 1.0)  # unknowns scaled to O(1)
         self.extremes: dict[tuple, dict] = {}
         self.used: list[str] = []
+        self.Uv = None  # the sample inputs as variables (a curve: see kincas.curve)
 
     # --- parsing ---
     def parse(self, text, where):
@@ -131,7 +132,12 @@ class Problem:
                              for k in range(K)])
         self.Qv = ca.SX.sym("q", sym.nq, K)
         self.Q = self.Qv * ca.DM(self.qs) if sym.nq else self.Qv
-        # the checking path: the samples with REFINE poses in between, in order
+        self.make_path()
+        self._dense0 = None
+
+    def make_path(self):
+        """The checking path: the samples with REFINE poses in between, in order."""
+        K = self.K
         sub = max(2, math.ceil(REFINE / max(K - 1, 1))) if K > 1 else 1
         t = np.arange((K - 1) * sub + 1) / sub
         idx = np.minimum(np.floor(t).astype(int), K - 1)
@@ -139,7 +145,20 @@ class Problem:
         lerp = lambda A: A[idx] + (A[nxt] - A[idx]) * frac
         self.path = (lerp(self.U), lerp(self.Ud), lerp(self.Udd))
         self.at = np.arange(K) * sub
-        self._dense0 = None
+
+    def free_inputs(self, lo, hi, rows, scale, normal=None):
+        """Make the (single) input at every sample a variable u_k = scale * v_k with bounds
+        lo <= u_k <= hi (arrays) and extra constraints rows(u) -> [(SX, low, high)];
+        normal(U) gives the fitted inputs as reported (whole turns taken off)."""
+        if self.extremes:
+            raise ModelError("max()/min() cannot be combined with a curve (its inputs are fitted)")
+        self.Uv = self.ca.SX.sym("u", self.K)
+        self.us, self.ulo, self.uhi = scale, np.asarray(lo) / scale, np.asarray(hi) / scale
+        self.urows, self.unormal = rows(self.Uv * scale), normal
+
+    def u_at(self, k):
+        """The input at sample k: a number, or the variable when the inputs are fitted."""
+        return self.U[k] if self.Uv is None else self.Uv[k] * self.us
 
     def sign(self, q, u, p) -> float:
         """Sign of det(g_q) with columns scaled to O(1): it tells the assembly branch."""
@@ -171,7 +190,7 @@ class Problem:
         return ca.Function("e", [sym.q, sym.u, sym.p, self.ud, self.udd, self.ds], [E])
 
     def at_sample(self, F, k):
-        return F(self.Q[:, k], self.U[k], self.P, self.Ud[k], self.Udd[k], self.D[:, k])
+        return F(self.Q[:, k], self.u_at(k), self.P, self.Ud[k], self.Udd[k], self.D[:, k])
 
     def aggregate(self, f, kind, E, text):
         if f in ("sum", "mean"):
@@ -203,6 +222,8 @@ class Problem:
             return self.extremes[key]["value"]
         if sym.nu != 1:
             raise ModelError(f"{f}({text}): needs a mechanism driven by one input")
+        if self.Uv is not None:
+            raise ModelError(f"{f}({text}): max()/min() cannot be combined with a curve")
         if self._dense0 is None:
             self._dense0 = self.dense(self.m)
         d0, F = self._dense0, self.fn(E)
@@ -241,21 +262,30 @@ class Problem:
     def solve(self, f, rows, check_path, max_iter, tol) -> dict:
         ca, sym, K = self.ca, self.sym, self.K
         ext = list(self.extremes.values())
-        X = ca.vertcat(self.xp, ca.vec(self.Qv), *[v for e in ext for v in e["x"]])
+        free = self.Uv is not None
+        Uv = [self.Uv] if free else []
+        X = ca.vertcat(self.xp, ca.vec(self.Qv), *Uv, *[v for e in ext for v in e["x"]])
         lo = [b[0] / s for b, s in zip(self.vary.values(), self.pscale)]
         hi = [b[1] / s for b, s in zip(self.vary.values(), self.pscale)]
         x0 = np.r_[[self.m.parameter(p) / s for p, s in zip(self.vary, self.pscale)],
-                   (self.Q0 / self.qs).ravel(), *[e["x0"] for e in ext]]
-        lbx = np.r_[lo, np.full(sym.nq * K, -np.inf), *[e["lo"] for e in ext]]
-        ubx = np.r_[hi, np.full(sym.nq * K, np.inf), *[e["hi"] for e in ext]]
-        closure = [sym.f_res(self.Q[:, k], self.U[k], self.P) / self.L for k in range(K)]
+                   (self.Q0 / self.qs).ravel(), *([self.U[:, 0] / self.us] if free else []),
+                   *[e["x0"] for e in ext]]
+        lbx = np.r_[lo, np.full(sym.nq * K, -np.inf), *([self.ulo] if free else []),
+                    *[e["lo"] for e in ext]]
+        ubx = np.r_[hi, np.full(sym.nq * K, np.inf), *([self.uhi] if free else []),
+                    *[e["hi"] for e in ext]]
+        closure = [sym.f_res(self.Q[:, k], self.u_at(k), self.P) / self.L for k in range(K)]
         G = [*closure, *[e["rows"] for e in ext]]
         lbg = [np.zeros(g.numel()) for g in G]
         ubg = list(lbg)
+        for g, a, b in (self.urows if free else []):  # the fitted inputs' order
+            G.append(g)
+            lbg.append(np.full(g.numel(), a))
+            ubg.append(np.full(g.numel(), b))
         # The branch is kept at every sample: det(g_q) keeps the initial design's sign there
         # (a polynomial in q, so its derivatives are exact too; it also keeps the samples off
         # singular positions, where det(g_q) = 0).
-        poses = [(self.Q[:, k], self.U[k], self.ref[k]) for k in range(K)]
+        poses = [(self.Q[:, k], self.u_at(k), self.ref[k]) for k in range(K)]
         poses += [(e["x"][0] * ca.DM(self.qs), e["x"][1], e["sign"]) for e in ext]
         for q, u, sign in poses:
             if sign and sym.nq:
@@ -289,6 +319,12 @@ class Problem:
         mech = self.m.with_parameters(**varied)
         p = np.array([v for _, v in mech.parameters])
         Q = x[nv:nv + sym.nq * K].reshape(K, sym.nq) * self.qs
+        at = nv + sym.nq * K
+        if self.Uv is not None:  # fitted inputs: the checks and the report follow them
+            self.U = x[at:at + K, None] * self.us
+            self.U = self.U if self.unormal is None else self.unormal(self.U)
+            at += K
+            self.make_path()
         for k in range(K):  # polish, and judge by the residual and the branch
             sol = model.newton(Q[k], self.U[k], p, self.L)
             Q[k] = sol.q
@@ -298,7 +334,7 @@ class Problem:
             elif self.ref[k] and self.sign(sol.q, self.U[k], p) != self.ref[k]:
                 problems.append(f"sample {k + 1}: the optimised design is on another assembly "
                                 f"branch than the initial one")
-        xs, at = [x[:nv], (Q / self.qs).ravel()], nv + sym.nq * K
+        xs = [x[:nv], (Q / self.qs).ravel(), *([self.U[:, 0] / self.us] if self.Uv is not None else [])]
         for e in self.extremes.values():
             q, u = x[at:at + sym.nq] * self.qs, x[at + sym.nq]
             sol = model.newton(q, np.array([u]), p, self.L)
