@@ -33,6 +33,7 @@ so the rocker from D = (4, 0) is c = sqrt((sqrt(10) - 4)^2 + 2.5^2).)
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -160,20 +161,20 @@ def _once(m, samples, vary, minimize, constraints, data, rates, accelerations, d
     rows = [(c, prob.evaluate(e, c.expr)) for c, e in cons]
     r = OptimizeResult(**prob.solve(f, rows, check_path, max_iter, tol))
     if curve is not None:
-        r.info["distances"] = curve_distances(r.sweep, curve, prob.at)
+        r.info["curve"] = {"point": curve.point, "targets": curve.targets,
+                           "distances": curve_distances(r.sweep, curve, prob.at)}
     return r
 
 
 # --- scenes: the [optimize] section ---
 
-FIELDS = {"vary", "minimize", "constraints", "data", "samples", "check_path", "max_iter"}
+FIELDS = {"vary", "minimize", "constraints", "data", "samples", "check_path", "max_iter", "curve"}
+CURVE_FIELDS = {"point", "targets", "within", "order"}
 
 
 def read_section(sc) -> dict:
     """The scene's `[optimize]` section as keywords of optimize(); SceneError naming the
     field. Samples, data and bounds are in the scene's units (degrees where it says so)."""
-    import math
-
     from .errors import SceneError
 
     t = sc.study.raw.get("optimize")
@@ -182,7 +183,8 @@ def read_section(sc) -> dict:
                          "= [low, high] } and minimize = \"EXPRESSION\")")
     problems = [f"[optimize]: unknown field {k!r} (expected one of {sorted(FIELDS)})"
                 for k in t if k not in FIELDS]
-    problems += [f"[optimize] {k}: missing" for k in ("vary", "minimize") if k not in t]
+    needed = ("vary",) if "curve" in t else ("vary", "minimize")
+    problems += [f"[optimize] {k}: missing" for k in needed if k not in t]
     kw = {"vary": t.get("vary"), "minimize": t.get("minimize"), "data": t.get("data"),
           "constraints": t.get("constraints", []), "deg": sc.study.deg}
     if not isinstance(kw["constraints"], list) or not all(isinstance(c, dict) for c in kw["constraints"]):
@@ -216,10 +218,54 @@ def read_section(sc) -> dict:
             else:
                 problems.append("[optimize] samples: expected { from = a, to = b, steps = n } "
                                 "or a list of input values")
+    if "curve" in t:
+        if "samples" in t:
+            problems.append("[optimize] samples: not with curve (the inputs at the targets "
+                            "are fitted; give the curve's range as within = [low, high])")
+        samples = _read_curve(sc, t["curve"], problems)
     if problems:
         raise SceneError(problems)
     kw["samples"] = samples
     return kw
+
+
+def _read_curve(sc, c, problems):
+    """[optimize.curve] as a Curve (None and problems appended when it is wrong)."""
+    from .curve import Curve
+
+    if not isinstance(c, dict):
+        problems.append("[optimize] curve: expected a table { point = \"P\", targets = "
+                        "[[x, y], ...] } (or an [optimize.curve] section)")
+        return None
+    bad = [f"[optimize] curve: unknown field {k!r} (expected one of {sorted(CURVE_FIELDS)})"
+           for k in c if k not in CURVE_FIELDS]
+    bad += [f"[optimize] curve: {k}: missing" for k in ("point", "targets") if k not in c]
+    m = sc.mechanism
+    if len(m.inputs) != 1:
+        bad.append("[optimize] curve: only for a mechanism with one input")
+    if not isinstance(c.get("point", ""), str):
+        bad.append(f"[optimize] curve: point: expected a point's name, got {c['point']!r}")
+    if bad:
+        problems += bad
+        return None
+    inp = m.inputs[0]
+    k = math.pi / 180 if inp.is_angle and sc.study.deg else 1.0
+    within = c.get("within")
+    if within is None:  # default: the range swept by the scene's [[inputs]]
+        u = np.asarray(sc.study.inputs[inp.key], dtype=float)
+        within = (float(u.min()), float(u.max())) if u.max() > u.min() else None
+        if within is None and not inp.is_angle:
+            problems.append(f"[optimize] curve: within: missing (the [[inputs]] of {inp.key} "
+                            f"do not sweep a range)")
+            return None
+    elif isinstance(within, list) and len(within) == 2 and all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) for x in within):
+        within = (within[0] * k, within[1] * k)
+    try:
+        return Curve(c["point"], c["targets"], within=within, order=c.get("order", "auto"))
+    except ModelError as e:
+        problems += [f"[optimize] {p}" for p in e.problems]
+        return None
 
 
 def run_scene(sc) -> OptimizeResult:
@@ -263,8 +309,6 @@ def cli_run(args) -> int:
 
 def report(sc, r: OptimizeResult) -> dict:
     """The result as the JSON object of `kincas optimize --json`, in the scene's units."""
-    import math
-
     from .cli import _list
     from .symbolic import is_angular
 
@@ -273,6 +317,12 @@ def report(sc, r: OptimizeResult) -> dict:
     bounds = sc.study.raw["optimize"]["vary"]
     key = sc.mechanism.inputs[0].key
     num = lambda v: float(v) if math.isfinite(v) else None
+    curve = {}
+    if "curve" in r.info:  # the fitted input at each target and the distance left there
+        c = r.info["curve"]
+        curve = {"curve": {"point": c["point"], "targets": c["targets"].tolist(),
+                           "inputs": {key: _list(user(key, r.samples[key]))},
+                           "distances": _list(c["distances"])}}
     return {
         "title": sc.study.title, "units": sc.study.units, "ok": r.ok, "converged": r.converged,
         "status": r.status, "message": r.message, "problems": r.problems,
@@ -287,6 +337,7 @@ def report(sc, r: OptimizeResult) -> dict:
                          "value": _list(np.atleast_1d(c["value"]))} for c in r.constraints],
         "extremes": [{"kind": e["kind"], "expr": e["expr"], "value": num(e["value"]),
                       "input": {key: num(float(user(key, e["input"])))}} for e in r.extremes],
+        **curve,
     }
 
 
@@ -311,6 +362,13 @@ def _print(sc, r: OptimizeResult, doc: dict):
     for e in doc["extremes"]:
         (k, u), = e["input"].items()
         print(f"{e['kind']}({e['expr']}) = {e['value']:.8g} at {k} = {u:.6g}")
+    if "curve" in doc:
+        c = doc["curve"]
+        (k, u), = c["inputs"].items()
+        print(f"{'target x':>12}  {'target y':>12}  {k + ' (fitted)':>20}  {'distance':>12}")
+        for (x, y), ui, d in zip(c["targets"], u, c["distances"]):
+            shown = lambda v, f: format(v, f) if v is not None else "-"
+            print(f"{x:>12.6g}  {y:>12.6g}  {shown(ui, '>20.8g')}  {shown(d, '>12.4g')}")
     print("\n[parameters]   # the optimised design" + ("" if r.ok else " (NOT optimal, see above)"))
     for p, v in r.parameters.items():
         print(f"{p} = {v:.12g}")
