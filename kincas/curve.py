@@ -53,11 +53,14 @@ class Curve:
     order: str = "auto"
 
     def __post_init__(self):
-        t = np.asarray(self.targets, dtype=float) if _pairs(self.targets) else None
-        if t is None or len(t) < 1 or not np.all(np.isfinite(t)):
-            raise ModelError(f"curve: targets: expected a list of [x, y] pairs of finite "
-                             f"numbers, got {self.targets!r}")
-        self.targets = t
+        t = self.targets
+        if not isinstance(t, (list, tuple, np.ndarray)) or not len(t):
+            raise ModelError(f"curve: targets: expected a list of [x, y] pairs, got {t!r}")
+        for i, xy in enumerate(t):
+            if not _pair(xy):
+                raise ModelError(f"curve: targets[{i + 1}]: expected [x, y] (finite numbers), "
+                                 f"got {xy!r}")
+        self.targets = np.asarray(t, dtype=float)
         if self.order not in ORDERS:
             raise ModelError(f"curve: order: expected one of {', '.join(ORDERS)}, got {self.order!r}")
         if self.within is not None:
@@ -69,11 +72,10 @@ class Curve:
             self.within = (float(w[0]), float(w[1]))
 
 
-def _pairs(v) -> bool:
-    return isinstance(v, (list, tuple, np.ndarray)) and all(
-        isinstance(p, (list, tuple, np.ndarray)) and len(p) == 2 and all(
-            isinstance(x, (int, float, np.floating, np.integer)) and not isinstance(x, bool)
-            for x in p) for p in v)
+def _pair(p) -> bool:
+    return isinstance(p, (list, tuple, np.ndarray)) and len(p) == 2 and all(
+        isinstance(x, (int, float, np.floating, np.integer)) and not isinstance(x, bool)
+        and math.isfinite(x) for x in p)
 
 
 # --- the start: the targets projected onto the initial design's coupler curve ---

@@ -147,6 +147,12 @@ def _once(m, samples, vary, minimize, constraints, data, rates, accelerations, d
         raise ModelError("minimize: missing (an expression; optional only with a curve)")
     objective = None if minimize is None else prob.parse(minimize, "minimize")
     cons = [prob.parse_constraint(_as_constraint(c, i), i) for i, c in enumerate(constraints)]
+    named = ([("minimize", objective)] if objective else []) + [
+        (f"constraints[{i + 1}]", e) for i, (_, e) in enumerate(cons)]
+    for where, e in named if curve is not None else ():
+        if e.extremes:
+            raise ModelError(f"{where}: max()/min() over the input's range cannot be combined "
+                             f"with a curve (its inputs are fitted)")
     if curve is None:
         sw0 = sweep(m, samples, rates=rates, accelerations=accelerations, report=[])
         prob.set_samples(sw0, sweep)
@@ -260,6 +266,10 @@ def _read_curve(sc, c, problems):
             return None
     elif isinstance(within, list) and len(within) == 2 and all(
             isinstance(x, (int, float)) and not isinstance(x, bool) for x in within):
+        if not within[0] < within[1]:
+            problems.append(f"[optimize] curve: within: expected [low, high] with low < high, "
+                            f"got {within!r}")
+            return None
         within = (within[0] * k, within[1] * k)
     try:
         return Curve(c["point"], c["targets"], within=within, order=c.get("order", "auto"))

@@ -21,7 +21,7 @@ import kincas
 from kincas import Input, Link, Mechanism, ModelError, Slide
 from kincas.cli import main
 from kincas.expressions import parse
-from kincas.optimize import Constraint, optimize, run_scene
+from kincas.optimize import Constraint, Curve, optimize, run_scene
 from kincas.scene import load, loads
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -351,6 +351,115 @@ def test_bad_sections_are_scene_errors(capsys, tmp_path, change, words):
     assert change[0] in text
     path = tmp_path / "bad.toml"
     path.write_text(text.replace(change[0], change[1]), encoding="utf-8")
+    code, out, err = run(capsys, path)
+    assert code == 2 and "Traceback" not in err
+    for w in words:
+        assert w in err, err
+
+
+# --- path synthesis without timing: a curve whose inputs are fitted ---
+
+
+def nearest_on_curve(targets, **dims):
+    """Distance from each target to the closed-form coupler curve, on a fine grid of the
+    whole turn (NaN where that four-bar does not assemble)."""
+    th = np.linspace(0.0, 2 * np.pi, 200001)
+    with np.errstate(invalid="ignore"):
+        x, y = coupler_point(th, **dims)
+    d2 = (targets[:, None, 0] - x) ** 2 + (targets[:, None, 1] - y) ** 2
+    return np.sqrt(np.nanmin(d2, axis=1))
+
+
+def test_curve_targets_without_timing_are_reached_exactly():
+    ref = dict(r1=120.0, r2=25.0, r3=100.0, r4=90.0, px=40.0, py=40.0)
+    # irregular inputs, starting in mid-turn; the optimiser is not told them
+    hidden = np.radians([200.0, 214, 239, 263, 280, 307, 331, 352, 371, 384, 418, 457, 491, 520])
+    tx, ty = coupler_point(hidden, **ref)
+    start = coupler_fourbar(r1=110, r2=35, r3=80, r4=95, px=20, py=60)  # perturbed design
+    r = optimize(start, Curve("P", np.c_[tx, ty]), vary=PATH_VARY)
+    assert r.ok and r.converged and r.problems == []
+    assert r.objective < 1e-14 and r.initial_objective > 1000
+    u = r.samples["crank.angle"]
+    assert np.all(np.diff(u) >= 0) and u[-1] - u[0] <= 2 * np.pi  # in order, within a turn
+    # through every target: the closed form at the fitted inputs and the fitted dimensions
+    x, y = coupler_point(u, **r.varied)
+    assert np.abs(x - tx).max() < 1e-7 and np.abs(y - ty).max() < 1e-7
+    assert np.abs(r.info["curve"]["distances"]).max() < 1e-7
+    # and kincas.sweep of the optimised mechanism through the fitted inputs
+    sw = kincas.sweep(r.mechanism, {"crank.angle": u}, report=["P.x", "P.y"])
+    assert all(s == "ok" for s in sw.status)
+    assert np.abs(sw["P.x"] - tx).max() < 1e-7 and np.abs(sw["P.y"] - ty).max() < 1e-7
+    # the four-bar whose curve it is, and the inputs at which it passes (modulo a turn)
+    for k, v in ref.items():
+        assert r.varied[k] == pytest.approx(v, rel=1e-6), k
+    assert np.abs(np.angle(np.exp(1j * (u - hidden)))).max() < 1e-6
+
+
+def test_curve_in_the_other_direction_is_fitted_decreasing():
+    ref = dict(r1=120.0, r2=25.0, r3=100.0, r4=90.0, px=40.0, py=40.0)
+    hidden = np.radians([100.0, 70, 52, 20, -10, -45, -90, -120, -170])  # crank runs backwards
+    tx, ty = coupler_point(hidden, **ref)
+    r = optimize(coupler_fourbar(), Curve("P", np.c_[tx, ty]), vary=PATH_VARY)
+    assert r.ok and r.objective < 1e-14
+    u = r.samples["crank.angle"]
+    assert np.all(np.diff(u) <= 0)
+    x, y = coupler_point(u, **r.varied)
+    assert np.hypot(x - tx, y - ty).max() < 1e-7
+
+
+def test_unreachable_curve_leaves_a_positive_objective():
+    # |P| <= r2 + hypot(px, py) <= 40 + hypot(60, 60): a circle around (0, 160) is out of
+    # reach, so the objective is at least sum (|T_i| - reach)^2 for any design in the bounds
+    vary = {"r1": (40, 200), "r2": (10, 40), "r3": (30, 200), "r4": (30, 200),
+            "px": (-60, 60), "py": (-60, 60)}
+    a = np.radians(np.arange(0.0, 360.0, 30.0))
+    T = np.c_[20 * np.cos(a), 160 + 20 * np.sin(a)]
+    r = optimize(coupler_fourbar(), Curve("P", T, order="free"), vary=vary)
+    assert r.ok and r.converged
+    bound = np.sum((np.hypot(T[:, 0], T[:, 1]) - (40 + math.hypot(60, 60))) ** 2)
+    assert r.objective > bound > 1000
+    # the objective is what the closed form gives at the fitted inputs ...
+    u = r.samples["crank.angle"]
+    x, y = coupler_point(u, **r.varied)
+    d = np.hypot(x - T[:, 0], y - T[:, 1])
+    assert np.sum(d * d) == pytest.approx(r.objective, rel=1e-10)
+    assert np.allclose(r.info["curve"]["distances"], d, rtol=1e-9)
+    # ... and each fitted input is the nearest point of the optimised curve to its target
+    assert np.abs(d - nearest_on_curve(T, **r.varied)).max() < 1e-6
+
+
+def test_curve_example_fits_the_nearest_curve(capsys):
+    code, doc, _ = run(capsys, EXAMPLES / "synthesis_curve.toml", "--json")
+    assert code == 0 and doc["ok"]
+    T = np.array(doc["curve"]["targets"])
+    u = np.radians(doc["curve"]["inputs"]["crank.angle"])  # reported in degrees
+    x, y = coupler_point(u, **doc["varied"])
+    d = np.hypot(x - T[:, 0], y - T[:, 1])
+    assert np.sum(d * d) == pytest.approx(doc["objective"], rel=1e-9)
+    assert np.allclose(doc["curve"]["distances"], d, rtol=1e-8)
+    assert 1 < doc["objective"] < doc["initial_objective"]
+    # nearest: no point of the optimised coupler curve is closer to any target
+    assert np.abs(d - nearest_on_curve(T, **doc["varied"])).max() < 1e-5
+    code, out, _ = run(capsys, EXAMPLES / "synthesis_curve.toml")
+    assert code == 0 and "crank.angle (fitted)" in out and "[parameters]" in out
+
+
+@pytest.mark.parametrize("change, words", [
+    (('point = "P"', 'point = "Z"'), ["[optimize] curve: point", "'Z'"]),
+    (('point = "P"', ''), ["[optimize] curve: point: missing"]),
+    (('[[20.0, 40.0],', '[[20.0, 40.0, 1],'), ["[optimize] curve: targets[1]", "[20.0, 40.0, 1]"]),
+    (('order = "auto"', 'order = "sideways"'), ["[optimize] curve: order", "sideways"]),
+    (('order = "auto"', 'order = "auto"\nwithin = [360, 0]'), ["[optimize] curve: within", "[360, 0]"]),
+    (('order = "auto"', 'order = "auto"\ncolour = 1'), ["[optimize] curve", "colour"]),
+    (('[optimize.curve]', 'samples = [0, 90]\n\n[optimize.curve]'), ["[optimize] samples: not with curve"]),
+    (('[optimize.curve]', 'minimize = "max(P.x)"\n\n[optimize.curve]'), ["[optimize] minimize: max()/min()", "curve"]),
+    (('[optimize.curve]', 'data = { t = [1, 2] }\n\n[optimize.curve]'), ["[optimize] data: t: 2 values for 12 samples"]),
+])
+def test_bad_curve_sections_are_scene_errors(capsys, tmp_path, change, words):
+    text = (EXAMPLES / "synthesis_curve.toml").read_text(encoding="utf-8")
+    assert change[0] in text
+    path = tmp_path / "bad.toml"
+    path.write_text(text.replace(change[0], change[1], 1), encoding="utf-8")
     code, out, err = run(capsys, path)
     assert code == 2 and "Traceback" not in err
     for w in words:
