@@ -43,7 +43,8 @@ from .errors import ModelError
 from .results import Sweep
 from .curve import Curve, constrain as curve_constrain, distances as curve_distances
 from .curve import objective as curve_objective, start as curve_start
-from .simultaneous import EXTREME_MOVED, Problem
+from .checks import EXTREME_MOVED
+from .simultaneous import Problem
 
 MAX_ROUNDS = 3  # IPOPT runs when extremes moved away from where they were tracked
 

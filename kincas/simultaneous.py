@@ -18,18 +18,17 @@ import numpy as np
 from .errors import ModelError
 from .expressions import CONST, SAMPLE, Evaluator, parse
 from .model import Mechanism
+from .checks import Checks, _short
 from .results import Sweep, wrap_angle
 
 REFINE = 400  # poses of the checking sweep between the first and the last sample, at least
-SAME_POSE = 1e-7  # relative: a pose reached by the checking sweep equals the optimised one
 CON_TOL = 1e-6  # relative violation allowed of a constraint after polishing
-EXTREME_MOVED = "the checking sweep reaches"  # the words of that problem, for a new round
 
 
 # --- the problem: parsing, the NLP, the checks ---
 
 
-class Problem:
+class Problem(Checks):
     """One optimisation: parses the expressions, builds the NLP, runs IPOPT, checks."""
 
     def __init__(self, m: Mechanism, model, vary, data, deg):
@@ -374,63 +373,7 @@ class Problem:
             values=values, constraints=cons, extremes=extremes,
             iterations=int(stats.get("iter_count", 0)), problems=problems, sweep=sw)
 
-    def check_path(self, mech, Q, p, problems, check_path):
-        """Sweep the optimised design from the first sample through the others: it must reach
-        each optimised pose without leaving its branch and assemble on the way."""
-        if check_path or self.extremes:
-            sw, at = self.dense(mech), self.at
-        else:
-            sw = self.sweep_fn(mech, {k: self.U[:, j] for j, k in enumerate(self.keys)},
-                               rates={k: self.Ud[:, j] for j, k in enumerate(self.keys)},
-                               accelerations={k: self.Udd[:, j] for j, k in enumerate(self.keys)},
-                               report=list(self.used))
-            at = np.arange(self.K)
-        angle = ~self.sym.is_length
-        for k in range(self.K):
-            if not check_path and not sw.ok[at[k]]:
-                continue  # reported by the polishing already
-            lost = np.flatnonzero(~sw.ok[at[k - 1] if k else 0:at[k] + 1])
-            if len(lost):
-                u = self.path[0][(at[k - 1] if k else 0) + lost[0]]
-                problems.append(f"the optimised design does not assemble on the way to sample "
-                                f"{k + 1} (at input {_short(u)})")
-                break
-            d = sw.q[at[k]] - Q[k]
-            d[angle] = wrap_angle(d[angle])
-            if np.any(np.abs(d) > SAME_POSE * self.qs):
-                problems.append(f"sample {k + 1}: driven from sample {max(k, 1)}, the optimised "
-                                f"design arrives in another assembly (a branch defect)")
-                break
-        values = {n: sw[n][at] for n in self.used}
-        return sw, values
-
-    def check_extremes(self, sw, p, problems):
-        """Each tracked max()/min() must be the extreme of the checking sweep as well."""
-        out, (U, Ud, Udd) = [], self.path
-        ok, zero = np.flatnonzero(sw.ok), np.zeros(len(self.data))
-        for e in self.extremes.values():
-            F, fn = e["F"], e["fn"]
-            value = float(F(e["q"], e["u"], p, e["rate"][0], e["rate"][1], zero))
-            u = e["u"] if e["start"] is None else e["start"] + (e["u"] - e["start"]) % (2 * math.pi)
-            out.append({"kind": fn, "expr": e["text"], "input": float(u), "value": value})
-            if not len(ok):
-                continue
-            v = np.asarray(F.map(len(ok))(sw.q[ok].T, U[ok].T, np.repeat(p[:, None], len(ok), 1),
-                                          Ud[ok].T, Udd[ok].T, np.zeros((len(zero), len(ok))))).ravel()
-            j = int(np.argmax(v) if fn == "max" else np.argmin(v))
-            slack = 1e-6 * max(float(np.ptp(v)), abs(value), 1e-300)
-            if (v[j] > value + slack) if fn == "max" else (v[j] < value - slack):
-                problems.append(f"{fn}({e['text']}): the optimiser tracked {value:.6g} at input "
-                                f"{e['u']:.6g}, but {EXTREME_MOVED} {v[j]:.6g} at "
-                                f"input {U[ok[j], 0]:.6g}")
-        return out
-
 
 def _numbers(v) -> bool:
     return isinstance(v, (list, tuple, np.ndarray)) and all(
         isinstance(x, (int, float, np.floating, np.integer)) and not isinstance(x, bool) for x in v)
-
-
-def _short(v) -> str:
-    v = np.atleast_1d(np.asarray(v, float))
-    return ", ".join(f"{x:.6g}" for x in v[:4]) + (", ..." if len(v) > 4 else "")
