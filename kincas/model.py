@@ -398,11 +398,8 @@ def _check(m: Mechanism) -> list[str]:
 
 
 def _check_mobility(m: Mechanism) -> tuple[list[str], int]:
-    """(problems, number of redundant equations). Counting decides, except where it gives
-    fewer freedoms than inputs: a redundant joint (a third parallel link in a parallelogram)
-    removes a freedom from the count but not from the chain, so there the rank of the
-    constraint Jacobian at an assembly decides (kincas/redundant.py, numeric: imported only
-    then, so that declaring an ordinary mechanism never needs casadi)."""
+    """(problems, redundant equations). Where counting gives fewer freedoms than inputs, a
+    redundant joint may hide one: the Jacobian's rank decides (kincas/redundant.py)."""
     st = m.structure
     n_param = sum(inp.kind == "parameter" for inp in m.inputs)
     dof = st.mobility + n_param
