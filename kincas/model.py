@@ -225,6 +225,7 @@ class Mechanism:
     inputs: tuple[Input, ...] = ()
     guess: tuple[tuple[str, tuple[Num, Num]], ...] = ()
     structure: Structure = field(init=False, repr=False, compare=False)
+    redundant: int = field(init=False, repr=False, compare=False, default=0)
 
     def __post_init__(self):
         def items(v):
@@ -240,9 +241,10 @@ class Mechanism:
             raise ModelError(problems)
         object.__setattr__(self, "structure",
                            _structure([g for g, _ in self.ground], self.links, len(self.slides)))
-        problems = _check_mobility(self)
+        problems, redundant = _check_mobility(self)
         if problems:
             raise ModelError(problems)
+        object.__setattr__(self, "redundant", redundant)  # equations implied by the others
 
     # --- lookups ---
     @property
@@ -395,17 +397,25 @@ def _check(m: Mechanism) -> list[str]:
     return out
 
 
-def _check_mobility(m: Mechanism) -> list[str]:
+def _check_mobility(m: Mechanism) -> tuple[list[str], int]:
+    """(problems, redundant equations). Where counting gives fewer freedoms than inputs, a
+    redundant joint may hide one: the Jacobian's rank decides (kincas/redundant.py)."""
     st = m.structure
     n_param = sum(inp.kind == "parameter" for inp in m.inputs)
     dof = st.mobility + n_param
     if dof == len(m.inputs) and st.mobility >= 0:
-        return []
+        return [], 0
     detail = (f"{st.n_unknowns} unknown coordinates, {st.n_equations} equations"
               + (f", plus {n_param} driven parameter(s)" if n_param else ""))
     hint = ""
-    if dof < len(m.inputs):  # fewer freedoms than expected: often a redundant constraint
-        hint = ("; kincas counts every joint as independent, so a redundant one (a third "
-                "parallel link in a parallelogram) removes a freedom: leave it out")
+    if dof < len(m.inputs):  # fewer freedoms than expected: perhaps a redundant constraint
+        from .redundant import rank_test
+        free, redundant, ok = rank_test(m)
+        if ok:
+            return [], redundant
+        hint = ("; a redundant joint would add freedoms to this count, but "
+                + ("no assembly was found near the guess to test for one" if free is None else
+                   f"the constraint Jacobian at an assembly near the guess gives it "
+                   f"{free + n_param} degree(s) of freedom"))
     return [f"[inputs]: the mechanism has {dof} degree(s) of freedom ({detail}) "
-            f"but {len(m.inputs)} input(s) drive it; give one input per degree of freedom{hint}"]
+            f"but {len(m.inputs)} input(s) drive it; give one input per degree of freedom{hint}"], 0

@@ -77,6 +77,16 @@ class _Call:
         return self.out
 
 
+def _lsolve(J, b):
+    """J^-1 b; least squares where J is tall (redundant joints) or singular."""
+    if J.shape[0] == J.shape[1]:
+        try:
+            return np.linalg.solve(J, b)
+        except np.linalg.LinAlgError:
+            pass
+    return np.linalg.lstsq(J, b, rcond=None)[0]
+
+
 @dataclass
 class Solution:
     q: np.ndarray
@@ -91,7 +101,8 @@ class Model:
 
     def __init__(self, sym: Symbolic):
         self.sym = sym
-        self.nq, self.nu = sym.nq, sym.nu
+        self.nq, self.nu, self.ng = sym.nq, sym.nu, sym.ng
+        self.square = self.ng == self.nq  # tall: redundant joints (a consistent system)
         m = sym.mech
         locs = [sym.val(c) for lk in m.links for _, xy in lk.points for c in xy]
         self.f_local = ca.Function("local", [sym.u, sym.p], [ca.vertcat(*locs)])
@@ -112,7 +123,11 @@ class Model:
         return g.ravel().copy(), J.copy()
 
     def newton(self, q, u, p, L, max_iter=40) -> Solution:
-        """Damped Newton on g(q) = 0 with the exact Jacobian; the residual is relative to L."""
+        """Damped Newton on g(q) = 0 with the exact Jacobian; the residual is relative to L.
+
+        With redundant joints g_q is tall: the step is Gauss-Newton's, the least-squares
+        solution of g_q dq = -g, which converges quadratically on a consistent system
+        (the residual at the solution is zero) where g_q has full column rank."""
         q = np.array(q, dtype=float)
         g, J = self.resjac(q, u, p)
         r = np.abs(g).max(initial=0.0) / L
@@ -120,10 +135,7 @@ class Model:
         for it in range(max_iter):
             if r <= TOL:
                 return Solution(q, r, it, True, J)
-            try:
-                dq = np.linalg.solve(J, -g)
-            except np.linalg.LinAlgError:
-                dq = np.linalg.lstsq(J, -g, rcond=None)[0]
+            dq = _lsolve(J, -g)
             if not np.all(np.isfinite(dq)):
                 break
             dq /= max(1.0, np.abs(dq / scale).max())  # a trust region keeps steps on the branch
@@ -141,25 +153,23 @@ class Model:
         return Solution(q, r, max_iter, r <= ACCEPT, J)
 
     def tangent(self, q, u, p) -> np.ndarray:
-        """dq/du (nq x nu) at a solved pose, from the implicit function theorem."""
+        """dq/du (nq x nu) at a solved pose, from the implicit function theorem:
+        -g_q^-1 g_u, or -pinv(g_q) g_u for a tall consistent g_q (redundant joints)."""
         _, J, Ju = self._tangent(q, u, p)
-        try:
-            return np.linalg.solve(J, -Ju)
-        except np.linalg.LinAlgError:
-            return np.linalg.lstsq(J, -Ju, rcond=None)[0]
+        return _lsolve(J, -Ju)
 
     def jac(self, q, u, p) -> np.ndarray:
         return self._resjac(q, u, p)[1].copy()
 
     def jacobians_at(self, Q, U, p):
-        """g_q (N, nq, nq) and g_u (N, nq, nu) at N poses in one mapped call."""
-        n = Q.shape[0]
+        """g_q (N, ng, nq) and g_u (N, ng, nu) at N poses in one mapped call."""
+        n, ng = Q.shape[0], self.ng
         if n == 0:
-            return np.zeros((0, self.nq, self.nq)), np.zeros((0, self.nq, self.nu))
+            return np.zeros((0, ng, self.nq)), np.zeros((0, ng, self.nu))
         f = self.sym.f_tangent.map(n)
         _, J, Ju = f(Q.T, U.T, np.repeat(np.reshape(p, (-1, 1)), n, axis=1))
-        J = np.asarray(ca.densify(J)).reshape(self.nq, n, self.nq).transpose(1, 0, 2)
-        Ju = np.asarray(ca.densify(Ju)).reshape(self.nq, n, self.nu).transpose(1, 0, 2)
+        J = np.asarray(ca.densify(J)).reshape(ng, n, self.nq).transpose(1, 0, 2)
+        Ju = np.asarray(ca.densify(Ju)).reshape(ng, n, self.nu).transpose(1, 0, 2)
         return J, Ju
 
     def points(self, q, u, p) -> np.ndarray:

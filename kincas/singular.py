@@ -64,7 +64,7 @@ def classify(J: np.ndarray, Gu: np.ndarray, tol: float = FLAG_SIGMA) -> str | No
         return None
     G = np.hstack([J, Gu])
     sg = np.linalg.svd(G, compute_uv=False)
-    if sg[J.shape[0] - 1] <= tol * max(sg[0], 1.0) * 1e3:
+    if sg[J.shape[1] - 1] <= tol * max(sg[0], 1.0) * 1e3:  # rank [J Gu] < nq
         return "change point"
     return "limit" if Gu.shape[1] == 1 else "singular"
 
@@ -104,19 +104,19 @@ def locate_singular(model, q, u, p, L, direction, max_iter: int = 40):
     for _ in range(max_iter):
         F, JF = (np.asarray(a) for a in f(q, u0 + s * d, p, v, v0))
         F = F.ravel()
-        r = np.abs(F[:2 * nq]).max() / L + abs(F[-1])
+        r = np.abs(F[:-1]).max() / L + abs(F[-1])
         if r < 1e-14:
             break
         A = np.hstack([JF[:, :nq], JF[:, nq:-nq] @ d[:, None], JF[:, -nq:]])
-        try:
-            step = np.linalg.solve(A, -F)
+        try:  # Gauss-Newton where g_q is tall (redundant joints: a consistent system)
+            step = np.linalg.solve(A, -F) if A.shape[0] == A.shape[1] else np.linalg.lstsq(A, -F, rcond=None)[0]
         except np.linalg.LinAlgError:
             return None
         if not np.all(np.isfinite(step)):
             return None
         q, s, v = q + step[:nq], s + step[nq], v + step[nq + 1:]
     F = np.asarray(f(q, u0 + s * d, p, v, v0)[0]).ravel()
-    if np.abs(F[:2 * nq]).max() / L > 1e-11:
+    if np.abs(F[:-1]).max() / L > 1e-11:
         return None
     return q, u0 + s * d, s
 

@@ -119,7 +119,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 
     # The fast pass (compiled, checked pose by pose) solves what it can; every pose it does
     # not accept goes to the careful path above, and the fast pass restarts after it.
-    fast = sweeper_for(model, tuple(report), compile) if method == "fast" else None
+    # (a tall system, with redundant joints, has no compiled pass: its g_q is not square)
+    fast = sweeper_for(model, tuple(report), compile) if method == "fast" and model.square else None
     if fast is not None and (compile is False or fast.worth_it(n)):
         run = fast.sweep(U, p, L, careful, Ud=Ud, Udd=Udd, progress=progress, jacobians=True)
     elif method in ("fast", "careful"):  # "fast" for a kernel too large to pay for itself
@@ -147,15 +148,15 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 class _CarefulRun:
     """The arrays of a sweep solved on the careful path alone (as `FastRun` has them)."""
 
-    def __init__(self, n, nq, nr):
+    def __init__(self, n, nq, nr, ng):
         self.Q, self.solved = np.full((n, nq), np.nan), np.zeros(n, dtype=bool)
         self.residual, self.iterations = np.full(n, np.nan), np.zeros(n, dtype=int)
-        self.values, self.jacobian = np.full((nr, n), np.nan), np.full((n, nq, nq), np.nan)
+        self.values, self.jacobian = np.full((nr, n), np.nan), np.full((n, ng, nq), np.nan)
 
 
 def _careful_only(model, report, U, Ud, Udd, p, careful, progress) -> _CarefulRun:
     n = U.shape[0]
-    run, j = _CarefulRun(n, model.nq, len(report)), None
+    run, j = _CarefulRun(n, model.nq, len(report), model.ng), None
     for k in range(n):
         if progress is not None and k % 256 == 0:
             progress(k, n)
@@ -255,7 +256,8 @@ def _ill(model: Model, J, L) -> bool:
     # The 1-norm condition number (an LU and an inverse) is within a factor n of the 2-norm
     # one, and several times cheaper than singular values for large mechanisms.
     with np.errstate(all="ignore"):
-        c = np.linalg.cond(J * np.where(model.sym.is_length, 1.0, 1.0 / L), 1)
+        # (2-norm, from singular values, for a tall g_q: redundant joints)
+        c = np.linalg.cond(J * np.where(model.sym.is_length, 1.0, 1.0 / L), 1 if model.square else None)
     return not c < 1e2 * max(1.0, np.sqrt(J.shape[0]))
 
 
@@ -278,13 +280,29 @@ def _scaled_det(model: Model, J, L) -> float:
 
 
 def _det_sign(model: Model, sol: Solution, L) -> int:
+    """The sign of det(g_q), which tells the assembly branches apart; 0 near a singular
+    position, and for a tall g_q (redundant joints), which has no determinant."""
+    if not model.square:
+        return 0
     d = _scaled_det(model, sol.J, L)
     return 0 if abs(d) < 1e-8 else int(np.sign(d))
 
 
 def _same_branch(model: Model, J0, sol: Solution, L) -> bool:
-    d0 = _scaled_det(model, J0, L)
-    d1 = _scaled_det(model, sol.J, L)
+    """Whether det(g_q) kept its sign from J0 to sol.J (or either is nearly singular).
+
+    A tall g_q (redundant joints) has no determinant, but a relative invariant serves:
+    with J0 = Q0 R0 (Q0 an orthonormal basis of J0's column space), det(Q0' J) is
+    continuous in J and equals det R0 at J0, so it changes sign only where Q0' J is
+    singular: det(Q0' J1) and det(R0) of opposite signs mean a singular position was
+    crossed, exactly as det g_q's sign change does for a square system (for which
+    this is the same test: Q0 is square and orthogonal)."""
+    c = np.where(model.sym.is_length, 1.0, 1.0 / L)
+    if model.square:
+        d0, d1 = _scaled_det(model, J0, L), _scaled_det(model, sol.J, L)
+    else:
+        Q0, R0 = np.linalg.qr(J0 * c)
+        d0, d1 = float(np.prod(np.diag(R0))), float(np.linalg.det(Q0.T @ (sol.J * c)))
     return np.sign(d0) == np.sign(d1) or min(abs(d0), abs(d1)) < 1e-8
 
 
@@ -311,7 +329,19 @@ def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, J=None) 
     cq, cu = _scales(model, L)
     J = J * cq
     dets = np.zeros(n)
-    dets[idx] = np.linalg.det(J) if len(idx) else []
+    if model.square:
+        dets[idx] = np.linalg.det(J) if len(idx) else []
+    elif len(idx):  # tall (redundant joints): no determinant, so chain the relative test of
+        # _same_branch along the sweep: the orientation flips from pose k to the next where
+        # det(Q_k' J_next) and det R_k differ in sign (J_k = Q_k R_k).
+        Qk, Rk = np.linalg.qr(J)
+        dR = np.prod(np.diagonal(Rk, axis1=1, axis2=2), axis=1)
+        o = 1.0
+        for a in range(len(idx)):
+            dets[idx[a]] = o * abs(dR[a])
+            if a + 1 < len(idx):
+                flip = np.sign(dR[a]) * np.sign(np.linalg.det(Qk[a].T @ J[a + 1]))
+                o = o * flip if flip != 0 else o
     sv = np.linalg.svd(J, compute_uv=False) if len(idx) else np.zeros((0, model.nq))
     for j in np.flatnonzero(sv[:, -1] <= FLAG_SIGMA * np.maximum(sv[:, 0], 1.0)):
         Gu = Ju[j] * cu if Ju is not None else scaled_jacobians(model, Q[idx[j]], U[idx[j]], p, L)[1]

@@ -3,7 +3,11 @@
 Unknowns q: the angle of every link that hangs on a point of what is already placed, and
 (x, y, angle) of a link that floats; a link driven by an angle input takes the input instead
 of an unknown. Inputs u: one per `Input` (a driven parameter is replaced by its input).
-Parameters p: every named parameter. The residual g(q, u, p) = 0 is square.
+Parameters p: every named parameter. The residual g(q, u, p) = 0 is square, or tall when
+the mechanism has redundant joints (`Mechanism.redundant` equations implied by the others,
+kincas/redundant.py): then g_q has full column rank at a regular pose and the system is
+consistent, so each linear solve below is done by its normal equations,
+g_q' g_q x = g_q' b, which give the exact solution of a consistent g_q x = b.
 
 Time derivatives come from the exact Jacobians. With z = (q, u):
     g_q q' = -g_u u'                                   (velocities)
@@ -126,8 +130,9 @@ class Symbolic:
         self.q = ca.vertcat(*qs) if qs else ca.SX(0, 1)
         self.nq = len(qs)
         self.g = ca.vertcat(*eqs) if eqs else ca.SX(0, 1)
-        if self.g.numel() != self.nq:  # guarded by the model's mobility check
-            raise ModelError(f"[inputs]: {self.nq} unknowns but {self.g.numel()} equations")
+        self.ng = self.g.numel()
+        if self.ng < self.nq:  # guarded by the model's mobility check
+            raise ModelError(f"[inputs]: {self.nq} unknowns but {self.ng} equations")
         self.angles = {lk.name: self.frames[lk.name][2] for lk in m.links}
         self.is_length = np.array([k == "length" for _, k in self.unknowns], dtype=bool)
         self.Jq = ca.jacobian(self.g, self.q)
@@ -141,6 +146,13 @@ class Symbolic:
     def _point_matrix(self):
         pts = [self.points[p] for p in self.mech.moving_points]
         return ca.horzcat(*[ca.vertcat(x, y) for x, y in pts]) if pts else ca.SX(2, 0)
+
+    def lsolve(self, b):
+        """g_q^-1 b, or for a tall consistent system (redundant joints) the solution of its
+        normal equations (g_q' g_q) x = g_q' b, exact when g_q x = b has a solution."""
+        if self.ng == self.nq:
+            return ca.solve(self.Jq, b)
+        return ca.solve(ca.mtimes(self.Jq.T, self.Jq), ca.mtimes(self.Jq.T, b))
 
     # --- quantities ---
     def position_expr(self, obj: str, attr: str):
@@ -190,20 +202,24 @@ class Symbolic:
         out = ca.vertcat(*raw) if raw else ca.SX(0, 1)
         orders = self._needs(out, qd_s, qdd_s)
         if orders >= 1:  # only build the linear solves that the report needs
-            qd = ca.densify(-ca.solve(self.Jq, ca.mtimes(self.Ju, ud)))  # dense even with no input
+            qd = ca.densify(-self.lsolve(ca.mtimes(self.Ju, ud)))  # dense even with no input
             qdd = ca.SX.zeros(self.nq)
             if orders >= 2:
                 gam = ca.jtimes(ca.jtimes(self.g, z, zd), z, zd)
-                qdd = ca.densify(ca.substitute(-ca.solve(self.Jq, ca.mtimes(self.Ju, udd) + gam), qd_s, qd))
+                qdd = ca.densify(ca.substitute(-self.lsolve(ca.mtimes(self.Ju, udd) + gam), qd_s, qd))
             out = ca.substitute(ca.substitute(out, qdd_s, qdd), qd_s, qd)
         rows = [out[i] for i in range(out.numel())]
         sens = [(i, b) for i, (k, _, b) in enumerate(parsed) if k == "sens"]
         if sens:
             gp = ca.jacobian(self.g, self.p)
-            dq_dp = -ca.solve(self.Jq, gp)  # one factorisation serves every parameter
+            dq_dp = -self.lsolve(gp)  # one factorisation serves every parameter
             for i, b in sens:
                 j = self.pnames.index(b)
                 rows[i] = ca.jtimes(rows[i], self.q, dq_dp[:, j]) + ca.jacobian(rows[i], self.p[j])
+                if self.ng > self.nq:  # redundant joints: p must keep g_q dq + g_p dp = 0
+                    # solvable, or a change of p jams the chain and there is no derivative
+                    miss = ca.mmax(ca.fabs(ca.mtimes(self.Jq, dq_dp[:, j]) + gp[:, j]))
+                    rows[i] = ca.if_else(miss > 1e-8 * (1 + ca.mmax(ca.fabs(gp[:, j]))), np.nan, rows[i])
         out = ca.vertcat(*rows) if rows else ca.SX(0, 1)
         return ca.Function("quantities", [self.q, self.u, self.p, ud, udd], [out])
 
