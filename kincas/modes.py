@@ -222,7 +222,7 @@ def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
     keep.sort(key=lambda t: tuple(np.round(t[1] / (SAME * L))))
     links = [lk.name for lk in m.links]
     out = []
-    s = np.where(sym.is_length, 1.0, 1.0 / L)  # columns scaled to O(1), as solve.py does
+    s = model.column_scale(L)  # columns scaled to O(1)
     for q, pts in keep:
         ang = model.quantities([f"{lk}.angle" for lk in links], q[None, :], u[None, :], p,
                                np.ones((1, len(u))), np.zeros((1, len(u))))[:, 0]

@@ -158,19 +158,14 @@ class Model:
         _, J, Ju = self._tangent(q, u, p)
         return _lsolve(J, -Ju)
 
+    def column_scale(self, L) -> np.ndarray:
+        """Factors bringing g_q's columns to O(1) at any size: an angle unknown's column is
+        a length (times 1/L), a length unknown's is a ratio (times 1). Conditioning and
+        determinant signs compared through it mean the same at 1e-6 m and at 1e6 m."""
+        return np.where(self.sym.is_length, 1.0, 1.0 / L)
+
     def jac(self, q, u, p) -> np.ndarray:
         return self._resjac(q, u, p)[1].copy()
-
-    def jacobians_at(self, Q, U, p):
-        """g_q (N, ng, nq) and g_u (N, ng, nu) at N poses in one mapped call."""
-        n, ng = Q.shape[0], self.ng
-        if n == 0:
-            return np.zeros((0, ng, self.nq)), np.zeros((0, ng, self.nu))
-        f = self.sym.f_tangent.map(n)
-        _, J, Ju = f(Q.T, U.T, np.repeat(np.reshape(p, (-1, 1)), n, axis=1))
-        J = np.asarray(ca.densify(J)).reshape(ng, n, self.nq).transpose(1, 0, 2)
-        Ju = np.asarray(ca.densify(Ju)).reshape(ng, n, self.nu).transpose(1, 0, 2)
-        return J, Ju
 
     def points(self, q, u, p) -> np.ndarray:
         """World positions of the moving points, 2 x n."""

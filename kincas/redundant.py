@@ -99,7 +99,7 @@ def rank_test(m):
     from .numeric import compile
     from .singular import _scales
     model = compile(m)
-    nq, nu = model.nq, model.nu
+    nq = model.nq
     p = np.array([v for _, v in m.parameters], float)
     L = m.size()
     guess = {k: (m.value(x), m.value(y)) for k, (x, y) in m.guess}

@@ -42,10 +42,8 @@ FLAG_SIGMA = 1e-7  # relative smallest singular value at which a pose *is* singu
 
 
 def _scales(model, L):
-    sym = model.sym
-    cq = np.where(sym.is_length, 1.0, 1.0 / L)
-    cu = np.array([1.0 / L if i.kind == "angle" else 1.0 for i in sym.mech.inputs])
-    return cq, cu
+    cu = np.array([1.0 / L if i.kind == "angle" else 1.0 for i in model.sym.mech.inputs])
+    return model.column_scale(L), cu
 
 
 def scaled_jacobians(model, q, u, p, L):
@@ -67,10 +65,6 @@ def classify(J: np.ndarray, Gu: np.ndarray, tol: float = FLAG_SIGMA) -> str | No
     if sg[J.shape[1] - 1] <= tol * max(sg[0], 1.0) * 1e3:  # rank [J Gu] < nq
         return "change point"
     return "limit" if Gu.shape[1] == 1 else "singular"
-
-
-def sigma_min(J: np.ndarray) -> float:
-    return float(np.linalg.svd(J, compute_uv=False)[-1]) if J.size else np.inf
 
 
 # --- locating a limit exactly ---
@@ -140,18 +134,18 @@ def input_range(m: Mechanism, inputs: dict, key: str | None = None, *, max_steps
     """Range of input `key` (default: the first) on the branch of the pose at `inputs`,
     the other inputs held at their values. Limits are located to rounding precision."""
     from .numeric import compile
-    from .solve import solve
+    from .solve import sweep
     model = compile(m)
     keys = [i.key for i in m.inputs]
     key = key or keys[0]
     i = keys.index(key)
-    pose = solve(m, inputs, report=[])
-    if not pose.ok:
+    start = sweep(m, inputs, report=[])  # the starting pose, solved once
+    if not start.ok[0]:
         raise ValueError(f"the mechanism does not assemble at {inputs}")
     p = np.array([v for _, v in m.parameters], float)
     L = m.size()
-    u0 = np.array([pose.inputs[k] for k in keys])
-    q0 = _pose_q(model, m, u0, p, L)
+    u0 = np.array([start.inputs[k][0] for k in keys])
+    q0 = start.q[0]
     is_angle = m.inputs[i].kind == "angle"
     cq, cu = _scales(model, L)
     # unknowns / scale are O(1): angles as they are, lengths over the size
@@ -167,12 +161,6 @@ def input_range(m: Mechanism, inputs: dict, key: str | None = None, *, max_steps
         return Range(key, u0[i] - np.pi, u0[i] + np.pi, True, [], u0[i])
     return Range(key, min(ends.values()), max(ends.values()), False,
                  sorted(limits, key=lambda t: t[1]), u0[i])
-
-
-def _pose_q(model, m, u, p, L):
-    from .solve import sweep
-    sw = sweep(m, {k: [v] for k, v in zip([i.key for i in m.inputs], u)}, report=[])
-    return sw.q[0]
 
 
 def _follow(model, q, u, p, L, i, direction, scale, is_angle, max_steps):

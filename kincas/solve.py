@@ -257,7 +257,7 @@ def _ill(model: Model, J, L) -> bool:
     # one, and several times cheaper than singular values for large mechanisms.
     with np.errstate(all="ignore"):
         # (2-norm, from singular values, for a tall g_q: redundant joints)
-        c = np.linalg.cond(J * np.where(model.sym.is_length, 1.0, 1.0 / L), 1 if model.square else None)
+        c = np.linalg.cond(J * model.column_scale(L), 1 if model.square else None)
     return not c < 1e2 * max(1.0, np.sqrt(J.shape[0]))
 
 
@@ -276,7 +276,7 @@ def _secant(q0, u0, u1, prev):
 
 def _scaled_det(model: Model, J, L) -> float:
     # Columns scaled to O(1) so the determinant's size means the same at every scale.
-    return float(np.linalg.det(J * np.where(model.sym.is_length, 1.0, 1.0 / L))) if J.size else 1.0
+    return float(np.linalg.det(J * model.column_scale(L))) if J.size else 1.0
 
 
 def _det_sign(model: Model, sol: Solution, L) -> int:
@@ -297,7 +297,7 @@ def _same_branch(model: Model, J0, sol: Solution, L) -> bool:
     singular: det(Q0' J1) and det(R0) of opposite signs mean a singular position was
     crossed, exactly as det g_q's sign change does for a square system (for which
     this is the same test: Q0 is square and orthogonal)."""
-    c = np.where(model.sym.is_length, 1.0, 1.0 / L)
+    c = model.column_scale(L)
     if model.square:
         d0, d1 = _scaled_det(model, J0, L), _scaled_det(model, sol.J, L)
     else:
@@ -309,7 +309,7 @@ def _same_branch(model: Model, J0, sol: Solution, L) -> bool:
 # --- singular positions met by a sweep ---
 
 
-def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, J=None) -> list[dict]:
+def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, J) -> list[dict]:
     """Flag solved poses at or next to a singular position and locate it exactly.
 
     A limit lies between a solved pose and a neighbour with no assembly; a sign change of
@@ -317,17 +317,13 @@ def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, J=None) 
     (a change point, or a limit met exactly); a pose whose scaled g_q is numerically
     singular is flagged where it stands.
     """
-    from .singular import FLAG_SIGMA, _scales, classify, locate_singular, scaled_jacobians
+    from .singular import FLAG_SIGMA, classify, locate_singular, scaled_jacobians
     n, events = len(ok), []
     if model.nq == 0 or m.inputs == () or n == 0:
         return events
     idx = np.flatnonzero(ok)
-    if J is None:
-        J, Ju = model.jacobians_at(Q[idx], U[idx], p)  # one mapped call for every solved pose
-    else:  # g_q per pose from the sweep; g_u only where a pose is flagged
-        J, Ju = J[idx], None
-    cq, cu = _scales(model, L)
-    J = J * cq
+    J = J[idx]  # g_q per solved pose, as the sweep kept it; g_u only where a pose is flagged
+    J = J * model.column_scale(L)
     dets = np.zeros(n)
     if model.square:
         dets[idx] = np.linalg.det(J) if len(idx) else []
@@ -344,7 +340,7 @@ def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, J=None) 
                 o = o * flip if flip != 0 else o
     sv = np.linalg.svd(J, compute_uv=False) if len(idx) else np.zeros((0, model.nq))
     for j in np.flatnonzero(sv[:, -1] <= FLAG_SIGMA * np.maximum(sv[:, 0], 1.0)):
-        Gu = Ju[j] * cu if Ju is not None else scaled_jacobians(model, Q[idx[j]], U[idx[j]], p, L)[1]
+        Gu = scaled_jacobians(model, Q[idx[j]], U[idx[j]], p, L)[1]
         flags[idx[j]] = classify(J[j], Gu)
     # Only a solved pose next to an unsolved one, or before a sign change of det g_q, can hold
     # an event: look at those alone (a sweep of 10^5 poses has a handful).

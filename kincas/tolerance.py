@@ -171,7 +171,7 @@ def _monte_carlo(m: Mechanism, sw, report, to, dp):
     if not len(ok_poses):
         return mc, shift, failed, 0
     F = _sample_function(model, tuple(report))
-    det_scale = np.where(sym.is_length, 1.0, 1.0 / L)  # columns to O(1): det signs comparable
+    det_scale = model.column_scale(L)  # columns to O(1): det signs comparable
     # Columns: sample-major within each solved pose, so each pose is one contiguous block.
     Pall = p0[:, None] + np.zeros((len(p0), n_s))
     Pall[cols, :] += dp.T
