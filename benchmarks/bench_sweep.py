@@ -4,7 +4,7 @@
 
 Measures, in one run so that the ratios compare like with like on a shared machine:
 1. per-pose cost of 100,000-pose sweeps (positions and velocities) of a four-bar and an
-   offset slider-crank: kincas's fast path (`kincas.fast`, first pose solved carefully, the
+   offset slider-crank: kincas's fast path (`kincas.core.fast`, first pose solved carefully, the
    rest in one compiled pass, quantities computed in the same pass) against the closed form
    in vectorised numpy, interleaved repeats, medians and spread; the pieces of the fast path
    (kernel alone, quantities apart, uncompiled) and `kincas.sweep` as it is now;
@@ -32,7 +32,7 @@ sys.path.insert(0, str(ROOT))
 
 import kincas  # noqa: E402
 from kincas import Input, Link, Mechanism, Slide  # noqa: E402
-from kincas.fast import FastSweeper, QuantityEvaluator  # noqa: E402
+from kincas.core.fast import FastSweeper, QuantityEvaluator  # noqa: E402
 
 W = 10.0  # input rate, rad/s
 
@@ -160,7 +160,7 @@ t0 = time.perf_counter()
 sys.path.insert(0, {root!r}); sys.path.insert(0, {here!r})
 import numpy as np, kincas
 from bench_sweep import FOURBAR, FOURBAR_REPORT
-from kincas.fast import FastSweeper
+from kincas.core.fast import FastSweeper
 t1 = time.perf_counter()
 fs = FastSweeper(kincas.compile(FOURBAR), FOURBAR_REPORT, compile=True)
 fs.backend.compiled(1)
@@ -226,8 +226,8 @@ sys.stdout.write(json.dumps(doc, allow_nan=False) + "\\n")  # dumps: the C encod
 _FAST_JSON = """
 import json, sys, numpy as np
 sys.path.insert(0, {root!r})
-from kincas.scene import load
-from kincas.fast import sweeper_for
+from kincas.cli.scene import load
+from kincas.core.fast import sweeper_for
 import kincas
 sc = load({scene!r})
 m, st = sc.mechanism, sc.study

@@ -13,11 +13,19 @@ Jacobians, sensitivities to every named parameter. Angles are radians in Python.
 >>> pose.status, round(pose["C.x"], 6)
 ('ok', 2.987219)
 """
+from . import _aliases
 from .errors import KincasError, ModelError, SceneError
 from .model import Input, Link, Mechanism, Param, Slide
 from .results import Pose, Sweep
-from .numeric import compile
-from .solve import solve, sweep
+from .core.numeric import compile
+from .analysis.sweeps import solve, sweep
+
+_aliases.install()  # `import kincas.modes` and other paths of the flat 0.1 layout
+
+
+def __getattr__(name):
+    return _aliases.attribute(name)
+
 
 __all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "solve", "sweep", "compile",
            "Pose", "Sweep", "KincasError", "ModelError", "SceneError"]

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 import kincas
-import kincas.scene
+import kincas.cli.scene
 from conftest import EXAMPLES, run_cli
-from kincas.modes import find_modes
+from kincas.analysis.modes import find_modes
 
 POSITION_TOL = 1e-9  # relative to the mechanism's size
 ANGLE_TOL = 1e-9  # radians
@@ -177,7 +177,7 @@ def triad_assemblies(r3=None, n=200_001):
 
 
 def triad_mechanism():
-    return kincas.scene.load(EXAMPLES / "assur_triad.toml").mechanism
+    return kincas.cli.scene.load(EXAMPLES / "assur_triad.toml").mechanism
 
 
 def test_independent_triad_method_finds_six_assemblies_that_close():
@@ -266,7 +266,7 @@ def test_stephenson3_sweep_matches_the_independent_branch(capsys):
     start = {k: np.array(v, float) for k, v in sc["guess"].items()}
     branch, ratio = track([stephenson_assemblies(a) for a in psi], start)
     assert ratio.max() < 0.2
-    size = kincas.scene.load(EXAMPLES / "stephenson3.toml").mechanism.size()
+    size = kincas.cli.scene.load(EXAMPLES / "stephenson3.toml").mechanism.size()
     for p in ("A", "B", "C"):
         for c, i in (("x", 0), ("y", 1)):
             got = np.array(out["values"][f"{p}.{c}"])
@@ -287,7 +287,7 @@ def test_stephenson3_sweep_matches_the_independent_branch(capsys):
 
 @pytest.mark.parametrize("driver_deg", [0, 100, 250])
 def test_stephenson3_modes_are_all_the_triad_assemblies(driver_deg):
-    m = kincas.scene.load(EXAMPLES / "stephenson3.toml").mechanism
+    m = kincas.cli.scene.load(EXAMPLES / "stephenson3.toml").mechanism
     a = math.radians(driver_deg)
     found = stephenson_assemblies(a, 200_001)
     assert len(found) >= 2
@@ -336,7 +336,7 @@ def test_eightbar_sweep_matches_the_independent_branch(capsys):
     start = {k: np.array(v, float) for k, v in sc["guess"].items()}
     branch, ratio = track([eightbar_assemblies(a) for a in th], start)
     assert ratio.max() < 0.2
-    size = kincas.scene.load(EXAMPLES / "eightbar.toml").mechanism.size()
+    size = kincas.cli.scene.load(EXAMPLES / "eightbar.toml").mechanism.size()
     for p in ("R", "S", "G"):
         for c, i in (("x", 0), ("y", 1)):
             got = np.array(out["values"][f"{p}.{c}"])
@@ -348,7 +348,7 @@ def test_eightbar_sweep_matches_the_independent_branch(capsys):
 
 @pytest.mark.parametrize("crank_deg", [0, 200])
 def test_eightbar_modes_are_all_the_assemblies(crank_deg):
-    m = kincas.scene.load(EXAMPLES / "eightbar.toml").mechanism
+    m = kincas.cli.scene.load(EXAMPLES / "eightbar.toml").mechanism
     a = math.radians(crank_deg)
     found = eightbar_assemblies(a, 200_001)
     assert len(found) >= 2

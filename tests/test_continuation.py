@@ -7,7 +7,7 @@ import pytest
 
 import kincas
 from kincas import Input, Link, Mechanism, Slide
-from kincas.singular import input_range
+from kincas.analysis.singular import input_range
 
 
 def fourbar(a, b, c, d, guess, s=1.0):

@@ -1,4 +1,4 @@
-"""The fast sweep (kincas.fast) against closed forms, its compiled and uncompiled paths against
+"""The fast sweep (kincas.core.fast) against closed forms, its compiled and uncompiled paths against
 each other, its disk cache, its fallback, and its refusal to jump branch near singular poses.
 
 Compiled kernels are shared through a module-wide cache directory (one compilation each)."""
@@ -13,8 +13,8 @@ import pytest
 
 import kincas
 from kincas import Input, Link, Mechanism, Slide
-from kincas.fast import FastRun, FastSweeper, QuantityEvaluator
-from kincas.numeric import Solution
+from kincas.core.fast import FastRun, FastSweeper, QuantityEvaluator
+from kincas.core.numeric import Solution
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -211,8 +211,8 @@ def test_no_unknowns_every_pose_goes_to_the_careful_path():
 
 @pytest.mark.parametrize("compiled", [True, False])
 def test_progress_in_blocks_gives_the_same_poses(fourbar_sweepers, compiled, monkeypatch):
-    import kincas.fast
-    monkeypatch.setattr(kincas.fast, "BLOCK", 300)  # blocks of 300 poses, state carried over
+    import kincas.core.fast
+    monkeypatch.setattr(kincas.core.fast, "BLOCK", 300)  # blocks of 300 poses, state carried over
     th = np.linspace(0, 2 * np.pi, 2000)
     U = th[:, None]
     model, p, L, q0 = first_pose(fourbar(), U)
@@ -240,7 +240,7 @@ def test_disk_cache_is_hit_by_a_second_process(cache):
 import json, numpy as np, kincas, sys
 sys.path.insert(0, {os.path.dirname(__file__)!r})
 from test_fast import fourbar
-from kincas.fast import FastSweeper
+from kincas.core.fast import FastSweeper
 fs = FastSweeper(kincas.compile(fourbar(b=3.6)), ["C.y"], compile=True)
 ok = fs.backend.compiled(10) is not None
 print(json.dumps({{"cached": fs.backend.library.cached, "compile": fs.backend.library.times["compile"],
@@ -253,9 +253,9 @@ print(json.dumps({{"cached": fs.backend.library.cached, "compile": fs.backend.li
 
 
 def test_the_cache_keeps_the_most_recently_used_libraries(tmp_path, monkeypatch):
-    import kincas.compiled
+    import kincas.core.compiled
     monkeypatch.setenv("KINCAS_CACHE", str(tmp_path))
-    monkeypatch.setattr(kincas.compiled, "MAX_CACHED", 2)
+    monkeypatch.setattr(kincas.core.compiled, "MAX_CACHED", 2)
     old = [tmp_path / f"kincas_sweep-old{i}.so" for i in range(3)]
     for i, f in enumerate(old):
         f.write_bytes(b"")

@@ -1,4 +1,4 @@
-"""Assembly modes (`kincas.modes`, `kincas modes`): every real assembly, each a ready [guess]
+"""Assembly modes (`kincas.analysis.modes`, `kincas modes`): every real assembly, each a ready [guess]
 block, and a sweep from each one that stays on its own branch.
 
 The answers are independent: circle intersections for the four-bar and the trammel, and for
@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 import kincas
-import kincas.scene
+import kincas.cli.scene
 from conftest import EXAMPLES, run_cli, write_scene
 from kincas import Input, Link, Mechanism, ModelError, Slide
-from kincas.modes import Mode, find_modes, scene_with_guess
+from kincas.analysis.modes import Mode, find_modes, scene_with_guess
 from test_class3 import POSITION_TOL, circles, match, track, triad_assemblies
 
 TRIAD = EXAMPLES / "assur_triad.toml"
@@ -31,7 +31,7 @@ def fourbar(a=1.0, b=3.5, c=3.0, d=4.0, guess=(3.6, 2.9)):
 
 def triad_structure():
     """The triad with leg 3 fixed at 12 and no input: a structure (0 degrees of freedom)."""
-    m = kincas.scene.load(TRIAD).mechanism
+    m = kincas.cli.scene.load(TRIAD).mechanism
     return Mechanism(parameters=m.parameters, ground=m.ground, links=m.links, inputs=[], guess=m.guess)
 
 
@@ -55,9 +55,9 @@ def test_fourbar_has_the_two_circle_intersections():
 
 @pytest.mark.parametrize("seed", [0, 1, 2, 3])
 def test_triad_six_modes_from_every_seed(seed):
-    modes = find_modes(kincas.scene.load(TRIAD).mechanism, 12.0, starts=256, seed=seed)
+    modes = find_modes(kincas.cli.scene.load(TRIAD).mechanism, 12.0, starts=256, seed=seed)
     match(modes, triad_assemblies(), 40.0, ["B1", "B2", "B3"])
-    again = find_modes(kincas.scene.load(TRIAD).mechanism, 12.0, starts=256, seed=seed)
+    again = find_modes(kincas.cli.scene.load(TRIAD).mechanism, 12.0, starts=256, seed=seed)
     assert [md.points for md in again] == [md.points for md in modes]  # deterministic
 
 
@@ -97,7 +97,7 @@ def test_bad_inputs_name_the_field():
 
 
 def test_guess_block_is_toml_that_gives_the_points_back():
-    for md in find_modes(kincas.scene.load(TRIAD).mechanism, 12.0):
+    for md in find_modes(kincas.cli.scene.load(TRIAD).mechanism, 12.0):
         pts = block_points(md.guess_block())
         assert set(pts) == set(md.points)
         for p, xy in pts.items():
@@ -109,7 +109,7 @@ def test_guess_block_is_toml_that_gives_the_points_back():
 def test_every_triad_mode_sweeps_on_its_own_branch():
     """Leg 3 from 12 to 16 mm, started from each mode's guess: every pose on the branch that
     the independent solution tracks from that mode, the first pose the mode itself."""
-    m = kincas.scene.load(TRIAD).mechanism
+    m = kincas.cli.scene.load(TRIAD).mechanism
     r3 = np.linspace(12, 16, 9)
     independent = [triad_assemblies(r, 50_001) for r in r3]
     report = [f"{p}.{c}" for p in ("B1", "B2", "B3") for c in "xy"]

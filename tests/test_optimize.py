@@ -20,9 +20,9 @@ from scipy.optimize import brentq
 import kincas
 from kincas import Input, Link, Mechanism, ModelError, Slide
 from kincas.cli import main
-from kincas.expressions import parse
-from kincas.optimize import Constraint, Curve, optimize, run_scene
-from kincas.scene import load, loads
+from kincas.synthesis.expressions import parse
+from kincas.synthesis.optimize import Constraint, Curve, optimize, run_scene
+from kincas.cli.scene import load, loads
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

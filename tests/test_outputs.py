@@ -20,7 +20,7 @@ import closed_forms as cf
 from conftest import EXAMPLES, ROOT, run_cli, write_scene
 
 import kincas
-from kincas.progress import Progress
+from kincas.cli.progress import Progress
 
 MISSING = 'kincas: --plot needs matplotlib: pip install "kincas[plot]"'
 
@@ -61,8 +61,8 @@ def test_csv_has_a_row_per_pose_the_json_numbers_and_units_in_the_header(capsys,
 
 
 def test_csv_header_units_follow_the_scene_format():
-    from kincas.outputs import write_csv
-    from kincas.scene import load
+    from kincas.cli.outputs import write_csv
+    from kincas.cli.scene import load
     sc = load(EXAMPLES / "fairbairn.toml")  # mm, deg, s
     buf = io.StringIO()
     write_csv(buf, sc.run(), sc)
@@ -140,11 +140,11 @@ def test_missing_matplotlib_is_one_line_and_status_2(capsys, tmp_path, monkeypat
 
 def test_the_library_imports_and_writes_csv_without_matplotlib():
     code = ("import sys; sys.modules['matplotlib'] = None\n"
-            "import io, kincas, kincas.plot, kincas.outputs, kincas.progress\n"
+            "import io, kincas, kincas.cli.plot, kincas.cli.outputs, kincas.cli.progress\n"
             "m = kincas.Mechanism(ground={'O': (0, 0)}, links=[kincas.Link.bar('c', 'O', 'A', 1),"
             " kincas.Link.bar('r', 'A', 'B', 3)], slides=[kincas.Slide('B', 'ground')],"
             " inputs=[kincas.Input.angle('c')], guess={'B': (4, 0)})\n"
-            "b = io.StringIO(); kincas.outputs.write_csv(b, kincas.sweep(m, {'c.angle': [0.0]}))\n"
+            "b = io.StringIO(); kincas.cli.outputs.write_csv(b, kincas.sweep(m, {'c.angle': [0.0]}))\n"
             "print(b.getvalue().splitlines()[1])\n"
             "try:\n    kincas.plot.draw(m, None)\nexcept ModuleNotFoundError as e:\n    print(e)\n")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=60)
@@ -156,8 +156,8 @@ def test_the_library_imports_and_writes_csv_without_matplotlib():
 
 def test_paths_and_pose_options(tmp_path, capsys):
     pytest.importorskip("matplotlib")
-    from kincas.outputs import write_outputs
-    from kincas.scene import load
+    from kincas.cli.outputs import write_outputs
+    from kincas.cli.scene import load
     sc = load(EXAMPLES / "fourbar_coupler.toml")
     sw = sc.run()
     args = argparse.Namespace(csv=None, plot=str(tmp_path / "p.png"), animate=None,
@@ -176,8 +176,8 @@ def test_paths_and_pose_options(tmp_path, capsys):
 def test_quantity_plot_marks_flags_and_shades_unsolved_poses(tmp_path):
     pytest.importorskip("matplotlib")
     from matplotlib.figure import Figure
-    from kincas.outputs import FLAG_STYLE, plot_quantities
-    from kincas.scene import load
+    from kincas.cli.outputs import FLAG_STYLE, plot_quantities
+    from kincas.cli.scene import load
     sc = load(write_scene(tmp_path, nongrashof_scene()))
     sw = sc.run()
     ok = sw.ok
@@ -207,7 +207,7 @@ def test_quantity_plot_marks_flags_and_shades_unsolved_poses(tmp_path):
 def test_quantity_plot_without_a_scene_names_radians():
     pytest.importorskip("matplotlib")
     from matplotlib.figure import Figure
-    from kincas.outputs import plot_quantities
+    from kincas.cli.outputs import plot_quantities
     m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
                          links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
                                 kincas.Link.bar("rocker", "D", "C", 3)],

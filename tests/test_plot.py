@@ -16,9 +16,9 @@ matplotlib = pytest.importorskip("matplotlib")
 matplotlib.use("Agg", force=True)
 
 import kincas  # noqa: E402
-from kincas.outputs import animate  # noqa: E402
-from kincas.plot import draw, geometry, new_figure  # noqa: E402
-from kincas.scene import load  # noqa: E402
+from kincas.cli.outputs import animate  # noqa: E402
+from kincas.cli.plot import draw, geometry, new_figure  # noqa: E402
+from kincas.cli.scene import load  # noqa: E402
 
 SIZE, DPI = (4.0, 3.0), 80
 EXAMPLE_FILES = sorted(EXAMPLES.glob("*.toml"))

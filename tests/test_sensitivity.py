@@ -18,8 +18,8 @@ import pytest
 import kincas
 from kincas import Input, Link, Mechanism, Slide
 from kincas.cli import main
-from kincas.scene import load, loads
-from kincas.sensitivity import sensitivities
+from kincas.cli.scene import load, loads
+from kincas.analysis.sensitivity import sensitivities
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 RATES = {"x": "vx", "y": "vy", "angle": "omega", "s": "v"}

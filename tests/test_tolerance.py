@@ -17,7 +17,7 @@ import pytest
 import kincas
 from kincas import Input, Link, Mechanism, ModelError, Slide
 from kincas.cli import main
-from kincas.tolerance import analyse
+from kincas.analysis.tolerance import analyse
 
 
 def fourbar(a=1.0, b=3.5, c=3.0, d=4.0, guess=(3.6, 2.9)):

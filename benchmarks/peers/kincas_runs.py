@@ -6,7 +6,7 @@
 - `solve per pose`: one `kincas.solve` call per pose, its guess the previous pose's points;
 - `newton per pose, tol T`: `kincas.compile(m).newton` from the previous pose's unknowns,
   velocities for all poses in one `model.quantities` call at the end; the tolerance is
-  kincas's module setting `kincas.numeric.TOL` (Newton's target residual), set for the run;
+  kincas's module setting `kincas.core.numeric.TOL` (Newton's target residual), set for the run;
 - `IPOPT per pose`: `model.nearest_assembly` (IPOPT, then a Newton polish) targeting the
   previous pose's points; slow, so it runs on every STRIDE-th pose only.
 
@@ -58,7 +58,7 @@ def methods() -> tuple[list[str], list]:
 @contextlib.contextmanager
 def newton_tolerance(tol):
     import importlib
-    ks = importlib.import_module("kincas.numeric")  # where Newton reads its target
+    ks = importlib.import_module("kincas.core.numeric")  # where Newton reads its target
     old = ks.TOL
     ks.TOL = tol
     try:

@@ -261,7 +261,7 @@ NOTES = """\
   warm from the last pose; it gives no velocities, so its error is positions only); the
   `mechanism` package's `Mechanism.iterate()` on vector loops (fsolve inside).
 - **kincas settings.** `newton per pose, tol T` sets kincas's module setting
-  `kincas.numeric.TOL` (Newton's target residual / L) for that run; `IPOPT per pose` runs
+  `kincas.core.numeric.TOL` (Newton's target residual / L) for that run; `IPOPT per pose` runs
   on every {stride}th pose only (it is slow); `solve per pose` passes the previous pose's
   points as the guess. Sweep options that this kincas does not have are listed, not faked.
 - **Stability.** A pose is *correct* within {match:g} L of the reference branch, a *branch

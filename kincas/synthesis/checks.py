@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from .results import wrap_angle
+from ..results import wrap_angle
 
 SAME_POSE = 1e-7  # relative: a pose reached by the checking sweep equals the optimised one
 EXTREME_MOVED = "the checking sweep reaches"  # the words of that problem, for a new round

@@ -41,10 +41,10 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
-from .errors import ModelError, SceneError
-from .model import Mechanism
-from .results import wrap_angle
-from .numeric import ACCEPT, MAX_STEP, TOL, compile
+from ..errors import ModelError, SceneError
+from ..model.mechanism import Mechanism
+from ..results import wrap_angle
+from ..core.numeric import ACCEPT, MAX_STEP, TOL, compile
 
 SAME = 1e-6  # two assemblies are one mode when every point agrees to this times the size
 CONVERGED = 1e-8  # a start whose relative residual reaches this is worth polishing
@@ -112,7 +112,7 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
     Q = Q[_unique(_point_rows(model, Q, u, p), 10 * SAME * L)]  # many starts, few modes
 
     found = [sol.q for sol in (model.newton(q, u, p, L) for q in Q) if sol.ok]  # polish
-    from .solve import sweep  # the assembly a sweep from the mechanism's guess starts on
+    from .sweeps import sweep  # the assembly a sweep from the mechanism's guess starts on
     first = sweep(m, {k: [v] for k, v in zip([i.key for i in m.inputs], u)}, report=[])
     picked = first.q[0] if first.ok[0] else None
     return _distinct(m, model, found + ([picked] if picked is not None else []), u, p, L, picked)
@@ -120,7 +120,7 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
 
 def _input_vector(m: Mechanism, inputs) -> np.ndarray:
     """One finite value per input (the pose at which the modes are wanted)."""
-    from .solve import _input_table
+    from .sweeps import _input_table
     U = _input_table(m, {} if inputs is None and not m.inputs else inputs, "inputs", None)
     if U.shape[0] != 1:
         raise ModelError("inputs: expected one value per input (modes are found at one pose)")
@@ -297,7 +297,7 @@ def cli_arguments(parser) -> None:
 def cli_run(args) -> int:
     """Find the modes at the scene's first pose; print them (and write scenes with --write).
     Exit status 0 when at least one assembly was found, 3 when none."""
-    from .scene import load
+    from ..cli.scene import load
     if args.starts < 1:
         raise SceneError(f"--starts: expected a whole number >= 1, got {args.starts}")
     sc = load(args.scene)

@@ -20,12 +20,12 @@ from typing import Mapping
 
 import numpy as np
 
-from .errors import ModelError
-from .fast import sweeper_for
-from .model import Mechanism
-from .numeric import Model, Solution, compile
-from .results import Pose, Sweep
-from .symbolic import default_report
+from ..errors import ModelError
+from ..core.fast import sweeper_for
+from ..model.mechanism import Mechanism
+from ..core.numeric import Model, Solution, compile
+from ..results import Pose, Sweep
+from ..core.symbolic import default_report
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
 

@@ -38,9 +38,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model import Mechanism
-from .errors import ModelError
-from .results import Sweep
+from ..model.mechanism import Mechanism
+from ..errors import ModelError
+from ..results import Sweep
 from .curve import Curve, constrain as curve_constrain, distances as curve_distances
 from .curve import objective as curve_objective, start as curve_start
 from .checks import EXTREME_MOVED
@@ -138,8 +138,8 @@ def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, con
 
 def _once(m, samples, vary, minimize, constraints, data, rates, accelerations, deg, check_path,
           max_iter, tol) -> OptimizeResult:
-    from .numeric import compile
-    from .solve import sweep
+    from ..core.numeric import compile
+    from ..analysis.sweeps import sweep
 
     model = compile(m)
     prob = Problem(m, model, vary, data, deg)
@@ -182,7 +182,7 @@ CURVE_FIELDS = {"point", "targets", "within", "order"}
 def read_section(sc) -> dict:
     """The scene's `[optimize]` section as keywords of optimize(); SceneError naming the
     field. Samples, data and bounds are in the scene's units (degrees where it says so)."""
-    from .errors import SceneError
+    from ..errors import SceneError
 
     t = sc.study.raw.get("optimize")
     if not isinstance(t, dict):
@@ -281,7 +281,7 @@ def _read_curve(sc, c, problems):
 
 def run_scene(sc) -> OptimizeResult:
     """Optimise as the scene's [optimize] section says (SceneError for a bad section)."""
-    from .errors import ModelError, SceneError
+    from ..errors import ModelError, SceneError
 
     kw = read_section(sc)
     try:
@@ -305,7 +305,7 @@ def cli_run(args) -> int:
     import json
     import sys
 
-    from .scene import load
+    from ..cli.scene import load
 
     sc = load(args.scene)
     r = run_scene(sc)
@@ -320,8 +320,8 @@ def cli_run(args) -> int:
 
 def report(sc, r: OptimizeResult) -> dict:
     """The result as the JSON object of `kincas optimize --json`, in the scene's units."""
-    from .cli import _list
-    from .symbolic import is_angular
+    from ..cli.app import _list
+    from ..core.symbolic import is_angular
 
     deg = sc.study.deg
     user = lambda n, v: np.degrees(v) if deg and is_angular(n) else np.asarray(v, float)

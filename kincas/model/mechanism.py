@@ -24,7 +24,7 @@ import re
 from dataclasses import dataclass, field, replace
 from typing import Iterable, Mapping, Union
 
-from .errors import ModelError
+from ..errors import ModelError
 
 # --- numbers that may name a parameter ---
 
@@ -409,7 +409,7 @@ def _check_mobility(m: Mechanism) -> tuple[list[str], int]:
               + (f", plus {n_param} driven parameter(s)" if n_param else ""))
     hint = ""
     if dof < len(m.inputs):  # fewer freedoms than expected: perhaps a redundant constraint
-        from .redundant import rank_test
+        from ..core.redundant import rank_test
         free, redundant, ok = rank_test(m)
         if ok:
             return [], redundant

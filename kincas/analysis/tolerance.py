@@ -36,8 +36,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import ModelError, SceneError
-from .model import Mechanism
+from ..errors import ModelError, SceneError
+from ..model.mechanism import Mechanism
 
 NEWTON_STEPS = 5  # after the first-order predictor; quadratic convergence needs few
 CHUNK = 40_000  # columns per mapped call: bounds the memory of very large runs
@@ -106,7 +106,7 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
     """Spread of the `report` quantities over `inputs` from independent normal parameter
     errors with standard deviations `std` (parameter name -> sigma, in its own unit)."""
     from .sensitivity import sensitivities
-    from .symbolic import default_report, parse_quantity
+    from ..core.symbolic import default_report, parse_quantity
 
     report = list(default_report(m) if report is None else report)
     problems = _check_std(m, std, "std")
@@ -152,7 +152,7 @@ def _check_std(m: Mechanism, std, where: str) -> list[str]:
 
 def _monte_carlo(m: Mechanism, sw, report, to, dp):
     """Monte-Carlo std and mean shift (poses x outputs), failures per pose, samples retried."""
-    from .numeric import ACCEPT, compile
+    from ..core.numeric import ACCEPT, compile
 
     model = compile(m)
     sym, nq = model.sym, model.nq
@@ -265,8 +265,8 @@ def _sample_function(model, report: tuple[str, ...]):
 
 def read_section(sc) -> dict:
     """The `[tolerance]` section as analyse()'s keywords; SceneError naming the field."""
-    from .numeric import compile
-    from .symbolic import parse_quantity
+    from ..core.numeric import compile
+    from ..core.symbolic import parse_quantity
 
     t = sc.study.raw.get("tolerance")
     if not isinstance(t, dict):
@@ -310,10 +310,10 @@ def cli_arguments(parser) -> None:
 
 def cli_run(args) -> int:
     """Run `kincas tolerance`: 0 when every pose and sample was solved, 3 otherwise."""
-    from .cli import _list, _unit, progress_for
-    from .symbolic import is_angular
+    from ..cli.app import _list, _unit, progress_for
+    from ..core.symbolic import is_angular
 
-    from .scene import load
+    from ..cli.scene import load
 
     sc = load(args.scene)
     kw = read_section(sc)

@@ -31,7 +31,7 @@ import ast
 import math
 from dataclasses import dataclass, field
 
-from .errors import ModelError
+from ..errors import ModelError
 
 UNARY = {"sin", "cos", "tan", "asin", "acos", "atan", "sqrt", "exp", "log", "abs"}
 BINARY = {"atan2", "hypot"}

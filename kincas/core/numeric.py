@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from .model import Mechanism
+from ..model.mechanism import Mechanism
 from .symbolic import Symbolic
 
 TOL = 1e-13  # Newton's target: residual relative to the mechanism's size

@@ -23,9 +23,9 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from .errors import OutputError
-from .model import Mechanism
-from .results import Sweep
+from ..errors import OutputError
+from ..model.mechanism import Mechanism
+from ..results import Sweep
 
 FLAG_STYLE = {"limit": ("#d62728", "limit of motion"), "change point": ("#9467bd", "change point"),
               "singular": ("#ff7f0e", "singular position")}
@@ -48,7 +48,7 @@ def heading(name: str, scene=None) -> str:
     >>> heading("rocker.alpha")
     'rocker.alpha [rad/s^2]'
     """
-    from .cli import _unit
+    from .app import _unit
     u = _unit(_units_of(scene), name)
     return f"{name} [{u}]" if u else name
 
@@ -273,7 +273,7 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
 
 
 def _caption(scene, sweep, inputs, i) -> str:
-    from .cli import _unit
+    from .app import _unit
     parts = []
     for k, v in inputs.items():
         u = _unit(scene, k)

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
-from .model import Mechanism
+from ..model.mechanism import Mechanism
 
 FLAG_SIGMA = 1e-7  # relative smallest singular value at which a pose *is* singular
 
@@ -133,8 +133,8 @@ class Range:
 def input_range(m: Mechanism, inputs: dict, key: str | None = None, *, max_steps: int = 20000) -> Range:
     """Range of input `key` (default: the first) on the branch of the pose at `inputs`,
     the other inputs held at their values. Limits are located to rounding precision."""
-    from .numeric import compile
-    from .solve import sweep
+    from ..core.numeric import compile
+    from .sweeps import sweep
     model = compile(m)
     keys = [i.key for i in m.inputs]
     key = key or keys[0]
@@ -249,8 +249,8 @@ def cli_run(args) -> int:
     import json
     import math
 
-    from .errors import SceneError
-    from .scene import load
+    from ..errors import SceneError
+    from ..cli.scene import load
     sc = load(args.scene)
     m = sc.mechanism
     keys = [i.key for i in m.inputs]

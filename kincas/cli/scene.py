@@ -31,9 +31,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import KincasError, SceneError
-from .model import GROUND, Input, Link, Mechanism, Param, Slide
-from .results import Sweep
+from ..errors import KincasError, SceneError
+from ..model.mechanism import GROUND, Input, Link, Mechanism, Param, Slide
+from ..results import Sweep
 
 SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
             "output", "optimize", "tolerance"}
@@ -68,7 +68,7 @@ class Scene:
         return self.study.report + [q for q in self.study.sensitivity if q not in self.study.report]
 
     def run(self, **kw) -> Sweep:
-        from .solve import sweep  # casadi stays out of scene parsing
+        from ..analysis.sweeps import sweep  # casadi stays out of scene parsing
         st = self.study
         return sweep(self.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
                      report=self.quantities, **kw)
@@ -84,7 +84,7 @@ class Scene:
 
     def user_values(self, s: Sweep) -> dict[str, np.ndarray]:
         """Reported quantities in the scene's units (degrees where the scene says so)."""
-        from .symbolic import is_angular
+        from ..core.symbolic import is_angular
         return {k: self._to_user(k, v, angle=is_angular(k)) for k, v in s.values.items()}
 
     def _to_user(self, name, v, angle):
@@ -207,7 +207,7 @@ class _Reader:
         except KincasError as e:
             raise SceneError(e.problems) from None
         if report is None:
-            from .symbolic import default_report
+            from ..core.symbolic import default_report
             report = default_report(m)
         self.check_quantities(m, report, sens)
         study = Study(title=title if isinstance(title, str) else "", units=self.units,
@@ -329,8 +329,8 @@ class _Reader:
         return report, sens
 
     def check_quantities(self, m: Mechanism, report: list[str], sens: list[str]):
-        from .numeric import compile
-        from .symbolic import parse_quantity
+        from ..core.numeric import compile
+        from ..core.symbolic import parse_quantity
         sym = compile(m).sym
         bad = sym.check_names(report)
         # each `of` name and each `to` name once, under the field they were written in

@@ -97,7 +97,7 @@ def rank_test(m):
     parameters): their number less the rank of their Jacobian. None for both numbers when
     no assembly was found near the guess."""
     from .numeric import compile
-    from .singular import _scales
+    from ..analysis.singular import _scales
     model = compile(m)
     nq = model.nq
     p = np.array([v for _, v in m.parameters], float)

@@ -15,11 +15,11 @@ import math
 
 import numpy as np
 
-from .errors import ModelError
+from ..errors import ModelError
 from .expressions import CONST, SAMPLE, Evaluator, parse
-from .model import Mechanism
+from ..model.mechanism import Mechanism
 from .checks import Checks, _short
-from .results import Sweep, wrap_angle
+from ..results import Sweep, wrap_angle
 
 REFINE = 400  # poses of the checking sweep between the first and the last sample, at least
 CON_TOL = 1e-6  # relative violation allowed of a constraint after polishing
@@ -174,7 +174,7 @@ class Problem(Checks):
 
     # --- expressions into the NLP's variables ---
     def leaf(self, kind, name):
-        from .symbolic import is_angular
+        from ..core.symbolic import is_angular
         ca, sym = self.ca, self.sym
         if kind == "quantity":
             e = self.model.quantity_function((name,))(sym.q, sym.u, sym.p, self.ud, self.udd)

@@ -17,19 +17,19 @@ import sys
 
 import numpy as np
 
-from . import __version__
-from .errors import KincasError, OutputError
-from .model import Param
+from .. import __version__
+from ..errors import KincasError, OutputError
+from ..model.mechanism import Param
 
 EXIT_OK, EXIT_SCENE, EXIT_UNSOLVED = 0, 2, 3
 
 # Further commands live in their own modules: each defines `cli_arguments(parser)` and
 # `cli_run(args) -> exit status`, and is imported only when it exists.
 COMMANDS = {
-    "range": ("kincas.singular", "range of motion of the input, its limits and singular positions"),
-    "modes": ("kincas.modes", "the distinct assembly modes at the scene's input, as [guess] blocks"),
-    "optimize": ("kincas.optimize", "optimise parameters as the scene's [optimize] section says"),
-    "tolerance": ("kincas.tolerance", "first-order and Monte-Carlo spread of outputs from parameter tolerances"),
+    "range": ("kincas.analysis.singular", "range of motion of the input, its limits and singular positions"),
+    "modes": ("kincas.analysis.modes", "the distinct assembly modes at the scene's input, as [guess] blocks"),
+    "optimize": ("kincas.synthesis.optimize", "optimise parameters as the scene's [optimize] section says"),
+    "tolerance": ("kincas.analysis.tolerance", "first-order and Monte-Carlo spread of outputs from parameter tolerances"),
 }
 
 
@@ -135,7 +135,7 @@ def _list(v) -> list:
 
 
 def _unit(sc, name: str) -> str:
-    from .symbolic import is_angular, parse_quantity
+    from ..core.symbolic import is_angular, parse_quantity
     u = sc.study.units
     L, A, T = u.get("length", ""), u.get("angle", "deg"), u.get("time", "s")
     kind, obj, attr = parse_quantity(name)

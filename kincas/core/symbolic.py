@@ -29,8 +29,8 @@ import re
 import casadi as ca
 import numpy as np
 
-from .errors import ModelError
-from .model import GROUND, Mechanism, as_param
+from ..errors import ModelError
+from ..model.mechanism import GROUND, Mechanism, as_param
 
 # --- quantity names ---
 

@@ -24,8 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import GROUND, Mechanism
-from .results import Sweep
+from ..model.mechanism import GROUND, Mechanism
+from ..results import Sweep
 
 PLOT_EXTRA = 'pip install "kincas[plot]"'
 
@@ -93,7 +93,7 @@ def _pose_function(model):
 
 def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
     """Positions of all points and the lines of all slides at every pose of `sweep`."""
-    from .numeric import compile
+    from ..core.numeric import compile
     model = compile(m)
     keys = [i.key for i in m.inputs]
     missing = [k for k in keys if k not in sweep.inputs]

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ModelError
+from ..errors import ModelError
 
 ORDERS = ("auto", "increasing", "decreasing", "free")
 STEPS = 721  # poses of the initial design's sweep onto which the targets are projected
@@ -115,7 +115,7 @@ def start(m, curve: Curve, sweep_fn, rates=None, accelerations=None):
 
 
 def _points(m, sw, i) -> dict:
-    from .numeric import compile
+    from ..core.numeric import compile
 
     model = compile(m)
     p = np.array([v for _, v in m.parameters], dtype=float)

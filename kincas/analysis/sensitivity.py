@@ -28,9 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ModelError
-from .model import Mechanism
-from .results import Sweep
+from ..errors import ModelError
+from ..model.mechanism import Mechanism
+from ..results import Sweep
 
 
 def names(of: list[str], to: list[str]) -> list[str]:
@@ -68,7 +68,7 @@ def sensitivities(m: Mechanism, inputs, of: list[str], to: list[str] | None = No
     """Sweep `m` over `inputs` and return every d(Q)/d(p), Q in `of`, p in `to` (default:
     every parameter that no input drives). `sweep_kw` goes to `kincas.sweep` (rates, ...);
     the quantities `of` are reported too, so `result.sweep[Q]` holds their values."""
-    from .solve import sweep  # casadi is imported only when something is solved
+    from .sweeps import sweep  # casadi is imported only when something is solved
 
     driven = {i.target for i in m.inputs if i.kind == "parameter"}
     to = [p for p in m.param_values if p not in driven] if to is None else list(to)

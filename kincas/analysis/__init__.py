@@ -1,0 +1,1 @@
+"""Sweeps, singular positions, assembly modes, sensitivities and tolerances."""

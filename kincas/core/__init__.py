@@ -1,0 +1,1 @@
+"""Residuals, structure, Newton and compiled kernels: the only place casadi is used."""

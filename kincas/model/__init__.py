@@ -1,0 +1,7 @@
+"""Declarations of a mechanism as immutable values: names, structure and mobility checks.
+
+No casadi and no solving here: see `kincas.core` for that.
+"""
+from .mechanism import GROUND, Input, Link, Mechanism, Num, Param, Slide, Structure, as_param
+
+__all__ = ["GROUND", "Input", "Link", "Mechanism", "Num", "Param", "Slide", "Structure", "as_param"]

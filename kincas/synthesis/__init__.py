@@ -1,0 +1,1 @@
+"""Optimisation of dimensions, path synthesis and the expression language."""
