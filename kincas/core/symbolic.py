@@ -182,8 +182,11 @@ class Symbolic:
                            f"L.omega, L.alpha, S.s, S.v, S.a or d(Q)/d(p) with declared names)")
         return out
 
-    def quantity_function(self, names: list[str]) -> ca.Function:
+    def quantity_function(self, names: list[str], lsolve=None) -> ca.Function:
         """f(q, u, p, u', u'') -> the named quantities (only what they need is built).
+
+        `lsolve(b)`, if given, replaces `self.lsolve` for the linear solves with g_q (the
+        fast kernel solves them Assur group by group, kincas/core/blocks.py).
 
         Sensitivities d(Q)/d(p) follow the implicit function theorem on the same Jacobian:
         dq/dp = -g_q^-1 g_p, so dQ/dp = Q_q dq/dp + Q_p, with Q written in (q, u, p, u', u'')
@@ -201,18 +204,19 @@ class Symbolic:
                for k, a, b in parsed]
         out = ca.vertcat(*raw) if raw else ca.SX(0, 1)
         orders = self._needs(out, qd_s, qdd_s)
+        lsolve = lsolve or self.lsolve
         if orders >= 1:  # only build the linear solves that the report needs
-            qd = ca.densify(-self.lsolve(ca.mtimes(self.Ju, ud)))  # dense even with no input
+            qd = ca.densify(-lsolve(ca.mtimes(self.Ju, ud)))  # dense even with no input
             qdd = ca.SX.zeros(self.nq)
             if orders >= 2:
                 gam = ca.jtimes(ca.jtimes(self.g, z, zd), z, zd)
-                qdd = ca.densify(ca.substitute(-self.lsolve(ca.mtimes(self.Ju, udd) + gam), qd_s, qd))
+                qdd = ca.densify(ca.substitute(-lsolve(ca.mtimes(self.Ju, udd) + gam), qd_s, qd))
             out = ca.substitute(ca.substitute(out, qdd_s, qdd), qd_s, qd)
         rows = [out[i] for i in range(out.numel())]
         sens = [(i, b) for i, (k, _, b) in enumerate(parsed) if k == "sens"]
         if sens:
             gp = ca.jacobian(self.g, self.p)
-            dq_dp = -self.lsolve(gp)  # one factorisation serves every parameter
+            dq_dp = -lsolve(gp)  # one factorisation serves every parameter
             for i, b in sens:
                 j = self.pnames.index(b)
                 rows[i] = ca.jtimes(rows[i], self.q, dq_dp[:, j]) + ca.jacobian(rows[i], self.p[j])
