@@ -112,7 +112,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     else:
         raise ModelError(f"method: {method!r} is neither \"fast\" nor \"careful\"")
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
-    status = ["ok" if s else NO_ASSEMBLY for s in ok]
+    status = ["ok"] * n if ok.all() else ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
     events += _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma)
     values = run.values

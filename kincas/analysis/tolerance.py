@@ -31,6 +31,7 @@ from __future__ import annotations
 import json
 import math
 import sys
+import threading
 import weakref
 from dataclasses import dataclass, field
 
@@ -227,9 +228,16 @@ def _monte_carlo(m: Mechanism, sw, report, to, dp):
 
 
 _FUNCS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # model -> {report: F}
+_FUNCS_LOCK = threading.Lock()  # threads at once build each function once
 
 
 def _sample_function(model, report: tuple[str, ...]):
+    """`_build_sample_function`, built once per model and report, whatever the threads."""
+    with _FUNCS_LOCK:
+        return _build_sample_function(model, report)
+
+
+def _build_sample_function(model, report: tuple[str, ...]):
     """F(q0, u, p0, dp, u', u'') -> (q, |g|max, g_q, quantities): first-order predictor from
     the nominal pose, then NEWTON_STEPS Newton steps, all as one CasADi expression graph."""
     cache = _FUNCS.setdefault(model, {})

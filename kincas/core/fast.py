@@ -45,7 +45,7 @@ import numpy as np
 from .blocks import blocks_of, numeric_signs
 from .compiled import CHUNK, Backend, Library, QuantityEvaluator, ptr, rows, table
 from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, NEAR, RESIDUAL, STEP, SWEEP_C,
-                     kernel_functions, vm_step)
+                     kernel_functions, state_function, vm_step)
 
 # Kernel size, in casadi instructions, beyond which compiling costs more than it saves: gcc
 # -O3 took 1.7 s at 11k instructions, 13 s at 39k and 200 s (3.5 GB) at 150k.
@@ -185,14 +185,24 @@ class FastSweeper:
 
     def state(self, q, u, p) -> np.ndarray:
         """(q, J, T = dq/du, u, T, u) at a solved pose, matrices column-major as in casadi
-        (the second T, u stand for the pose before: the first prediction is linear)."""
-        _, J, Ju = (np.asarray(a) for a in self.sym.f_tangent(q, u, p))
-        try:
-            T = np.linalg.solve(J, -Ju)
-        except np.linalg.LinAlgError:  # a singular start: the next pose fails the branch test
-            T = np.full_like(Ju, np.nan)
-        T, u = T.ravel(order="F"), np.ravel(u)
-        return np.concatenate([np.ravel(q), J.ravel(order="F"), T, u, T, u])
+        (the second T, u stand for the pose before: the first prediction is linear). At a
+        singular start T is not finite, and the next pose fails the branch test."""
+        nq, nu = self.nq, self.nu
+        s = np.empty(nq + nq * nq + 2 * (nq * nu + nu))
+        s[:nq], s[nq + nq * nq + nq * nu:][:nu] = np.ravel(q), np.ravel(u)
+        f = self._state_call()
+        f(s[:nq], s[nq + nq * nq + nq * nu:][:nu], np.ravel(p), s[nq:nq + nq * nq], s[nq + nq * nq:][:nq * nu])
+        s[nq + nq * nq + nq * nu + nu:] = s[nq + nq * nq:nq + nq * nq + nq * nu + nu]
+        return s
+
+    def _state_call(self) -> "_Buffered":
+        f = getattr(self._local, "state", None)
+        if f is None:
+            with self._lock:
+                if getattr(self, "_kT", None) is None:
+                    self._kT = state_function(self.sym, self.blocks)
+            f = self._local.state = _Buffered(self._kT)
+        return f
 
     def measures(self, sol, u, p, L) -> np.ndarray:
         """The kernel's singular measures (signs per group, then sigma) at a solved pose."""
@@ -235,7 +245,10 @@ class FastSweeper:
                     continue
             sol = careful(k, last, r)
             r.record(k, sol)
-            last, k, going = (k if sol.ok else last), k + 1, False
+            if sol.ok and last is None and self.nq and self.nu and self._again(r, k):
+                last, going, k = k, True, k + 1  # the kernel took the pose over: go on from it
+            else:
+                last, k, going = (k if sol.ok else last), k + 1, False
             tick(k - 1, k)
         slow = np.flatnonzero(r.solved & ~r.accepted)
         if self.report and slow.size:
@@ -244,6 +257,17 @@ class FastSweeper:
         if progress is not None:
             progress(r.n, r.n)
         return r
+
+    def _again(self, r: FastRun, k: int) -> bool:
+        """Re-solve the first carefully solved pose k in the kernel (predicted where it is,
+        so Newton stops at once): its quantities and measures then come from the same pass,
+        not from a separate evaluation. False, with the careful record kept, if rejected."""
+        kept = r.Q[k].copy(), r.info[:, k].copy(), r.measures[:, k].copy()
+        if r.advance(k, r.Q[k], r.U[k], k + 1) == k + 1:
+            return True
+        r.Q[k], r.info[:, k], r.measures[:, k] = kept
+        r.solved[k] = True
+        return False
 
     # --- the virtual machine: the same arithmetic, mapaccum over CHUNK poses ---
     def _vm_function(self) -> ca.Function:
@@ -297,6 +321,26 @@ class FastSweeper:
             k += m
         s[:] = np.concatenate(parts)  # where the compiled loop leaves it too
         return stop
+
+
+class _Buffered:
+    """A casadi Function evaluated straight between numpy arrays (about 1 us a call instead
+    of 10-20 through DM). Its buffer holds raw pointers: one per thread, never shared."""
+
+    def __init__(self, f: ca.Function):
+        self.buf, self.call = f.buffer()
+        self.n_in = f.n_in()
+
+    def __call__(self, *arrays):
+        keep = [np.ascontiguousarray(a, dtype=float) for a in arrays]
+        for i, a in enumerate(keep[:self.n_in]):
+            self.buf.set_arg(i, memoryview(a))
+        for i, a in enumerate(keep[self.n_in:]):
+            self.buf.set_res(i, memoryview(a))
+        self.call()
+        for a, b in zip(keep[self.n_in:], arrays[self.n_in:]):
+            if a is not b:
+                b[...] = a
 
 
 def _take(table, idx):

@@ -75,6 +75,14 @@ def kernel_functions(sym, blocks, report=()) -> list[ca.Function]:
                          ca.vertcat(signs, sigma), y, d(step)], o)]
 
 
+def state_function(sym, blocks) -> ca.Function:
+    """kT(q, u, p) -> (g_q, dq/du) dense: the kernel's state at a pose solved elsewhere."""
+    q, u, p = ca.SX.sym("q", sym.nq), ca.SX.sym("u", sym.nu), ca.SX.sym("p", sym.np)
+    Jq, Ju = ca.Function("G", [sym.q, sym.u, sym.p], [sym.Jq, sym.Ju])(q, u, p)
+    return ca.Function("kT", [q, u, p], [ca.densify(Jq), ca.densify(-block_solve(Jq, Ju, blocks))],
+                       {"cse": True})
+
+
 def vm_step(kP, kN, kF, nq, nu, max_evals) -> ca.Function:
     """One pose for the virtual machine, the compiled loop's arithmetic with a fixed number
     of kN evaluations: once a step is below NEAR, q stays put, so it ends where the loop stops.
