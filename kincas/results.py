@@ -63,7 +63,7 @@ class Sweep:
 
     def __post_init__(self):
         for k in list(self.values):
-            if k.endswith(".angle") and not k.startswith("d("):
+            if k.endswith((".angle", ".phi")) and not k.startswith("d("):  # cam.phi too
                 self.values[k] = wrap_angle(self.values[k])
 
     def __len__(self) -> int:

@@ -26,6 +26,7 @@ from ..model.mechanism import Mechanism
 from ..core.numeric import Model, Solution, compile
 from ..results import Pose, Sweep
 from ..core.symbolic import default_report
+from ..core.joints import check_first_pose, settle_first
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
 
@@ -128,6 +129,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     else:
         raise ModelError(f"method: {method!r} is neither \"fast\" nor \"careful\"")
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
+    if ok.any():  # gear centre distances at the first solved pose
+        check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
     status = ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
     events += _singular_events(model, m, U, Q, ok, p, L, flags, J=run.jacobian)
@@ -187,7 +190,7 @@ def _first(model: Model, u, p, L, guess) -> Solution:
     sol = model.newton(q0, u, p, L)
     if not sol.ok:  # IPOPT: the assembly nearest the guessed points
         sol = model.nearest_assembly(q0, u, p, {k: np.array(v) for k, v in guess.items()}, L)
-    return sol
+    return settle_first(model, sol, u, p, L)  # gears relate angles taken in (-pi, pi]
 
 
 def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:

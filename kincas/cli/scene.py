@@ -36,7 +36,7 @@ from ..model.mechanism import GROUND, Input, Link, Mechanism, Param, Slide
 from ..results import Sweep
 
 SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
-            "output", "optimize", "tolerance"}
+            "output", "optimize", "tolerance", "gears", "racks", "cams", "cam_design"}
 
 
 @dataclass
@@ -196,6 +196,8 @@ class _Reader:
             self.err("[ground] ground: the name `ground` means the fixed frame")
         links = [self.link(k, v) for k, v in self.table("links").items()]
         slides = [self.slide(i, s) for i, s in enumerate(self.array("slides"))]
+        from .scene_joints import read as read_joints
+        gears, racks, cams = read_joints(self)
         inputs, values, rates, accs, written = self.inputs()
         guess = {k: self.xy(f"[guess] {k}", v) for k, v in self.table("guess").items()}
         report, sens = self.output()
@@ -203,7 +205,8 @@ class _Reader:
             raise SceneError(self.problems)
         try:
             m = Mechanism(parameters=self.params, ground=ground, links=[lk for lk in links if lk],
-                          slides=slides, inputs=inputs, guess=guess)
+                          slides=slides, inputs=inputs, guess=guess, gears=gears, racks=racks,
+                          cams=cams)
         except KincasError as e:
             raise SceneError(e.problems) from None
         if report is None:

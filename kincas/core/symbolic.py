@@ -31,6 +31,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import GROUND, Mechanism, as_param
+from . import joints as _joints
 
 # --- quantity names ---
 
@@ -54,7 +55,7 @@ def is_angular(name: str) -> bool:
     kind, a, b = parse_quantity(name)
     if kind == "sens":
         return is_angular(a)
-    return b in _LINK_Q
+    return b in _LINK_Q or b in _joints.ANGULAR_ATTRS
 
 
 def default_report(m: Mechanism) -> list[str]:
@@ -124,6 +125,7 @@ class Symbolic:
             ey = self.points[sl.point][1] - (oy + s * tx + c * ty)
             eqs.append(dx * ey - dy * ex)  # distance of the point from the line
             self.slide_s[sl.name] = dx * ex + dy * ey
+        eqs += _joints.equations(self, new)  # relative inputs, gears, racks, cams
         for k, i in enumerate(m.inputs):
             if i.kind == "slide":
                 eqs.append(self.slide_s[i.target] - self.u[k])
@@ -164,7 +166,7 @@ class Symbolic:
             return self.angles[obj], _LINK_Q[attr]
         if attr in _SLIDE_Q and obj in self.slide_s:
             return self.slide_s[obj], _SLIDE_Q[attr]
-        return None, None
+        return _joints.position_expr(self, obj, attr, _LINK_Q, _POINT_Q)
 
     def check_names(self, names: list[str], where: str = "[output] report") -> list[str]:
         """Problems with quantity names (unknown object or attribute)."""
@@ -179,7 +181,8 @@ class Symbolic:
                     out.append(f"{where}: {n!r}: {b!r} is driven by an input (use its rate instead)")
             elif self.position_expr(a, b)[0] is None:
                 out.append(f"{where}: unknown quantity {n!r} (expected P.x, P.vx, P.ax, L.angle, "
-                           f"L.omega, L.alpha, S.s, S.v, S.a or d(Q)/d(p) with declared names)")
+                           f"L.omega, L.alpha, A/B.angle, S.s, S.v, S.a, cam.contact.x, cam.phi, "
+                           f"cam.pressure or d(Q)/d(p) with declared names)")
         return out
 
     def quantity_function(self, names: list[str]) -> ca.Function:
@@ -225,6 +228,8 @@ class Symbolic:
 
     def _order_expr(self, obj, attr, z, zd, zdd):
         e, order = self.position_expr(obj, attr)
+        if order == "pressure":  # a cam's pressure angle: from the follower's velocity
+            return _joints.pressure(self, e, z, zd)
         if order >= 1:
             ed = ca.jtimes(e, z, zd)
             e = ed if order == 1 else ca.jtimes(ed, z, zd) + ca.jtimes(e, z, zdd)
