@@ -23,10 +23,11 @@ import numpy as np
 from ..errors import ModelError
 from ..core.fast import sweeper_for
 from ..model.mechanism import Mechanism
-from ..core.numeric import Model, Solution, compile
+from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
-from ..core.symbolic import default_report
-from ..core.joints import check_first_pose, settle_first
+from ..core.symbolic import default_report, needs_jerk
+from .continuation import careful_pose
+from ..core.joints import check_first_pose
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
 
@@ -65,11 +66,12 @@ def _input_table(m: Mechanism, inputs, what: str, default: float | None) -> np.n
 
 
 def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,
-          guess=None, progress=None, method: str = "fast", compile: bool | None = None) -> Sweep:
+          guess=None, progress=None, method: str = "fast", compile: bool | None = None,
+          jerks=None) -> Sweep:
     """Solve the mechanism at every pose of `inputs` (input key -> array), keeping the branch.
 
-    `rates` and `accelerations` give each input's first and second time derivative (default 1
-    and 0). `report` lists the quantities wanted (default: points and link angles); only what
+    `rates`, `accelerations` and `jerks` give each input's first, second and third time
+    derivative (default 1, 0 and 0). `report` lists the quantities wanted (default: points and link angles); only what
     they need is computed. `guess` overrides the mechanism's guessed points. `progress`, if
     given, is called as progress(done, total) while solving.
 
@@ -99,24 +101,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 
     def careful(k, j, run):
         """Pose k, which the fast pass did not accept, from the last solved pose j."""
-        u = U[k]
-        if j is None:
-            return _first(model, u, p, L, g)
-        fresh = j == k - 1
-        prev = (run.Q[j - 1], U[j - 1]) if fresh and j >= 1 and run.solved[j - 1] else None
-        sol = _continue(model, run.Q[j], U[j], u, p, L, depth=8 if fresh else 0, prev=prev)
-        if sol is None:
-            sol = _recover(model, m, (run.Q[j], U[j]), u, p, L)
-        if sol.ok and not fresh:  # back in range: on the same branch if it exists; say which
-            before = Solution(run.Q[j], 0.0, 0, True, model.jac(run.Q[j], U[j], p))
-            sign, before = _det_sign(model, sol, L), _det_sign(model, before, L)
-            if 0 not in (sign, before) and sign != before:
-                alt = _same_branch_assembly(model, m, u, p, L, before, run.Q[j], U[j])
-                if alt is not None:
-                    sol, sign = alt, before
-            events.append({"kind": "resume", "pose": int(k),
-                           "branch": "same" if sign == before or 0 in (sign, before) else "other"})
-        return sol
+        return careful_pose(model, m, U, p, L, g, k, j, run, events)
 
     # The fast pass (compiled, checked pose by pose) solves what it can; every pose it does
     # not accept goes to the careful path above, and the fast pass restarts after it.
@@ -135,6 +120,15 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     flags = [None] * n
     events += _singular_events(model, m, U, Q, ok, p, L, flags, J=run.jacobian)
     values = run.values
+    if jerks is not None:  # the inputs' jerks enter only the third derivatives
+        Uddd = np.broadcast_to(_input_table(m, jerks, "jerks", 0.0), U.shape)
+        third = [i for i, nm in enumerate(report) if needs_jerk(nm)]
+        if third and ok.any():
+            f = model.sym.quantity_function([report[i] for i in third], jerk=True).map(int(ok.sum()))
+            rep = np.repeat(p.reshape(-1, 1), int(ok.sum()), axis=1)
+            got = np.asarray(f(Q[ok].T, U[ok].T, rep, Ud[ok].T, Udd[ok].T, Uddd[ok].T))
+            values = np.array(values, dtype=float)
+            values[np.ix_(third, np.flatnonzero(ok))] = got
     keys = [i.key for i in m.inputs]
     events.sort(key=lambda e: e["pose"])
     for e in events:
@@ -176,137 +170,10 @@ def _careful_only(model, report, U, Ud, Udd, p, careful, progress) -> _CarefulRu
 
 
 def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,
-          guess=None) -> Pose:
+          guess=None, jerks=None) -> Pose:
     """Solve one pose (inputs: key -> value, or a value for a one-input mechanism)."""
     return sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
-                 guess=guess).pose(0)
-
-
-# --- one pose: from the guess, from the previous pose, after a failure ---
-
-
-def _first(model: Model, u, p, L, guess) -> Solution:
-    q0 = model.initial_q(u, p, guess, L)
-    sol = model.newton(q0, u, p, L)
-    if not sol.ok:  # IPOPT: the assembly nearest the guessed points
-        sol = model.nearest_assembly(q0, u, p, {k: np.array(v) for k, v in guess.items()}, L)
-    return settle_first(model, sol, u, p, L)  # gears relate angles taken in (-pi, pi]
-
-
-def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:
-    """Continuation failed: Newton straight from the last pose, then IPOPT (nearest assembly)."""
-    sol = model.newton(last[0], u, p, L)
-    if not sol.ok:
-        pts = model.points(last[0], last[1], p)
-        sol = model.nearest_assembly(last[0], u, p, {nm: pts[:, j] for j, nm in enumerate(m.moving_points)}, L)
-    return sol
-
-
-def _same_branch_assembly(model: Model, m: Mechanism, u, p, L, sign, q_last, u_last):
-    """Back in range after a gap (a limit, where the branches meet): the assembly whose
-    det(g_q) has the given sign, nearest the last solved pose; None if there is none.
-    The assemblies come from scattered starts, as `kincas modes` finds them."""
-    from .modes import find_modes
-    try:
-        modes = find_modes(m, {i.key: float(v) for i, v in zip(m.inputs, u)}, starts=128)
-    except ModelError:
-        return None
-    last = model.points(q_last, u_last, p)
-    near = [(float(np.linalg.norm(model.points(md.q, u, p) - last)), md.q)
-            for md in modes if md.orientation == sign]
-    if not near:
-        return None
-    sol = model.newton(min(near, key=lambda t: t[0])[1], u, p, L)
-    return sol if sol.ok and _det_sign(model, sol, L) == sign else None
-
-
-def _scaled_norm(model: Model, dq, L) -> float:
-    return float(np.abs(dq / np.where(model.sym.is_length, L, 1.0)).max(initial=0.0))
-
-
-def _continue(model: Model, q0, u0, u1, p, L, depth: int, prev=None) -> Solution | None:
-    """Predict, correct with Newton. The step is halved when the corrector fails or needs
-    many iterations, lands far from the prediction, or the sign of det(g_q) flips (the sign
-    tells the assembly branch apart).
-
-    The predictor is the exact tangent dq/du, except where g_q is nearly singular: there the
-    tangent is undefined (at a change point two branches cross), and the secant through
-    the previous pose `prev` = (q, u) carries the branch straight through.
-    """
-    J0 = model.jac(q0, u0, p)
-    pred = _secant(q0, u0, u1, prev) if prev is not None and _ill(model, J0, L) else None
-    if pred is None:
-        pred = q0 + model.tangent(q0, u0, p) @ (u1 - u0)
-    sol = model.newton(pred, u1, p, L)
-    if sol.ok and depth == 0:
-        return sol
-    if sol.ok:
-        moved = _scaled_norm(model, pred - q0, L)
-        far = _scaled_norm(model, sol.q - pred, L) > max(0.02, 0.5 * moved)
-        if sol.iterations <= 8 and not far and _same_branch(model, J0, sol, L):
-            return sol
-    if depth == 0:
-        return None
-    um = 0.5 * (u0 + u1)
-    mid = _continue(model, q0, u0, um, p, L, depth - 1, prev)
-    return None if mid is None else _continue(model, mid.q, um, u1, p, L, depth - 1, (q0, u0))
-
-
-def _ill(model: Model, J, L) -> bool:
-    """Whether g_q is too close to singular for its tangent to be trusted."""
-    if J.size == 0:
-        return False
-    # The 1-norm condition number (an LU and an inverse) is within a factor n of the 2-norm
-    # one, and several times cheaper than singular values for large mechanisms.
-    with np.errstate(all="ignore"):
-        # (2-norm, from singular values, for a tall g_q: redundant joints)
-        c = np.linalg.cond(J * model.column_scale(L), 1 if model.square else None)
-    return not c < 1e2 * max(1.0, np.sqrt(J.shape[0]))
-
-
-def _secant(q0, u0, u1, prev):
-    """q0 + (q0 - q_prev) t, when the new step continues the previous one's direction."""
-    qp, up = prev
-    d0, d1 = u0 - up, u1 - u0
-    n0 = float(d0 @ d0)
-    if n0 == 0.0:
-        return None
-    t = float(d1 @ d0) / n0
-    if np.linalg.norm(d1 - t * d0) > 1e-9 * np.linalg.norm(d1):
-        return None  # the inputs turned: no straight line to follow
-    return q0 + (q0 - qp) * t
-
-
-def _scaled_det(model: Model, J, L) -> float:
-    # Columns scaled to O(1) so the determinant's size means the same at every scale.
-    return float(np.linalg.det(J * model.column_scale(L))) if J.size else 1.0
-
-
-def _det_sign(model: Model, sol: Solution, L) -> int:
-    """The sign of det(g_q), which tells the assembly branches apart; 0 near a singular
-    position, and for a tall g_q (redundant joints), which has no determinant."""
-    if not model.square:
-        return 0
-    d = _scaled_det(model, sol.J, L)
-    return 0 if abs(d) < 1e-8 else int(np.sign(d))
-
-
-def _same_branch(model: Model, J0, sol: Solution, L) -> bool:
-    """Whether det(g_q) kept its sign from J0 to sol.J (or either is nearly singular).
-
-    A tall g_q (redundant joints) has no determinant, but a relative invariant serves:
-    with J0 = Q0 R0 (Q0 an orthonormal basis of J0's column space), det(Q0' J) is
-    continuous in J and equals det R0 at J0, so it changes sign only where Q0' J is
-    singular: det(Q0' J1) and det(R0) of opposite signs mean a singular position was
-    crossed, exactly as det g_q's sign change does for a square system (for which
-    this is the same test: Q0 is square and orthogonal)."""
-    c = model.column_scale(L)
-    if model.square:
-        d0, d1 = _scaled_det(model, J0, L), _scaled_det(model, sol.J, L)
-    else:
-        Q0, R0 = np.linalg.qr(J0 * c)
-        d0, d1 = float(np.prod(np.diag(R0))), float(np.linalg.det(Q0.T @ (sol.J * c)))
-    return np.sign(d0) == np.sign(d1) or min(abs(d0), abs(d1)) < 1e-8
+                 guess=guess, jerks=jerks).pose(0)
 
 
 # --- singular positions met by a sweep ---

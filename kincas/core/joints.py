@@ -1,7 +1,7 @@
 """Residuals, quantities and placement of gears, racks, cams and relative angle inputs.
 
-Called from `Symbolic._build` (`equations`), `Symbolic.position_expr` (`position_expr`),
-`Model.initial_q` (`relative_start`, `place`) and the first pose of a sweep (`settle_first`,
+Called from `Symbolic._build` (`equations`), as one of Symbolic's quantity extensions
+(`check`, `expression`), from `Model.initial_q` (`relative_start`, `place`) and the first pose of a sweep (`settle_first`,
 `first_pose_problems`). Every equation is written in lengths, so that Newton's residual,
 relative to the mechanism's size, means the same for them as for loop closures:
 
@@ -38,7 +38,7 @@ from ..model.joints import Circle, split_relative
 from ..model.mechanism import GROUND
 
 ANGULAR_ATTRS = {"phi", "pressure"}  # cam quantities in the scene's angle unit
-_PRESSURE_FLOOR = 1e-9  # a follower slower than this times (profile size x input rates) stands
+_PRESSURE_FLOOR = 1e-9  # a follower slower than this times the inputs' speed scale stands
 
 
 # --- equations ---
@@ -128,44 +128,65 @@ def polar_radius(sym, prof, phi):
     return a0 + dt * (b0 + dt * (c0 + dt * d0)), b0 + dt * (2 * c0 + 3 * dt * d0)
 
 
-# --- quantities ---
+# --- quantities (an extension module of Symbolic: `check` and `expression`) ---
+
+_REL_Q = {"angle": 0, "omega": 1, "alpha": 2, "jerk": 3}
+_CONTACT_Q = {"x": (0, 0), "y": (1, 0), "vx": (0, 1), "vy": (1, 1), "ax": (0, 2), "ay": (1, 2)}
 
 
-def position_expr(sym, obj: str, attr: str, link_q: dict, point_q: dict):
-    """(expression, derivative order) of a joint quantity, or (None, None). The pressure
-    angle is (data, "pressure"): it needs velocities, built by `pressure`."""
+def _parse(sym, name: str):
+    """("relative", (A, B), order) | ("contact", cam, (component, order)) | ("phi" or
+    "pressure", cam, None), or None when the name is not a joint quantity."""
+    obj, _, attr = name.rpartition(".")
     rel = split_relative(obj)
-    if rel is not None and attr in link_q:
-        a, b = rel
-        if a in sym.angles and (b == GROUND or b in sym.angles):
-            return sym.frames[a][2] - sym.frames[b][2], link_q[attr]
-        return None, None
+    if rel is not None and attr in _REL_Q:
+        return "relative", rel, _REL_Q[attr]
     cams = getattr(sym, "cams", {})
     head, _, tail = obj.partition(".")
-    if tail == "contact" and head in cams and attr in point_q:
-        comp, order = point_q[attr]
-        return cams[head]["contact"][comp], order
-    if not tail and obj in cams:
-        if attr == "phi":
-            phi = cams[obj]["phi"]
-            return ca.atan2(ca.sin(phi), ca.cos(phi)), 0  # wrapped to (-pi, pi]
-        if attr == "pressure":
-            return cams[obj], "pressure"
-    return None, None
+    if tail == "contact" and head in cams and attr in _CONTACT_Q:
+        return "contact", head, _CONTACT_Q[attr]
+    if obj in cams and attr in ("phi", "pressure"):
+        return attr, obj, None
+    return None
 
 
-def pressure(sym, data, z, zd):
+def check(sym, name: str):
+    """None when `name` is not a joint quantity; else its problems ([] if fine)."""
+    what = _parse(sym, name)
+    if what is None:
+        return None
+    if what[0] == "relative":
+        bodies = set(sym.angles) | {GROUND}
+        return [f"unknown body {b!r} (a link's name or \"ground\")" for b in what[1] if b not in bodies]
+    return []
+
+
+def expression(sym, name: str, t):
+    """A relative angle and its rates, a cam's contact point, contact angle (wrapped to
+    (-pi, pi]) or pressure angle."""
+    kind, obj, order = _parse(sym, name)
+    if kind == "relative":
+        a, b = obj
+        return t.d(sym.frames[a][2] - sym.frames[b][2], order)
+    data = sym.cams[obj]
+    if kind == "contact":
+        return t.d(data["contact"][order[0]], order[1])
+    if kind == "phi":
+        return ca.atan2(ca.sin(data["phi"]), ca.cos(data["phi"]))
+    return pressure(data, t)
+
+
+def pressure(data, t):
     """The acute angle between the common normal and the follower point's absolute velocity,
-    atan2(|n x v|, |n . v|) in [0, pi/2]; NaN for a flat face and where the point stands."""
+    atan2(|n x v|, |n . v|) in [0, pi/2]; NaN for a flat face and where the point stands
+    (|v| <= 1e-9 of the inputs' speed scale, as for kincas/core/geometry.py's nulls)."""
     if data["point"] is None:
         return ca.SX(np.nan)
     n = data["normal"]
-    v = [ca.jtimes(c, z, zd) for c in data["point"]]
+    v = [t.d(c) for c in data["point"]]
     speed = ca.sqrt(v[0] ** 2 + v[1] ** 2)
-    ud = zd[sym.nq:]
-    ref = data["size"] * (ca.mmax(ca.fabs(ud)) if sym.nu else 0)
     ang = ca.atan2(ca.fabs(n[0] * v[1] - n[1] * v[0]), ca.fabs(n[0] * v[0] + n[1] * v[1]))
-    return ca.if_else(speed <= _PRESSURE_FLOOR * ref, np.nan, ang)
+    return ca.if_else(speed <= _PRESSURE_FLOOR * t.speed_scale, np.nan, ang)
 
 
 # --- placement of the first pose ---

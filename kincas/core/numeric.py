@@ -27,6 +27,7 @@ import numpy as np
 
 from ..model.mechanism import Mechanism
 from . import joints as _joints
+from .structure import Structure
 from .symbolic import Symbolic
 
 TOL = 1e-13  # Newton's target: residual relative to the mechanism's size
@@ -114,6 +115,29 @@ class Model:
         self._qfun: dict[tuple, ca.Function] = {}
         self._resjac, self._tangent = _Call(sym.f_resjac), _Call(sym.f_tangent)
         self._res = _Call(sym.f_res)
+        self.structure = Structure(sym)
+
+    # --- structure: Assur groups and their scales ---
+    @property
+    def blocks(self):
+        """The Assur groups of g_q in solve order (see kincas/core/structure.py): each has
+        `.rows` (equations), `.cols` (unknowns), `.size` and `.links`; block i's equations
+        involve only unknowns of blocks 0..i."""
+        return self.structure.blocks
+
+    def scales(self, u, p):
+        """(eq_scale, q_scale): per equation, the length its residual is measured against;
+        per unknown, the scale of a step (1 for an angle, a length for a length unknown).
+        Both come from the unknown's or equation's own group (its block's bodies), not from
+        the whole drawing, so a far point elsewhere loosens nobody's tolerance."""
+        local = np.asarray(self.f_local(u, p), float).ravel()
+        ground = np.asarray(self.f_ground(u, p), float).ravel()
+        Lb = self.structure.block_lengths(local, ground, self.sym.mech.size())
+        eq, qs = np.ones(self.ng), np.ones(self.nq)
+        for b, L in zip(self.blocks, Lb):
+            eq[b.rows] = L
+            qs[b.cols] = np.where(self.sym.is_length[b.cols], L, 1.0)
+        return eq, qs
 
     # --- residuals and Newton ---
     def residual(self, q, u, p) -> np.ndarray:
