@@ -35,6 +35,7 @@ from ..errors import KincasError, SceneError
 from ..model.mechanism import GROUND, Input, Link, Mechanism, Param, Slide
 from ..results import Sweep
 
+LARGEST = 1e100  # beyond it, squared lengths overflow double precision
 SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
             "output", "optimize", "tolerance"}
 
@@ -96,16 +97,21 @@ class Scene:
 def load(path: str | Path) -> Scene:
     """Read a scene file. Raises SceneError (naming section and field) when it is malformed."""
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        data = Path(path).read_bytes()
     except OSError as e:
         raise SceneError(f"scene: cannot read {str(path)!r}: {e.strerror or e}") from None
+    try:
+        text = data.decode("utf-8-sig")  # a byte-order mark, as some editors write, is accepted
+    except UnicodeDecodeError as e:
+        raise SceneError(f"scene: {str(path)!r} is not UTF-8 text (byte 0x{data[e.start]:02x} at "
+                         f"offset {e.start}): save it as UTF-8") from None
     return loads(text)
 
 
 def loads(text: str) -> Scene:
     """Parse a scene from TOML text."""
     try:
-        doc = tomllib.loads(text)
+        doc = tomllib.loads(text.removeprefix("\ufeff"))
     except tomllib.TOMLDecodeError as e:
         raise SceneError(f"scene: not valid TOML: {e}") from None
     return _Reader(doc).scene()
@@ -129,6 +135,7 @@ class _Reader:
         self.units = {"length": "", "angle": "deg", "time": "s",
                       **{k: str(v) for k, v in units.items()}} if isinstance(units, dict) else {}
         self.params = {}
+        self.bad_params = set()  # reported once, where declared; not again where used
 
     def err(self, msg: str):
         self.problems.append(msg)
@@ -144,15 +151,21 @@ class _Reader:
         """A number or a parameter's name; angles converted to radians."""
         k = math.pi / 180 if angle and self.deg else 1.0
         if isinstance(v, str):
-            if v not in self.params:
-                self.err(f"{where}: unknown parameter {v!r}")
+            # "-d": minus parameter d (names cannot start with "-", so this is unambiguous)
+            name, sign = (v[1:], -1.0) if v.startswith("-") else (v, 1.0)
+            if name not in self.params:
+                if name not in self.bad_params:
+                    self.err(f"{where}: unknown parameter {name!r}")
                 return 0.0
-            return Param(v, k) if k != 1.0 else v
+            return Param(name, sign * k) if sign * k != 1.0 else name
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             self.err(f"{where}: expected a number or a parameter's name, got {v!r}")
             return 0.0
         if not math.isfinite(v):
             self.err(f"{where}: {v} is not a finite number")
+            return 0.0
+        if abs(v) > LARGEST:
+            self.err(f"{where}: {v:g} is too large (at most {LARGEST:g}: lengths are squared)")
             return 0.0
         return float(v) * k
 
@@ -187,8 +200,11 @@ class _Reader:
         for k, v in self.table("parameters").items():
             if isinstance(v, bool) or not isinstance(v, (int, float)):
                 self.err(f"[parameters] {k}: expected a number, got {v!r}")
-            elif not math.isfinite(v):
-                self.err(f"[parameters] {k}: {v} is not a finite number")
+                self.bad_params.add(k)
+            elif not math.isfinite(v) or abs(v) > LARGEST:
+                self.err(f"[parameters] {k}: {v} is not a finite number" if not math.isfinite(v)
+                         else f"[parameters] {k}: {v:g} is too large (at most {LARGEST:g})")
+                self.bad_params.add(k)
             else:
                 self.params[k] = float(v)
         ground = {k: self.xy(f"[ground] {k}", v) for k, v in self.table("ground").items()}
@@ -199,6 +215,9 @@ class _Reader:
         inputs, values, rates, accs, written = self.inputs()
         guess = {k: self.xy(f"[guess] {k}", v) for k, v in self.table("guess").items()}
         report, sens = self.output()
+        if not self.doc.get("links"):
+            self.err("[links]: none declared: a mechanism needs at least one moving link "
+                     "(see docs/scene-format.md)")
         if self.problems:
             raise SceneError(self.problems)
         try:
@@ -295,6 +314,8 @@ class _Reader:
                 if isinstance(n, bool) or not isinstance(n, int) or n < 1:
                     self.err(f"{where}: sweep.steps: expected a whole number >= 1, got {n!r}")
                     continue
+                if not self.affordable(f"{where}: sweep.steps", n):
+                    continue
                 a = self.value(f"{where}: sweep.from", sw["from"])
                 b = self.value(f"{where}: sweep.to", sw["to"])
                 vals = np.linspace(a, b, n)
@@ -308,6 +329,25 @@ class _Reader:
             self.err(f"[[inputs]] sweep.steps: inputs that sweep advance together, but their "
                      f"steps differ ({sorted(steps)})")
         return inputs, values, rates, accs, written
+
+    def affordable(self, where: str, steps: int) -> bool:
+        """Whether a sweep of `steps` poses fits in memory (refused up front, before any array
+        is made). The unknowns are counted from the file: at most a point's two coordinates
+        per link point, one per slide."""
+        from . import bounds
+        links = self.doc.get("links", {})
+        nq = sum(len(t.get("points", ())) for t in links.values() if isinstance(t, dict)) \
+            if isinstance(links, dict) else 4
+        nq += len(self.doc.get("slides", [])) if isinstance(self.doc.get("slides"), list) else 0
+        out = self.doc.get("output", {})
+        report = out.get("report") if isinstance(out, dict) else None
+        nrep = len(report) if isinstance(report, list) else 2 * nq
+        try:
+            bounds.check(where, steps, bounds.per_pose(nq, nrep))
+        except ValueError as e:
+            self.err(str(e))
+            return False
+        return True
 
     def output(self):
         out = self.table("output")

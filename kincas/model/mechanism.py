@@ -40,6 +40,7 @@ class Param:
 Num = Union[float, int, str, Param]
 GROUND = "ground"
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
+NAME_RULE = "a name starts with an ASCII letter or _, then ASCII letters, digits, _ or -"
 
 
 def as_param(v: Num) -> Param | None:
@@ -324,20 +325,20 @@ def _check(m: Mechanism) -> list[str]:
 
     for k, v in m.parameters:
         if not _NAME.match(k):
-            out.append(f"[parameters] {k}: not a valid name")
+            out.append(f"[parameters] {k}: not a valid name ({NAME_RULE})")
         if not math.isfinite(v):
             out.append(f"[parameters] {k}: {v} is not a finite number")
     gnames = set()
     for g, (x, y) in m.ground:
         if g == GROUND or not _NAME.match(g):
-            out.append(f"[ground] {g}: not a valid point name")
+            out.append(f"[ground] {g}: not a valid point name ({NAME_RULE})")
         gnames.add(g)
         num(f"[ground] {g}", x), num(f"[ground] {g}", y)
     lnames: set[str] = set()
     for lk in m.links:
         where = f"[links] {lk.name}"
         if lk.name == GROUND or not _NAME.match(lk.name):
-            out.append(f"{where}: not a valid link name")
+            out.append(f"{where}: not a valid link name ({NAME_RULE})")
         if lk.name in lnames:
             out.append(f"{where}: declared twice")
         lnames.add(lk.name)
@@ -348,7 +349,7 @@ def _check(m: Mechanism) -> list[str]:
             out.append(f"{where}: points: a point is named twice")
         for p, (x, y) in lk.points:
             if not _NAME.match(p):
-                out.append(f"{where}: points: {p!r} is not a valid point name")
+                out.append(f"{where}: points: {p!r} is not a valid point name ({NAME_RULE})")
             num(f"{where}: points.{p}" if not lk.two_point else f"{where}: length", x)
             num(f"{where}: points.{p}", y)
         if len([p for p in names if p in gnames]) > 1:
