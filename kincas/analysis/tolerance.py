@@ -325,7 +325,7 @@ def cli_run(args) -> int:
     st = sc.study
     r = analyse(sc.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
                 progress=progress_for(args), **kw)
-    user = lambda n, v: np.degrees(v) if is_angular(n) and st.deg else np.asarray(v, float)
+    user = lambda n, v: np.degrees(v) if is_angular(n, sc.mechanism) and st.deg else np.asarray(v, float)
     inputs = {k: user(k, v) for k, v in r.inputs.items()}
     fo = {n: user(n, r.first_order[n]) for n in r.names}
     mc = {n: user(n, r.monte_carlo[n]) for n in r.names}

@@ -181,9 +181,10 @@ def _unit(sc, name: str) -> str:
         angular = any(isinstance(sl.angle, Param) and sl.angle.name == name and sl.angle.scale != 1
                       for sl in sc.mechanism.slides)
         return A if angular else L
-    base = A if is_angular(name) else L  # input keys L.angle included
-    order = {"vx": 1, "vy": 1, "omega": 1, "v": 1, "ax": 2, "ay": 2, "alpha": 2, "a": 2}.get(attr, 0)
-    return base + ("" if order == 0 else f"/{T}" if order == 1 else f"/{T}^2")
+    base = A if is_angular(name, sc.mechanism) else L  # input keys L.angle included
+    order = {"vx": 1, "vy": 1, "omega": 1, "v": 1, "ax": 2, "ay": 2, "alpha": 2, "a": 2,
+             "jx": 3, "jy": 3, "jerk": 3}.get(attr, 0)
+    return base + ("" if order == 0 else f"/{T}" if order == 1 else f"/{T}^{order}")
 
 
 def _table(sc, sw, inputs, values):

@@ -37,7 +37,7 @@ from ..results import Sweep
 
 LARGEST = 1e100  # beyond it, squared lengths overflow double precision
 SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
-            "output", "optimize", "tolerance"}
+            "output", "optimize", "tolerance", "gravity", "loads"}
 
 
 @dataclass
@@ -52,6 +52,7 @@ class Study:
     report: list[str]
     sensitivity: list[str] = field(default_factory=list)
     written: dict[str, np.ndarray] = field(default_factory=dict)  # inputs as the file gives them
+    jerks: dict[str, float] = field(default_factory=dict)  # the inputs' third derivatives
     raw: dict = field(default_factory=dict, repr=False)  # the parsed TOML, for extensions
 
     @property
@@ -74,6 +75,8 @@ class Scene:
         `user_values(sweep)` give the numbers in the scene's units, as `kincas solve` prints."""
         from ..analysis.sweeps import sweep  # casadi stays out of scene parsing
         st = self.study
+        if any(st.jerks.values()):
+            kw.setdefault("jerks", st.jerks)
         return sweep(self.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
                      report=self.quantities, **kw)
 
@@ -89,7 +92,7 @@ class Scene:
     def user_values(self, s: Sweep) -> dict[str, np.ndarray]:
         """Reported quantities in the scene's units (degrees where the scene says so)."""
         from ..core.symbolic import is_angular
-        return {k: self._to_user(k, v, angle=is_angular(k)) for k, v in s.values.items()}
+        return {k: self._to_user(k, v, angle=is_angular(k, self.mechanism)) for k, v in s.values.items()}
 
     def _to_user(self, name, v, angle):
         # A parameter used as an angle stays in the scene's unit inside, so d(Q)/d(p) is
@@ -138,6 +141,7 @@ class _Reader:
         self.units = {"length": "", "angle": "deg", "time": "s",
                       **{k: str(v) for k, v in units.items()}} if isinstance(units, dict) else {}
         self.params = {}
+        self.jerks: dict[str, float] = {}
         self.bad_params = set()  # reported once, where declared; not again where used
 
     def err(self, msg: str):
@@ -216,6 +220,8 @@ class _Reader:
         links = [self.link(k, v) for k, v in self.table("links").items()]
         slides = [self.slide(i, s) for i, s in enumerate(self.array("slides"))]
         inputs, values, rates, accs, written = self.inputs()
+        from . import scene_loads
+        grav, loads = scene_loads.gravity(self, doc), scene_loads.read_loads(self)
         guess = {k: self.xy(f"[guess] {k}", v) for k, v in self.table("guess").items()}
         report, sens = self.output()
         if not self.doc.get("links"):
@@ -225,7 +231,7 @@ class _Reader:
             raise SceneError(self.problems)
         try:
             m = Mechanism(parameters=self.params, ground=ground, links=[lk for lk in links if lk],
-                          slides=slides, inputs=inputs, guess=guess)
+                          slides=slides, inputs=inputs, guess=guess, gravity=grav, loads=loads)
         except KincasError as e:
             raise SceneError(e.problems) from None
         if report is None:
@@ -234,7 +240,7 @@ class _Reader:
         self.check_quantities(m, report, sens)
         study = Study(title=title if isinstance(title, str) else "", units=self.units,
                       inputs=values, rates=rates, accelerations=accs, report=report,
-                      sensitivity=sens, written=written, raw=doc)
+                      sensitivity=sens, written=written, raw=doc, jerks=self.jerks)
         return Scene(m, study)
 
     def array(self, name) -> list[dict]:
@@ -250,21 +256,22 @@ class _Reader:
             self.err(f"{where}: points: missing (a link is {{ points = [\"P\", \"Q\"], length = L }} "
                      f"or {{ points = {{ P = [x, y], ... }} }})")
             return None
-        pts = t["points"]
+        from .scene_loads import LINK_FIELDS, link_inertia
+        pts, inertia = t["points"], link_inertia(self, where, t)
         if isinstance(pts, list):
-            self.fields(where, t, {"points", "length"})
+            self.fields(where, t, {"points", "length"} | LINK_FIELDS)
             if len(pts) != 2 or not all(isinstance(p, str) for p in pts):
                 self.err(f"{where}: points: the two-point form takes two point names")
                 return None
             if "length" not in t:
                 self.err(f"{where}: length: missing (the two-point form needs a length)")
                 return None
-            return Link.bar(name, pts[0], pts[1], self.num(f"{where}: length", t["length"]))
+            return Link.bar(name, pts[0], pts[1], self.num(f"{where}: length", t["length"]), **inertia)
         if isinstance(pts, dict):
-            self.fields(where, t, {"points"})
+            self.fields(where, t, {"points"} | LINK_FIELDS)
             if "length" in t:
                 self.err(f"{where}: length: only the two-point form takes a length")
-            return Link(name, {p: self.xy(f"{where}: points.{p}", xy) for p, xy in pts.items()})
+            return Link(name, {p: self.xy(f"{where}: points.{p}", xy) for p, xy in pts.items()}, **inertia)
         self.err(f"{where}: points: expected a list of two names or a table of local coordinates")
         return None
 
@@ -289,7 +296,7 @@ class _Reader:
         for i, t in enumerate(self.array("inputs")):
             where = f"[[inputs]] {i + 1}"
             self.fields(where, t, {"angle", "parameter", "slide", "value", "sweep", "rate",
-                                   "acceleration"})
+                                   "acceleration", "jerk"})
             kinds = [k for k in ("angle", "parameter", "slide") if k in t]
             if len(kinds) != 1:
                 self.err(f"{where}: give exactly one of angle, parameter or slide")
@@ -328,6 +335,7 @@ class _Reader:
             values[inp.key] = vals * k
             rates[inp.key] = self.value(f"{where}: rate", t.get("rate", 1.0), ang)
             accs[inp.key] = self.value(f"{where}: acceleration", t.get("acceleration", 0.0), ang)
+            self.jerks[inp.key] = self.value(f"{where}: jerk", t.get("jerk", 0.0), ang)
         if len(steps) > 1:
             self.err(f"[[inputs]] sweep.steps: inputs that sweep advance together, but their "
                      f"steps differ ({sorted(steps)})")
