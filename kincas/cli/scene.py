@@ -36,7 +36,7 @@ from ..model.mechanism import GROUND, Input, Link, Mechanism, Param, Slide
 from ..results import Sweep
 
 SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
-            "output", "optimize", "tolerance"}
+            "output", "optimize", "tolerance", "study"}
 
 
 @dataclass
