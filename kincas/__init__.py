@@ -15,7 +15,7 @@ Jacobians, sensitivities to every named parameter. Angles are radians in Python.
 """
 from . import _aliases
 from .errors import KincasError, ModelError, SceneError
-from .model import Input, Link, Mechanism, Param, Slide
+from .model import Input, Link, Load, Mechanism, Param, Slide
 from .results import Pose, Sweep
 from .core.numeric import compile
 from .analysis.sweeps import solve, sweep
@@ -29,6 +29,7 @@ def __getattr__(name):
     return _aliases.attribute(name)
 
 
-__all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "solve", "sweep", "sweep_designs", "study", "compile",
+__all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "sweep",
+           "sweep_designs", "study", "compile",
            "Pose", "Sweep", "KincasError", "ModelError", "SceneError"]
 __version__ = "0.1.0"

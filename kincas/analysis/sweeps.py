@@ -25,7 +25,7 @@ from ..core.fast import sweeper_for
 from ..model.mechanism import Mechanism
 from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
-from ..core.symbolic import default_report
+from ..core.symbolic import default_report, needs_jerk
 from .continuation import careful_pose
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
@@ -65,11 +65,12 @@ def _input_table(m: Mechanism, inputs, what: str, default: float | None) -> np.n
 
 
 def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,
-          guess=None, progress=None, method: str = "fast", compile: bool | None = None) -> Sweep:
+          guess=None, progress=None, method: str = "fast", compile: bool | None = None,
+          jerks=None) -> Sweep:
     """Solve the mechanism at every pose of `inputs` (input key -> array), keeping the branch.
 
-    `rates` and `accelerations` give each input's first and second time derivative (default 1
-    and 0). `report` lists the quantities wanted (default: points and link angles); only what
+    `rates`, `accelerations` and `jerks` give each input's first, second and third time
+    derivative (default 1, 0 and 0). `report` lists the quantities wanted (default: points and link angles); only what
     they need is computed. `guess` overrides the mechanism's guessed points. `progress`, if
     given, is called as progress(done, total) while solving.
 
@@ -116,6 +117,15 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     flags = [None] * n
     events += _singular_events(model, m, U, Q, ok, p, L, flags, J=run.jacobian)
     values = run.values
+    if jerks is not None:  # the inputs' jerks enter only the third derivatives
+        Uddd = np.broadcast_to(_input_table(m, jerks, "jerks", 0.0), U.shape)
+        third = [i for i, nm in enumerate(report) if needs_jerk(nm)]
+        if third and ok.any():
+            f = model.sym.quantity_function([report[i] for i in third], jerk=True).map(int(ok.sum()))
+            rep = np.repeat(p.reshape(-1, 1), int(ok.sum()), axis=1)
+            got = np.asarray(f(Q[ok].T, U[ok].T, rep, Ud[ok].T, Udd[ok].T, Uddd[ok].T))
+            values = np.array(values, dtype=float)
+            values[np.ix_(third, np.flatnonzero(ok))] = got
     keys = [i.key for i in m.inputs]
     events.sort(key=lambda e: e["pose"])
     for e in events:
@@ -157,10 +167,10 @@ def _careful_only(model, report, U, Ud, Udd, p, careful, progress) -> _CarefulRu
 
 
 def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,
-          guess=None) -> Pose:
+          guess=None, jerks=None) -> Pose:
     """Solve one pose (inputs: key -> value, or a value for a one-input mechanism)."""
     return sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
-                 guess=guess).pose(0)
+                 guess=guess, jerks=jerks).pose(0)
 
 
 # --- singular positions met by a sweep ---

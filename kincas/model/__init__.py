@@ -2,6 +2,7 @@
 
 No casadi and no solving here: see `kincas.core` for that.
 """
+from .loads import Inertia, Load
 from .mechanism import GROUND, Input, Link, Mechanism, Num, Param, Slide, Structure, as_param
 
-__all__ = ["GROUND", "Input", "Link", "Mechanism", "Num", "Param", "Slide", "Structure", "as_param"]
+__all__ = ["Inertia", "Load", "GROUND", "Input", "Link", "Mechanism", "Num", "Param", "Slide", "Structure", "as_param"]

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field, replace
 from typing import Iterable, Mapping, Union
 
 from ..errors import ModelError
+from .loads import Inertia, Load, check_loads
 
 # --- numbers that may name a parameter ---
 
@@ -40,6 +41,7 @@ class Param:
 Num = Union[float, int, str, Param]
 GROUND = "ground"
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
+NAME_RULE = "a name starts with an ASCII letter or _, then ASCII letters, digits, _ or -"
 
 
 def as_param(v: Num) -> Param | None:
@@ -65,7 +67,9 @@ class Link:
 
     `Link.bar(name, P, Q, length)` is the two-point form: origin at P, x axis towards Q.
     `Link(name, {"A": (0, 0), "E": (550, 0)})` is the local-coordinates form; the link's
-    angle is the angle of its frame's x axis.
+    angle is the angle of its frame's x axis. Optional `mass`, `inertia` (about the centre
+    of gravity) and `cg` (in the link's frame; default the mean of its points) give its
+    inertia for efforts and shaking forces (kincas/model/loads.py).
 
     >>> Link.bar("rod", "E", "F", 360).local("F")
     (360, 0.0)
@@ -74,17 +78,20 @@ class Link:
     name: str
     points: tuple[tuple[str, tuple[Num, Num]], ...]
     two_point: bool = False
+    inertial: Inertia = Inertia()
 
-    def __init__(self, name: str, points, two_point: bool = False):
+    def __init__(self, name: str, points, two_point: bool = False, *, mass: Num = 0.0,
+                 inertia: Num = 0.0, cg=None):
         items = points.items() if isinstance(points, Mapping) else points
         object.__setattr__(self, "name", name)
         object.__setattr__(self, "points", tuple((p, _pair(xy)) for p, xy in items))
         object.__setattr__(self, "two_point", two_point)
+        object.__setattr__(self, "inertial", Inertia(mass, inertia, None if cg is None else _pair(cg)))
 
     @classmethod
-    def bar(cls, name: str, p: str, q: str, length: Num) -> "Link":
+    def bar(cls, name: str, p: str, q: str, length: Num, **inertia) -> "Link":
         """Two-point link P-Q of the given length (a number or a parameter name)."""
-        return cls(name, ((p, (0.0, 0.0)), (q, (length, 0.0))), two_point=True)
+        return cls(name, ((p, (0.0, 0.0)), (q, (length, 0.0))), two_point=True, **inertia)
 
     @property
     def point_names(self) -> tuple[str, ...]:
@@ -224,6 +231,8 @@ class Mechanism:
     slides: tuple[Slide, ...] = ()
     inputs: tuple[Input, ...] = ()
     guess: tuple[tuple[str, tuple[Num, Num]], ...] = ()
+    gravity: tuple[Num, Num] = (0.0, 0.0)  # acceleration vector, length/time²
+    loads: tuple[Load, ...] = ()
     structure: Structure = field(init=False, repr=False, compare=False)
     redundant: int = field(init=False, repr=False, compare=False, default=0)
 
@@ -236,6 +245,8 @@ class Mechanism:
         object.__setattr__(self, "links", tuple(self.links))
         object.__setattr__(self, "slides", tuple(self.slides))
         object.__setattr__(self, "inputs", tuple(self.inputs))
+        object.__setattr__(self, "gravity", _pair(self.gravity))
+        object.__setattr__(self, "loads", tuple(self.loads))
         problems = _check(self)
         if problems:
             raise ModelError(problems)
@@ -324,20 +335,20 @@ def _check(m: Mechanism) -> list[str]:
 
     for k, v in m.parameters:
         if not _NAME.match(k):
-            out.append(f"[parameters] {k}: not a valid name")
+            out.append(f"[parameters] {k}: not a valid name ({NAME_RULE})")
         if not math.isfinite(v):
             out.append(f"[parameters] {k}: {v} is not a finite number")
     gnames = set()
     for g, (x, y) in m.ground:
         if g == GROUND or not _NAME.match(g):
-            out.append(f"[ground] {g}: not a valid point name")
+            out.append(f"[ground] {g}: not a valid point name ({NAME_RULE})")
         gnames.add(g)
         num(f"[ground] {g}", x), num(f"[ground] {g}", y)
     lnames: set[str] = set()
     for lk in m.links:
         where = f"[links] {lk.name}"
         if lk.name == GROUND or not _NAME.match(lk.name):
-            out.append(f"{where}: not a valid link name")
+            out.append(f"{where}: not a valid link name ({NAME_RULE})")
         if lk.name in lnames:
             out.append(f"{where}: declared twice")
         lnames.add(lk.name)
@@ -348,7 +359,7 @@ def _check(m: Mechanism) -> list[str]:
             out.append(f"{where}: points: a point is named twice")
         for p, (x, y) in lk.points:
             if not _NAME.match(p):
-                out.append(f"{where}: points: {p!r} is not a valid point name")
+                out.append(f"{where}: points: {p!r} is not a valid point name ({NAME_RULE})")
             num(f"{where}: points.{p}" if not lk.two_point else f"{where}: length", x)
             num(f"{where}: points.{p}", y)
         if len([p for p in names if p in gnames]) > 1:
@@ -386,6 +397,7 @@ def _check(m: Mechanism) -> list[str]:
             what = "is a ground point (fixed)" if p in gnames else "is not a point of any link"
             out.append(f"[guess] {p}: {what}")
         num(f"[guess] {p}", x), num(f"[guess] {p}", y)
+    out += check_loads(m, num)
     if out:
         return out  # the numeric checks below need every name to resolve
     for lk in m.links:

@@ -324,7 +324,7 @@ def report(sc, r: OptimizeResult) -> dict:
     from ..core.symbolic import is_angular
 
     deg = sc.study.deg
-    user = lambda n, v: np.degrees(v) if deg and is_angular(n) else np.asarray(v, float)
+    user = lambda n, v: np.degrees(v) if deg and is_angular(n, sc.mechanism) else np.asarray(v, float)
     bounds = sc.study.raw["optimize"]["vary"]
     key = sc.mechanism.inputs[0].key
     num = lambda v: float(v) if math.isfinite(v) else None
