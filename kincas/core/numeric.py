@@ -2,9 +2,11 @@
 
 `compile(m)` gives the `Model` of m's structure, built once and cached (parameter values are
 numeric inputs, so changing them does not rebuild it). Every CasADi call on a hot path goes
-through zero-copy numpy buffers. Newton aims at a residual of `TOL` times the mechanism's
-size and a pose counts as solved below `ACCEPT`; tolerances relative to the size make a
-mechanism of 1e-6 m and one of 1e6 m reach the same relative accuracy.
+through zero-copy numpy buffers (one set per thread). Newton solves the Assur groups of the
+structure one after another (kincas/core/structure.py), each aiming at a residual of `TOL`
+times its own group's length; a pose counts as solved below `ACCEPT`. Tolerances relative
+to each group make a mechanism of 1e-6 m and one of 1e6 m, or a small group beside a far
+point, reach the same relative accuracy.
 
 >>> import numpy as np, kincas
 >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
@@ -27,12 +29,10 @@ import casadi as ca
 import numpy as np
 
 from ..model.mechanism import Mechanism
+from .newton import lsolve as _lsolve, newton as _newton
 from .structure import Structure
 from .symbolic import Symbolic
-
-TOL = 1e-13  # Newton's target: residual relative to the mechanism's size
-ACCEPT = 1e-10  # a pose whose relative residual is above this is not solved
-MAX_STEP = 0.5  # largest Newton step per iteration: radians, or this times the size
+from .tolerances import ACCEPT, MAX_ITER, MAX_STEP, TOL  # noqa: F401  (their old home)
 
 
 # --- compiled models, one per structure (parameter values stay numeric inputs) ---
@@ -99,16 +99,6 @@ class _Call:
         return [a.reshape(s, order="F").copy(order="F") for a, s in zip(flat, shapes)]
 
 
-def _lsolve(J, b):
-    """J^-1 b; least squares where J is tall (redundant joints) or singular."""
-    if J.shape[0] == J.shape[1]:
-        try:
-            return np.linalg.solve(J, b)
-        except np.linalg.LinAlgError:
-            pass
-    return np.linalg.lstsq(J, b, rcond=None)[0]
-
-
 @dataclass
 class Solution:
     q: np.ndarray
@@ -133,6 +123,7 @@ class Model:
         self._nlp = None
         self._qfun: dict[tuple, ca.Function] = {}
         self._memo: dict = {}
+        self._blocks = None
         self._lock = threading.RLock()  # guards the lazily built members above
         self._resjac, self._tangent = _Call(sym.f_resjac), _Call(sym.f_tangent)
         self._res = _Call(sym.f_res)
@@ -169,35 +160,52 @@ class Model:
         g, J = self._resjac(q, u, p)
         return g.ravel(), J
 
-    def newton(self, q, u, p, L, max_iter=40) -> Solution:
-        """Damped Newton on g(q) = 0 with the exact Jacobian; the residual is relative to L.
+    def newton(self, q, u, p, L=None, max_iter=MAX_ITER) -> Solution:
+        """Solve g(q) = 0 near q, one Assur group after another (kincas/core/newton.py).
 
-        With redundant joints g_q is tall: the step is Gauss-Newton's, the least-squares
-        solution of g_q dq = -g, which converges quadratically on a consistent system
-        (the residual at the solution is zero) where g_q has full column rank."""
+        Each block of `self.blocks` is solved by its own damped Newton with the exact
+        Jacobian, its residual measured against its own group's length (`scales`), with the
+        unknowns of earlier blocks fixed; so the cost grows with the number of groups and a
+        far point elsewhere loosens nobody's tolerance. With redundant joints g_q is tall:
+        the step is Gauss-Newton's, the least-squares solution of g_q dq = -g, which
+        converges quadratically on a consistent system where g_q has full column rank.
+        `L` is not used (tolerances were once relative to the whole mechanism's size).
+        The residual reported is the largest over all equations, each relative to its group.
+        """
         q = np.array(q, dtype=float)
-        g, J = self.resjac(q, u, p)
-        r = np.abs(g).max(initial=0.0) / L
-        scale = np.where(self.sym.is_length, MAX_STEP * L, MAX_STEP)
-        for it in range(max_iter):
-            if r <= TOL:
-                return Solution(q, r, it, True, J)
-            dq = _lsolve(J, -g)
-            if not np.all(np.isfinite(dq)):
+        eq, qs = self.scales(u, p)
+        its, ok = 0, True
+        for b, call in zip(self.blocks, self._block_calls()):
+            def F(x, b=b, call=call):
+                q[b.cols] = x
+                g, J = call(q, u, p)
+                return g.ravel(), J
+            res = _newton(F, q[b.cols], qs[b.cols], eq[b.rows], max_iter=max_iter)
+            q[b.cols] = res.x
+            its = max(its, res.iterations)
+            if not res.ok:
+                ok = False
                 break
-            dq /= max(1.0, np.abs(dq / scale).max())  # a trust region keeps steps on the branch
-            t = 1.0
-            while True:  # backtrack until the residual decreases
-                qn = q + t * dq
-                gn, Jn = self.resjac(qn, u, p)
-                rn = np.abs(gn).max(initial=0.0) / L
-                if rn < (1 - 1e-4 * t) * r or rn <= TOL or t < 1 / 32:
-                    break
-                t /= 2
-            if not rn < r and rn > TOL:
-                break  # no progress: stagnation at a non-solution (or at rounding level)
-            q, g, J, r = qn, gn, Jn, rn
-        return Solution(q, r, max_iter, r <= ACCEPT, J)
+        g, J = self.resjac(q, u, p)
+        r = float(np.abs(g / eq).max(initial=0.0))
+        r = r if np.isfinite(r) else np.inf
+        return Solution(q, r, its, ok and r <= ACCEPT, J)
+
+    def _block_calls(self):
+        """Per block, (q, u, p) -> (its equations, their Jacobian in its unknowns)."""
+        with self._lock:
+            if self._blocks is None:
+                if len(self.blocks) == 1 and self.blocks[0].size == self.nq:
+                    self._blocks = [self._resjac]  # one group: the whole system
+                else:
+                    sym, calls = self.sym, []
+                    for k, b in enumerate(self.blocks):
+                        gb = sym.g[[int(i) for i in b.rows]]
+                        qb = sym.q[[int(j) for j in b.cols]]
+                        calls.append(_Call(ca.Function(f"block{k}", [sym.q, sym.u, sym.p],
+                                                       [gb, ca.jacobian(gb, qb)])))
+                    self._blocks = calls
+            return self._blocks
 
     def tangent(self, q, u, p) -> np.ndarray:
         """dq/du (nq x nu) at a solved pose, from the implicit function theorem:
