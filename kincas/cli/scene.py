@@ -37,8 +37,8 @@ from ..results import Sweep
 
 LARGEST = 1e100  # beyond it, squared lengths overflow double precision
 SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
-            "output", "optimize", "tolerance", "gravity", "loads", "gears", "racks", "cams",
-            "cam_design"}
+            "output", "optimize", "tolerance", "gravity", "loads", "study", "gears", "racks",
+            "cams", "cam_design"}
 
 
 @dataclass
