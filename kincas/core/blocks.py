@@ -14,55 +14,19 @@ triad), and zeros on one side of them. So:
   (sigma_min = 2|d| / (sqrt(F + 2|d|) + sqrt(F - 2|d|)), F = ||A||_F^2), |d| / F^((n-1)/2)
   beyond (the largest singular value is at most sqrt(F)).
 
->>> import numpy as np, casadi as ca, kincas
->>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
-...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
-...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
->>> [(b.rows.tolist(), b.cols.tolist()) for b in blocks_of(kincas.compile(m).sym)]
-[([0, 1], [0, 1])]
+The blocks are `Model.blocks` (kincas/core/structure.py), each with `.rows` and `.cols`.
+
+>>> import numpy as np, casadi as ca
+>>> from kincas.core.structure import Block
 >>> A = ca.DM([[2.0, 1.0], [0.0, 3.0]])
->>> signs, rel = block_measures(A, np.ones(2), blocks_of_sparsity(A.sparsity()))
+>>> signs, rel = block_measures(A, np.ones(2), [Block(np.arange(2), np.arange(2), ())])
 >>> round(float(rel * np.sqrt(14)), 12), round(float(np.linalg.svd(A.full(), compute_uv=False)[-1]), 12)
 (1.84240297561, 1.84240297561)
 """
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import casadi as ca
 import numpy as np
-
-
-class Block(NamedTuple):
-    """One irreducible diagonal block of g_q: its equations (rows) and unknowns (cols)."""
-    rows: np.ndarray
-    cols: np.ndarray
-
-
-# --- the blocks, in an order that solves each after the ones it depends on ---
-
-
-def blocks_of_sparsity(sp: ca.Sparsity) -> list[Block]:
-    """The diagonal blocks of a square sparsity's block-triangular form, in solve order."""
-    if sp.size1() == 0:
-        return []
-    nb, rp, cp, rb, cb, *_ = sp.btf()
-    out = [Block(np.array(rp[rb[b]:rb[b + 1]], dtype=int), np.array(cp[cb[b]:cb[b + 1]], dtype=int))
-           for b in range(nb)]
-    pattern = np.array(ca.DM(sp, 1).full()) != 0
-    needs = [{c for c in range(nb) if c != b and pattern[np.ix_(out[b].rows, out[c].cols)].any()}
-             for b in range(nb)]
-    order, done = [], set()
-    while len(order) < nb:  # a topological order (btf's own is one, upper or lower)
-        b = next(b for b in range(nb) if b not in done and needs[b] <= done)
-        order.append(b)
-        done.add(b)
-    return [out[b] for b in order]
-
-
-def blocks_of(sym) -> list[Block]:
-    """The Assur groups of a square symbolic model as blocks of its g_q (see module text)."""
-    return blocks_of_sparsity(sym.Jq.sparsity())
 
 
 # --- symbolic solves and measures over the blocks ---

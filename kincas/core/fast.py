@@ -42,7 +42,7 @@ import weakref
 import casadi as ca
 import numpy as np
 
-from .blocks import blocks_of, numeric_signs
+from .blocks import numeric_signs
 from .compiled import CHUNK, Backend, Library, QuantityEvaluator, ptr, rows, table
 from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, NEAR, RESIDUAL, STEP, SWEEP_C,
                      kernel_functions, state_function, vm_step)
@@ -349,10 +349,8 @@ def _take(table, idx):
 
 
 def _model_blocks(model):
-    """The model's Assur groups as blocks of g_q, in solve order (`model.blocks` when the
-    model has them, else from g_q's block-triangular form)."""
-    blocks = getattr(model, "blocks", None)
-    return list(blocks) if blocks is not None else blocks_of(model.sym)
+    """The model's Assur groups as blocks of g_q, in solve order."""
+    return list(model.blocks)
 
 
 # --- one sweeper per compiled model and report ---

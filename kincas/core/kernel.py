@@ -137,7 +137,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     if (conv) for (i = 0; i < NQ; ++i) q[i] -= dq[i];
     for (i = 0; i < NQ; ++i) Q[k*NQ + i] = q[i];
     for (i = 0; i < NO; ++i) vals[i*ld + k] = y[i];  /* one contiguous row per quantity */
-    for (i = 0; i < NM; ++i) meas[i*ld + k] = ms[i];
+    if (meas) for (i = 0; i < NM; ++i) meas[i*ld + k] = ms[i];
     info[k] = rf[0]; info[ld + k] = rf[1]; info[2*ld + k] = mc[0]; info[3*ld + k] = mc[1];
     info[4*ld + k] = (casadi_real) it;
     if (!(conv && mc[0] <= thr[2] && mc[1] <= thr[3])) break;
