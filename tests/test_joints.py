@@ -343,3 +343,44 @@ def test_model_errors_from_python():
     with pytest.raises(ModelError, match="profile.circle.radius"):
         Mechanism(ground={"O": (0, 0)}, links=[Link.bar("c", "O", "K", 1), Link.bar("a", "O", "F", 2)],
                   cams=[Cam("k", "c", Circle((0, 0), 0.0), knife="F")], inputs=[Input.angle("c")])
+
+
+# --- pictures ---
+
+
+def _line(ax, label):
+    found = [ln for ln in ax.lines if ln.get_label() == label]
+    assert found, (label, [ln.get_label() for ln in ax.lines])
+    return np.asarray(found[0].get_xydata(), float)
+
+
+def test_pictures_of_gears_racks_and_cams():
+    pytest.importorskip("matplotlib")
+    from matplotlib.figure import Figure
+    from kincas.cli.plot import draw
+    from kincas.cli.scene import load
+
+    def drawn(name, pose, report):
+        sc = load(EXAMPLES / f"{name}.toml")
+        sw = kincas.sweep(sc.mechanism, sc.study.inputs, report=report)
+        return draw(sc.mechanism, sw, pose=pose, ax=Figure().subplots()), sw
+
+    # planetary: the planet's pitch circle (radius 15) about C, the ring's (60) about O
+    ax, sw = drawn("planetary", 5, ["C.x", "C.y"])
+    circles = [xy for ln in ax.lines if ln.get_label() == "planet_ring pitch circle"
+               for xy in [np.asarray(ln.get_xydata())]]
+    centre = np.array([sw["C.x"][5], sw["C.y"][5]])
+    radii = sorted(float(np.hypot(*(xy - xy[:-1].mean(axis=0)).T).mean()) for xy in circles)  # closed: one point twice
+    assert radii == pytest.approx([15, 60], abs=1e-9)
+    assert any(np.allclose(np.hypot(*(xy - centre).T), 15) for xy in circles)
+    # rack: the pitch line 20 below the pinion's path y = 20, that is y = 0
+    ax, _ = drawn("rack_fourbar", 3, [])
+    np.testing.assert_allclose(_line(ax, "rack pitch line")[:, 1], 0, atol=1e-9)
+    # roller cam: the contact dot where kincas puts it, the roller's circle about F
+    ax, sw = drawn("roller_cam", 7, ["cam.contact.x", "cam.contact.y", "F.x", "F.y"])
+    np.testing.assert_allclose(_line(ax, "cam contact")[0], [sw["cam.contact.x"][7], sw["cam.contact.y"][7]])
+    roller = _line(ax, "cam roller") - [sw["F.x"][7], sw["F.y"][7]]
+    np.testing.assert_allclose(np.hypot(*roller.T), 10, atol=1e-9)
+    # flat face: along the tappet's x axis (horizontal) through the contact point
+    ax, sw = drawn("flat_tappet", 4, ["cam.contact.y"])
+    np.testing.assert_allclose(_line(ax, "cam face")[:, 1], sw["cam.contact.y"][4], atol=1e-9)
