@@ -38,7 +38,8 @@ MAX_STEP = 0.5  # largest Newton step per iteration: radians, or this times the 
 
 
 def _structure_key(m: Mechanism):
-    return (tuple(k for k, _ in m.parameters), m.ground, m.links, m.slides, m.inputs)
+    # loads and gravity enter the force quantities' expressions, so they are structure too
+    return (tuple(k for k, _ in m.parameters), m.ground, m.links, m.slides, m.inputs, m.gravity, m.loads)
 
 
 _CACHE: dict = {}
