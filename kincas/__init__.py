@@ -28,5 +28,6 @@ def __getattr__(name):
 
 
 __all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "sweep", "compile",
+           "sensitivities", "analyse", "optimize", "find_modes", "input_range",
            "Pose", "Sweep", "KincasError", "ModelError", "SceneError"]
 __version__ = "0.1.0"

@@ -11,7 +11,7 @@ one before along the exact tangent dq/du = -g_q^-1 g_u, so the branch is kept.
 ...            kincas.Link.bar("rocker", "D", "C", 3)],
 ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
 >>> r = kincas.sweep(m, {"crank.angle": np.linspace(0, 2 * np.pi, 7)}, report=["C.x", "C.y"])
->>> r.status[:2], bool(r.residual.max() < 1e-12)
+>>> r.status[:2].tolist(), bool(r.residual.max() < 1e-12)
 (['ok', 'ok'], True)
 """
 from __future__ import annotations

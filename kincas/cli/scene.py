@@ -19,7 +19,7 @@ in a scene is gathered into one `SceneError` naming the section and the field.
 ... C = [3.6, 2.9]
 ... ''')
 >>> out = sc.run()
->>> out.status, round(float(sc.user_values(out)["rocker.angle"][0]), 4)
+>>> out.status.tolist(), round(float(sc.user_values(out)["rocker.angle"][0]), 4)
 (['ok'], 109.7303)
 """
 from __future__ import annotations
@@ -70,6 +70,9 @@ class Scene:
         return self.study.report + [q for q in self.study.sensitivity if q not in self.study.report]
 
     def run(self, **kw) -> Sweep:
+        """Sweep the mechanism as the scene says. The Sweep is Python's: angles in RADIANS
+        whatever the scene's unit (like every kincas result); `user_inputs(sweep)` and
+        `user_values(sweep)` give the numbers in the scene's units, as `kincas solve` prints."""
         from ..analysis.sweeps import sweep  # casadi stays out of scene parsing
         st = self.study
         if any(st.jerks.values()):
