@@ -30,6 +30,7 @@ COMMANDS = {
     "modes": ("kincas.analysis.modes", "the distinct assembly modes at the scene's input, as [guess] blocks"),
     "optimize": ("kincas.synthesis.optimize", "optimise parameters as the scene's [optimize] section says"),
     "tolerance": ("kincas.analysis.tolerance", "first-order and Monte-Carlo spread of outputs from parameter tolerances"),
+    "study": ("kincas.cli.study", "many designs at once: the scene's [study] section, one row per design"),
 }
 
 
