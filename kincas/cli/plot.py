@@ -18,6 +18,7 @@ shows exactly the poses that were solved; poses not "ok" are left out of paths.
 """
 from __future__ import annotations
 
+import threading
 import weakref
 from collections import Counter
 from dataclasses import dataclass
@@ -71,12 +72,18 @@ class Geometry:
 
 
 _POSE_FUNCTIONS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_POSE_LOCK = threading.Lock()  # threads drawing at once build each function once
 
 
 def _pose_function(model):
     """(q, u, p) -> ground points, moving points, and for each slide its line's point
     `through` and direction angle, all in world coordinates (a body's frame is origin
     (ox, oy) and angle th: a local vector v maps to origin + R(th) v)."""
+    with _POSE_LOCK:
+        return _POSE_FUNCTIONS[model] if model in _POSE_FUNCTIONS else _build_pose_function(model)
+
+
+def _build_pose_function(model):
     if model not in _POSE_FUNCTIONS:
         import casadi as ca
         sym, m = model.sym, model.sym.mech
