@@ -27,6 +27,7 @@ from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
 from ..core.symbolic import default_report
 from .continuation import careful_pose
+from .events import null_derivatives
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
 
@@ -114,8 +115,10 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
     status = ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
-    events += _singular_events(model, m, U, Q, ok, p, L, flags, J=run.jacobian)
+    found, at = _singular_events(model, m, U, Q, ok, p, L, flags, J=run.jacobian)
+    events += found
     values = run.values
+    null_derivatives(model, report, values, Q, U, p, at)  # no wrong number at a singular pose
     keys = [i.key for i in m.inputs]
     events.sort(key=lambda e: e["pose"])
     for e in events:
@@ -166,62 +169,19 @@ def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 # --- singular positions met by a sweep ---
 
 
-def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, J) -> list[dict]:
-    """Flag solved poses at or next to a singular position and locate it exactly.
-
-    A limit lies between a solved pose and a neighbour with no assembly; a sign change of
-    det(g_q) between two solved neighbours means the sweep crossed a singular position
-    (a change point, or a limit met exactly); a pose whose scaled g_q is numerically
-    singular is flagged where it stands.
-    """
-    from .singular import FLAG_SIGMA, classify, locate_singular, scaled_jacobians
-    n, events = len(ok), []
+def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, J):
+    """Each Assur group's mode and conditioning at every solved pose (from g_q per pose), then
+    the events and flags they imply (kincas/analysis/events.py). Returns (events, at: the
+    poses exactly at a singular position, moved onto it)."""
+    from ..core.assembly import modes
+    from .events import sweep_events, tall_orientation
+    n = len(ok)
     if model.nq == 0 or m.inputs == () or n == 0:
-        return events
+        return [], np.zeros(n, dtype=bool)
     idx = np.flatnonzero(ok)
-    J = J[idx]  # g_q per solved pose, as the sweep kept it; g_u only where a pose is flagged
-    J = J * model.column_scale(L)
-    dets = np.zeros(n)
-    if model.square:
-        dets[idx] = np.linalg.det(J) if len(idx) else []
-    elif len(idx):  # tall (redundant joints): no determinant, so chain the relative test of
-        # _same_branch along the sweep: the orientation flips from pose k to the next where
-        # det(Q_k' J_next) and det R_k differ in sign (J_k = Q_k R_k).
-        Qk, Rk = np.linalg.qr(J)
-        dR = np.prod(np.diagonal(Rk, axis1=1, axis2=2), axis=1)
-        o = 1.0
-        for a in range(len(idx)):
-            dets[idx[a]] = o * abs(dR[a])
-            if a + 1 < len(idx):
-                flip = np.sign(dR[a]) * np.sign(np.linalg.det(Qk[a].T @ J[a + 1]))
-                o = o * flip if flip != 0 else o
-    sv = np.linalg.svd(J, compute_uv=False) if len(idx) else np.zeros((0, model.nq))
-    for j in np.flatnonzero(sv[:, -1] <= FLAG_SIGMA * np.maximum(sv[:, 0], 1.0)):
-        Gu = scaled_jacobians(model, Q[idx[j]], U[idx[j]], p, L)[1]
-        flags[idx[j]] = classify(J[j], Gu)
-    # Only a solved pose next to an unsolved one, or before a sign change of det g_q, can hold
-    # an event: look at those alone (a sweep of 10^5 poses has a handful).
-    before = np.r_[False, ~ok[:-1]]
-    after = np.r_[~ok[1:], False]
-    change = np.r_[ok[:-1] & ok[1:] & (np.sign(dets[:-1]) != np.sign(dets[1:])), False]
-    for k in idx[before[idx] | after[idx] | change[idx]]:
-        for nb in (k - 1, k + 1):
-            if not 0 <= nb < n:
-                continue
-            crossing = ok[nb] and nb == k + 1 and np.sign(dets[k]) != np.sign(dets[nb])
-            if ok[nb] and not crossing:
-                continue
-            if np.allclose(U[nb], U[k]):
-                continue
-            found = locate_singular(model, Q[k], U[k], p, L, direction=U[nb] - U[k])
-            if found is None:
-                continue
-            s = found[2]
-            if not (-1e-9 <= s <= 1 + 1e-9):
-                continue  # the singular position found is not between these two poses
-            kind = classify(*scaled_jacobians(model, found[0], found[1], p, L), tol=1e-6) or "singular"
-            at = k if (not ok[nb] or s <= 0.5) else nb
-            flags[at] = flags[at] or kind
-            events.append({"kind": kind, "pose": int(at),
-                           "inputs": {i.key: float(v) for i, v in zip(m.inputs, found[1])}})
-    return events
+    sign, cond = modes(model, J[idx], L)
+    if not model.square and len(idx):  # tall (redundant joints): a relative orientation
+        sign = tall_orientation(J[idx] * model.column_scale(L))[:, None].astype(int)
+    S, C = np.zeros((n, sign.shape[1]), int), np.ones((n, sign.shape[1]))
+    S[idx], C[idx] = sign, cond
+    return sweep_events(model, m, U, Q, ok, p, L, flags, S, C)

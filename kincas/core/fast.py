@@ -200,7 +200,7 @@ class FastRun:
     def jacobian(self) -> np.ndarray:
         """g_q at each pose, (N, nq, nq) (with `jacobians=True`; NaN where not solved)."""
         nq = self.sweeper.nq
-        return self.J.reshape(-1, nq, nq).transpose(0, 2, 1)
+        return self.J.reshape(self.n, nq, nq).transpose(0, 2, 1)  # n: also with no unknowns
 
     def advance(self, start: int, q_last, u_last, stop: int | None = None) -> int:
         """Solve poses start, start + 1, ... (before `stop`, default N) from the solved pose
