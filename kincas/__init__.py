@@ -15,10 +15,12 @@ Jacobians, sensitivities to every named parameter. Angles are radians in Python.
 """
 from . import _aliases
 from .errors import KincasError, ModelError, SceneError
-from .model import Input, Link, Mechanism, Param, Slide
+from .model import Input, Link, Load, Mechanism, Param, Slide
 from .results import Pose, Sweep
 from .core.numeric import compile
 from .analysis.sweeps import solve, sweep
+from .analysis.designs import sweep_designs
+from .synthesis.study import study
 
 _aliases.install()  # `import kincas.modes` and other paths of the flat 0.1 layout
 
@@ -27,6 +29,8 @@ def __getattr__(name):
     return _aliases.attribute(name)
 
 
-__all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "solve", "sweep", "compile",
+__all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "sweep",
+           "sweep_designs", "study", "compile",
+           "sensitivities", "analyse", "optimize", "find_modes", "input_range",
            "Pose", "Sweep", "KincasError", "ModelError", "SceneError"]
 __version__ = "0.1.0"

@@ -309,7 +309,7 @@ def test_driven_crank_alone_and_one_rigid_body():
     th = np.array([0.0, 0.5, 2.0])
     m = Mechanism(ground={"A": (0, 0)}, links=[Link.bar("crank", "A", "B", 2)], inputs=[Input.angle("crank")])
     sw = kincas.sweep(m, {"crank.angle": th}, report=["B.x", "B.y", "B.vx", "B.ay"])
-    assert sw.status == ["ok"] * 3
+    assert list(sw.status) == ["ok"] * 3
     assert np.allclose(sw["B.x"], 2 * np.cos(th), rtol=0, atol=1e-15)
     assert np.allclose(sw["B.vx"], -2 * np.sin(th), rtol=0, atol=1e-15)
     assert np.allclose(sw["B.ay"], -2 * np.sin(th), rtol=0, atol=1e-15)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.assembly import NEAR, assemble, blocks, group_links, modes, polish_singular
+from ..core.joints import settle_first
 from ..core.numeric import Model, Solution
 from ..model.mechanism import Mechanism
 
@@ -71,6 +72,10 @@ def _ambiguous(model: Model) -> bool:
 def _first(model: Model, u, p, L, guess) -> Solution:
     """The first pose: from the guessed points (the nearest assembly), or without a guess
     group by group in the default modes (see kincas/core/assembly.py)."""
+    return settle_first(model, _assembled(model, u, p, L, guess), u, p, L)  # gears: angles in (-pi, pi]
+
+
+def _assembled(model: Model, u, p, L, guess) -> Solution:
     if model.nq == 0:
         return model.newton(np.zeros(0), u, p, L)
     if not guess:
@@ -198,6 +203,14 @@ def _secant(q0, u0, u1, prev):
     if np.linalg.norm(d1 - t * d0) > 1e-9 * np.linalg.norm(d1):
         return None  # the inputs turned: no straight line to follow
     return q0 + (q0 - qp) * t
+
+
+def _det_sign(model: Model, sol: Solution, L) -> int:
+    """The sign of det(g_q) (the product of the groups' modes); 0 near a singular position,
+    and for a tall g_q (redundant joints), which has no determinant."""
+    if not model.square:
+        return 0
+    return int(np.prod(modes(model, sol.J, L)[0]))
 
 
 def _same_branch(model: Model, J0, sol: Solution, L) -> bool:

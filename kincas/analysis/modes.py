@@ -34,7 +34,6 @@ import math
 import re
 import sys
 import tomllib
-import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -146,9 +145,6 @@ def _scatter(m: Mechanism, model, n: int, L: float, seed: int) -> np.ndarray:
 
 # --- Newton from every start at once ---
 
-_STEPS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
-
 def _step_function(model) -> ca.Function:
     """(q, u, p, L) -> (q after one Newton step, relative residual at q), one start.
 
@@ -157,16 +153,15 @@ def _step_function(model) -> ca.Function:
     region that keeps a start from being thrown across the workspace by a near-singular
     Jacobian. Where g_q is singular the step is NaN and that start is dropped.
     """
-    if model not in _STEPS:
+    def build():
         sym = model.sym
         Ls = ca.SX.sym("L")
         dq = -ca.solve(sym.Jq, sym.g)
         scale = ca.if_else(ca.DM(sym.is_length.astype(float)), MAX_STEP * Ls, MAX_STEP)
         shrink = ca.fmax(1, ca.mmax(ca.fabs(dq) / scale)) if sym.nq else ca.SX(1)
         r = ca.mmax(ca.fabs(sym.g)) / Ls if sym.nq else ca.SX(0)
-        _STEPS[model] = ca.Function("newton_step", [sym.q, sym.u, sym.p, Ls],
-                                    [sym.q + dq / shrink, r])
-    return _STEPS[model]
+        return ca.Function("newton_step", [sym.q, sym.u, sym.p, Ls], [sym.q + dq / shrink, r])
+    return model.memo("modes.newton_step", build)
 
 
 def _batch_newton(model, Q, u, p, L, iterations):

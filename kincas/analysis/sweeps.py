@@ -11,7 +11,7 @@ one before along the exact tangent dq/du = -g_q^-1 g_u, so the branch is kept.
 ...            kincas.Link.bar("rocker", "D", "C", 3)],
 ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
 >>> r = kincas.sweep(m, {"crank.angle": np.linspace(0, 2 * np.pi, 7)}, report=["C.x", "C.y"])
->>> r.status[:2], bool(r.residual.max() < 1e-12)
+>>> r.status[:2].tolist(), bool(r.residual.max() < 1e-12)
 (['ok', 'ok'], True)
 """
 from __future__ import annotations
@@ -25,9 +25,10 @@ from ..core.fast import sweeper_for
 from ..model.mechanism import Mechanism
 from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
-from ..core.symbolic import default_report
+from ..core.symbolic import default_report, needs_jerk
 from .continuation import careful_pose
 from .events import null_derivatives
+from ..core.joints import check_first_pose
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
 
@@ -66,11 +67,12 @@ def _input_table(m: Mechanism, inputs, what: str, default: float | None) -> np.n
 
 
 def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,
-          guess=None, progress=None, method: str = "fast", compile: bool | None = None) -> Sweep:
+          guess=None, progress=None, method: str = "fast", compile: bool | None = None,
+          jerks=None) -> Sweep:
     """Solve the mechanism at every pose of `inputs` (input key -> array), keeping the branch.
 
-    `rates` and `accelerations` give each input's first and second time derivative (default 1
-    and 0). `report` lists the quantities wanted (default: points and link angles); only what
+    `rates`, `accelerations` and `jerks` give each input's first, second and third time
+    derivative (default 1, 0 and 0). `report` lists the quantities wanted (default: points and link angles); only what
     they need is computed. `guess` overrides the mechanism's guessed points. `progress`, if
     given, is called as progress(done, total) while solving.
 
@@ -113,11 +115,22 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     else:
         raise ModelError(f"method: {method!r} is neither \"fast\" nor \"careful\"")
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
+    if ok.any():  # gear centre distances at the first solved pose
+        check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
     status = ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
     found, at = _singular_events(model, m, U, Q, ok, p, L, flags, J=run.jacobian)
     events += found
     values = run.values
+    if jerks is not None:  # the inputs' jerks enter only the third derivatives
+        Uddd = np.broadcast_to(_input_table(m, jerks, "jerks", 0.0), U.shape)
+        third = [i for i, nm in enumerate(report) if needs_jerk(nm)]
+        if third and ok.any():
+            f = model.sym.quantity_function([report[i] for i in third], jerk=True).map(int(ok.sum()))
+            rep = np.repeat(p.reshape(-1, 1), int(ok.sum()), axis=1)
+            got = np.asarray(f(Q[ok].T, U[ok].T, rep, Ud[ok].T, Udd[ok].T, Uddd[ok].T))
+            values = np.array(values, dtype=float)
+            values[np.ix_(third, np.flatnonzero(ok))] = got
     null_derivatives(model, report, values, Q, U, p, at)  # no wrong number at a singular pose
     keys = [i.key for i in m.inputs]
     events.sort(key=lambda e: e["pose"])
@@ -160,10 +173,10 @@ def _careful_only(model, report, U, Ud, Udd, p, careful, progress) -> _CarefulRu
 
 
 def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,
-          guess=None) -> Pose:
+          guess=None, jerks=None) -> Pose:
     """Solve one pose (inputs: key -> value, or a value for a one-input mechanism)."""
     return sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
-                 guess=guess).pose(0)
+                 guess=guess, jerks=jerks).pose(0)
 
 
 # --- singular positions met by a sweep ---

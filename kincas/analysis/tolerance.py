@@ -31,7 +31,6 @@ from __future__ import annotations
 import json
 import math
 import sys
-import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -226,15 +225,13 @@ def _monte_carlo(m: Mechanism, sw, report, to, dp):
     return mc, shift, failed, retried
 
 
-_FUNCS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # model -> {report: F}
-
-
 def _sample_function(model, report: tuple[str, ...]):
     """F(q0, u, p0, dp, u', u'') -> (q, |g|max, g_q, quantities): first-order predictor from
     the nominal pose, then NEWTON_STEPS Newton steps, all as one CasADi expression graph."""
-    cache = _FUNCS.setdefault(model, {})
-    if report in cache:
-        return cache[report]
+    return model.memo(("tolerance.sample", report), lambda: _build_sample_function(model, report))
+
+
+def _build_sample_function(model, report):
     import casadi as ca
 
     sym = model.sym
@@ -255,9 +252,7 @@ def _sample_function(model, report: tuple[str, ...]):
     else:
         q, J, r = ca.SX(0, 1), ca.SX(0, 0), ca.SX(0)
     vals = model.quantity_function(report)(q, u, p, ud, udd)
-    F = ca.Function("tolerance_sample", [q0, u, p0, dp, ud, udd], [q, r, ca.vec(J), vals])
-    cache[report] = F
-    return F
+    return ca.Function("tolerance_sample", [q0, u, p0, dp, ud, udd], [q, r, ca.vec(J), vals])
 
 
 # --- scenes: the [tolerance] section ---
@@ -325,14 +320,14 @@ def cli_run(args) -> int:
     st = sc.study
     r = analyse(sc.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
                 progress=progress_for(args), **kw)
-    user = lambda n, v: np.degrees(v) if is_angular(n) and st.deg else np.asarray(v, float)
+    user = lambda n, v: np.degrees(v) if is_angular(n, sc.mechanism) and st.deg else np.asarray(v, float)
     inputs = {k: user(k, v) for k, v in r.inputs.items()}
     fo = {n: user(n, r.first_order[n]) for n in r.names}
     mc = {n: user(n, r.monte_carlo[n]) for n in r.names}
     if args.json:
         doc = {"title": st.title, "units": st.units, "samples": r.samples, "seed": r.seed,
                "std": r.std, "inputs": {k: _list(v) for k, v in inputs.items()},
-               "status": r.status, "failed": r.failed.tolist(),
+               "status": [str(s) for s in r.status], "failed": r.failed.tolist(),
                "nominal": {n: _list(user(n, r.nominal[n])) for n in r.names},
                "first_order": {n: _list(v) for n, v in fo.items()},
                "monte_carlo": {n: _list(v) for n, v in mc.items()},

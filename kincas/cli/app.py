@@ -21,7 +21,7 @@ from .. import __version__
 from ..errors import KincasError, OutputError
 from ..model.mechanism import Param
 
-EXIT_OK, EXIT_SCENE, EXIT_UNSOLVED = 0, 2, 3
+EXIT_OK, EXIT_SCENE, EXIT_UNSOLVED, EXIT_INTERRUPTED = 0, 2, 3, 130
 
 # Further commands live in their own modules: each defines `cli_arguments(parser)` and
 # `cli_run(args) -> exit status`, and is imported only when it exists.
@@ -30,6 +30,7 @@ COMMANDS = {
     "modes": ("kincas.analysis.modes", "the distinct assembly modes at the scene's input, as [guess] blocks"),
     "optimize": ("kincas.synthesis.optimize", "optimise parameters as the scene's [optimize] section says"),
     "tolerance": ("kincas.analysis.tolerance", "first-order and Monte-Carlo spread of outputs from parameter tolerances"),
+    "study": ("kincas.cli.study", "many designs at once: the scene's [study] section, one row per design"),
 }
 
 
@@ -70,7 +71,11 @@ def main(argv: list[str] | None = None) -> int:
         ap.print_help()
         return EXIT_SCENE
     try:
+        _check_args(args)
         return args.run(args) if hasattr(args, "run") else _solve(args)
+    except KeyboardInterrupt:  # Ctrl-C: the user knows why; one line, the shell's usual 130
+        print("\nkincas: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except BrokenPipeError:  # `kincas solve ... | head`: the reader left, nothing is wrong
         sys.stderr.close()
         return EXIT_OK
@@ -82,19 +87,51 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_SCENE
 
 
+def _check_args(args) -> None:
+    """Options every command shares, checked before any work: a seed is >= 0, --write names a
+    directory, and --starts / --samples fit in memory (a typo must not take the machine)."""
+    from pathlib import Path
+    from . import bounds
+    seed = getattr(args, "seed", None)
+    if seed is not None and seed < 0:
+        raise OutputError(f"--seed: expected a whole number >= 0, got {seed}")
+    write = getattr(args, "write", None)
+    if write and Path(write).exists() and not Path(write).is_dir():
+        raise OutputError(f"--write: {write} exists and is not a directory (--write names a directory)")
+    starts, samples = getattr(args, "starts", None), getattr(args, "samples", None)
+    if not (starts or args.command == "tolerance"):
+        return
+    from .scene import load
+    from ..core.numeric import compile
+    sc = load(args.scene)
+    nq, nrep = compile(sc.mechanism).sym.nq, len(sc.quantities)
+    try:
+        if starts:
+            bounds.check("--starts", starts, bounds.per_sample(nq, 0, 0))
+        if args.command == "tolerance":
+            t = sc.study.raw.get("tolerance", {})
+            field, n = ("--samples", samples) if samples else ("[tolerance] samples", t.get("samples"))
+            if isinstance(n, int) and not isinstance(n, bool) and n > 0:
+                std = t.get("std", {})
+                poses = max((len(v) for v in sc.study.inputs.values()), default=1)
+                bounds.check(field, n, bounds.per_sample(nq, nrep, len(std) if isinstance(std, dict) else 1, poses))
+    except ValueError as e:
+        raise OutputError(str(e)) from None
+
+
 def _solve(args) -> int:
     from .scene import load
     sc = load(args.scene)
     wants_files = args.csv or args.plot or args.animate or args.plot_quantities
-    if wants_files:  # a missing matplotlib or a wrong --paths fails before a long solve
+    if wants_files or args.pose is not None:  # wrong options fail before a long solve
         from .outputs import check_outputs
-        check_outputs(args, sc.mechanism)
+        check_outputs(args, sc.mechanism, len(next(iter(sc.study.inputs.values()))))
     sw = sc.run(progress=progress_for(args))
     inputs, values = sc.user_inputs(sw), sc.user_values(sw)
     if args.json:
         doc = {"title": sc.study.title, "units": sc.study.units,
                "inputs": {k: _list(v) for k, v in inputs.items()},
-               "status": sw.status, "flags": sw.flags,
+               "status": sw.status.tolist(), "flags": list(sw.flags),
                "values": {k: _list(v) for k, v in values.items()},
                "events": [_user_event(sc, e) for e in sw.events]}
         # dumps, not dump: json.dump streams through the pure-Python encoder, 4x slower
@@ -145,9 +182,10 @@ def _unit(sc, name: str) -> str:
         angular = any(isinstance(sl.angle, Param) and sl.angle.name == name and sl.angle.scale != 1
                       for sl in sc.mechanism.slides)
         return A if angular else L
-    base = A if is_angular(name) else L  # input keys L.angle included
-    order = {"vx": 1, "vy": 1, "omega": 1, "v": 1, "ax": 2, "ay": 2, "alpha": 2, "a": 2}.get(attr, 0)
-    return base + ("" if order == 0 else f"/{T}" if order == 1 else f"/{T}^2")
+    base = A if is_angular(name, sc.mechanism) else L  # input keys L.angle included
+    order = {"vx": 1, "vy": 1, "omega": 1, "v": 1, "ax": 2, "ay": 2, "alpha": 2, "a": 2,
+             "jx": 3, "jy": 3, "jerk": 3}.get(attr, 0)
+    return base + ("" if order == 0 else f"/{T}" if order == 1 else f"/{T}^{order}")
 
 
 def _table(sc, sw, inputs, values):

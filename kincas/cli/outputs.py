@@ -224,21 +224,67 @@ def _fail(message: str):
     raise OutputError(message)
 
 
-def check_outputs(args, mechanism=None) -> None:
-    """Fail early (one line, exit 2) when a picture is asked for and matplotlib is missing,
-    or when --paths names a point that does not exist."""
+# flag -> (attribute of the parsed arguments, what writes it: "matplotlib", "animation" or None)
+FILE_FLAGS = {"--csv": ("csv", None), "--plot": ("plot", "matplotlib"),
+              "--animate": ("animate", "animation"), "--plot-quantities": ("plot_quantities", "matplotlib")}
+
+
+def check_outputs(args, mechanism=None, poses: int | None = None) -> None:
+    """Fail early (one line, exit 2), before any solve: a picture asked for without matplotlib,
+    a file type that cannot be written, a folder that does not exist or cannot be written,
+    --paths naming a point that does not exist, --pose outside the sweep's `poses`."""
     from .plot import require_matplotlib
-    for flag, attr in (("--plot", "plot"), ("--animate", "animate"), ("--plot-quantities", "plot_quantities")):
-        if getattr(args, attr, None):
+    for flag, (attr, writer) in FILE_FLAGS.items():
+        path = getattr(args, attr, None)
+        if not path:
+            continue
+        if writer:
             try:
                 require_matplotlib(flag)
             except ModuleNotFoundError as e:
                 _fail(str(e))
+        check_path(flag, path, _formats(writer))
+    pose = getattr(args, "pose", None)
+    if poses is not None and pose is not None and not -poses <= pose < poses:
+        _fail(f"--pose: {pose} is not a pose of this sweep (0 to {poses - 1}, or -1 for the last)")
     if mechanism is not None and getattr(args, "paths", None):
         known = set(mechanism.moving_points) | set(mechanism.ground_points)
         bad = [p for p in _names(args.paths) if p not in known]
         if bad:
             _fail(f"--paths: unknown point(s) {', '.join(bad)} (points: {', '.join(sorted(known))})")
+
+
+def check_path(flag: str, path, formats=None) -> None:
+    """The file `path` can be written: its folder exists and is writable, and its extension is
+    one of `formats` (any when None)."""
+    import os
+    from pathlib import Path
+    p = Path(path)
+    folder = p.parent if str(p.parent) else Path(".")
+    if not folder.is_dir():
+        _fail(f"cannot write {path} ({flag}): the folder {folder} does not exist")
+    if not os.access(folder, os.W_OK):
+        _fail(f"cannot write {path} ({flag}): the folder {folder} is not writable")
+    if p.is_dir():
+        _fail(f"cannot write {path} ({flag}): it is a folder")
+    ext = p.suffix.lower().lstrip(".")
+    if formats is not None and ext not in formats:
+        _fail(f"cannot write {path} ({flag}): {repr(ext) + ' is' if ext else 'a file without extension is'} not "
+              f"supported (use one of {', '.join('.' + f for f in sorted(formats))})")
+
+
+def _formats(writer) -> set[str] | None:
+    """File extensions a writer can produce here."""
+    if writer == "matplotlib":
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        return set(FigureCanvasAgg.get_supported_filetypes())
+    if writer == "animation":
+        from matplotlib.animation import writers
+        out = {"gif", "webp", "apng"}  # Pillow, which the plot extra installs
+        if writers.is_available("ffmpeg"):
+            out |= {"mp4", "mkv", "webm", "mov", "avi"}
+        return out
+    return None
 
 
 def _names(text: str) -> list[str]:
@@ -249,11 +295,9 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
     """Write what the flags ask for: args.csv, args.plot, args.animate, args.plot_quantities
     (and, when the parser has them, args.paths "P,Q" and args.pose, the index drawn)."""
     m = scene.mechanism
-    check_outputs(args, m)
+    check_outputs(args, m, len(sweep))
     paths = _names(args.paths) if getattr(args, "paths", None) else None
     pose = getattr(args, "pose", None)
-    if pose is not None and not -len(sweep) <= pose < len(sweep):
-        _fail(f"--pose: {pose} is not a pose of this sweep (0 to {len(sweep) - 1})")
     length = scene.study.units.get("length", "")
     inputs = scene.user_inputs(sweep)
     captions = [_caption(scene, sweep, inputs, i) for i in range(len(sweep))]

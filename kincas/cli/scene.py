@@ -19,7 +19,7 @@ in a scene is gathered into one `SceneError` naming the section and the field.
 ... C = [3.6, 2.9]
 ... ''')
 >>> out = sc.run()
->>> out.status, round(float(sc.user_values(out)["rocker.angle"][0]), 4)
+>>> out.status.tolist(), round(float(sc.user_values(out)["rocker.angle"][0]), 4)
 (['ok'], 109.7303)
 """
 from __future__ import annotations
@@ -35,8 +35,10 @@ from ..errors import KincasError, SceneError
 from ..model.mechanism import GROUND, Input, Link, Mechanism, Param, Slide
 from ..results import Sweep
 
+LARGEST = 1e100  # beyond it, squared lengths overflow double precision
 SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
-            "output", "optimize", "tolerance"}
+            "output", "optimize", "tolerance", "gravity", "loads", "study", "gears", "racks",
+            "cams", "cam_design"}
 
 
 @dataclass
@@ -51,6 +53,7 @@ class Study:
     report: list[str]
     sensitivity: list[str] = field(default_factory=list)
     written: dict[str, np.ndarray] = field(default_factory=dict)  # inputs as the file gives them
+    jerks: dict[str, float] = field(default_factory=dict)  # the inputs' third derivatives
     raw: dict = field(default_factory=dict, repr=False)  # the parsed TOML, for extensions
 
     @property
@@ -68,8 +71,13 @@ class Scene:
         return self.study.report + [q for q in self.study.sensitivity if q not in self.study.report]
 
     def run(self, **kw) -> Sweep:
+        """Sweep the mechanism as the scene says. The Sweep is Python's: angles in RADIANS
+        whatever the scene's unit (like every kincas result); `user_inputs(sweep)` and
+        `user_values(sweep)` give the numbers in the scene's units, as `kincas solve` prints."""
         from ..analysis.sweeps import sweep  # casadi stays out of scene parsing
         st = self.study
+        if any(st.jerks.values()):
+            kw.setdefault("jerks", st.jerks)
         return sweep(self.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
                      report=self.quantities, **kw)
 
@@ -85,7 +93,7 @@ class Scene:
     def user_values(self, s: Sweep) -> dict[str, np.ndarray]:
         """Reported quantities in the scene's units (degrees where the scene says so)."""
         from ..core.symbolic import is_angular
-        return {k: self._to_user(k, v, angle=is_angular(k)) for k, v in s.values.items()}
+        return {k: self._to_user(k, v, angle=is_angular(k, self.mechanism)) for k, v in s.values.items()}
 
     def _to_user(self, name, v, angle):
         # A parameter used as an angle stays in the scene's unit inside, so d(Q)/d(p) is
@@ -96,16 +104,21 @@ class Scene:
 def load(path: str | Path) -> Scene:
     """Read a scene file. Raises SceneError (naming section and field) when it is malformed."""
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        data = Path(path).read_bytes()
     except OSError as e:
         raise SceneError(f"scene: cannot read {str(path)!r}: {e.strerror or e}") from None
+    try:
+        text = data.decode("utf-8-sig")  # a byte-order mark, as some editors write, is accepted
+    except UnicodeDecodeError as e:
+        raise SceneError(f"scene: {str(path)!r} is not UTF-8 text (byte 0x{data[e.start]:02x} at "
+                         f"offset {e.start}): save it as UTF-8") from None
     return loads(text)
 
 
 def loads(text: str) -> Scene:
     """Parse a scene from TOML text."""
     try:
-        doc = tomllib.loads(text)
+        doc = tomllib.loads(text.removeprefix("\ufeff"))
     except tomllib.TOMLDecodeError as e:
         raise SceneError(f"scene: not valid TOML: {e}") from None
     return _Reader(doc).scene()
@@ -129,6 +142,8 @@ class _Reader:
         self.units = {"length": "", "angle": "deg", "time": "s",
                       **{k: str(v) for k, v in units.items()}} if isinstance(units, dict) else {}
         self.params = {}
+        self.jerks: dict[str, float] = {}
+        self.bad_params = set()  # reported once, where declared; not again where used
 
     def err(self, msg: str):
         self.problems.append(msg)
@@ -144,15 +159,21 @@ class _Reader:
         """A number or a parameter's name; angles converted to radians."""
         k = math.pi / 180 if angle and self.deg else 1.0
         if isinstance(v, str):
-            if v not in self.params:
-                self.err(f"{where}: unknown parameter {v!r}")
+            # "-d": minus parameter d (names cannot start with "-", so this is unambiguous)
+            name, sign = (v[1:], -1.0) if v.startswith("-") else (v, 1.0)
+            if name not in self.params:
+                if name not in self.bad_params:
+                    self.err(f"{where}: unknown parameter {name!r}")
                 return 0.0
-            return Param(v, k) if k != 1.0 else v
+            return Param(name, sign * k) if sign * k != 1.0 else name
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             self.err(f"{where}: expected a number or a parameter's name, got {v!r}")
             return 0.0
         if not math.isfinite(v):
             self.err(f"{where}: {v} is not a finite number")
+            return 0.0
+        if abs(v) > LARGEST:
+            self.err(f"{where}: {v:g} is too large (at most {LARGEST:g}: lengths are squared)")
             return 0.0
         return float(v) * k
 
@@ -187,8 +208,11 @@ class _Reader:
         for k, v in self.table("parameters").items():
             if isinstance(v, bool) or not isinstance(v, (int, float)):
                 self.err(f"[parameters] {k}: expected a number, got {v!r}")
-            elif not math.isfinite(v):
-                self.err(f"[parameters] {k}: {v} is not a finite number")
+                self.bad_params.add(k)
+            elif not math.isfinite(v) or abs(v) > LARGEST:
+                self.err(f"[parameters] {k}: {v} is not a finite number" if not math.isfinite(v)
+                         else f"[parameters] {k}: {v:g} is too large (at most {LARGEST:g})")
+                self.bad_params.add(k)
             else:
                 self.params[k] = float(v)
         ground = {k: self.xy(f"[ground] {k}", v) for k, v in self.table("ground").items()}
@@ -196,14 +220,22 @@ class _Reader:
             self.err("[ground] ground: the name `ground` means the fixed frame")
         links = [self.link(k, v) for k, v in self.table("links").items()]
         slides = [self.slide(i, s) for i, s in enumerate(self.array("slides"))]
+        from .scene_joints import read as read_joints
+        gears, racks, cams = read_joints(self)
         inputs, values, rates, accs, written = self.inputs()
+        from . import scene_loads
+        grav, loads = scene_loads.gravity(self, doc), scene_loads.read_loads(self)
         guess = {k: self.xy(f"[guess] {k}", v) for k, v in self.table("guess").items()}
         report, sens = self.output()
+        if not self.doc.get("links"):
+            self.err("[links]: none declared: a mechanism needs at least one moving link "
+                     "(see docs/scene-format.md)")
         if self.problems:
             raise SceneError(self.problems)
         try:
             m = Mechanism(parameters=self.params, ground=ground, links=[lk for lk in links if lk],
-                          slides=slides, inputs=inputs, guess=guess)
+                          slides=slides, inputs=inputs, guess=guess, gravity=grav, loads=loads,
+                          gears=gears, racks=racks, cams=cams)
         except KincasError as e:
             raise SceneError(e.problems) from None
         if report is None:
@@ -212,7 +244,7 @@ class _Reader:
         self.check_quantities(m, report, sens)
         study = Study(title=title if isinstance(title, str) else "", units=self.units,
                       inputs=values, rates=rates, accelerations=accs, report=report,
-                      sensitivity=sens, written=written, raw=doc)
+                      sensitivity=sens, written=written, raw=doc, jerks=self.jerks)
         return Scene(m, study)
 
     def array(self, name) -> list[dict]:
@@ -228,21 +260,22 @@ class _Reader:
             self.err(f"{where}: points: missing (a link is {{ points = [\"P\", \"Q\"], length = L }} "
                      f"or {{ points = {{ P = [x, y], ... }} }})")
             return None
-        pts = t["points"]
+        from .scene_loads import LINK_FIELDS, link_inertia
+        pts, inertia = t["points"], link_inertia(self, where, t)
         if isinstance(pts, list):
-            self.fields(where, t, {"points", "length"})
+            self.fields(where, t, {"points", "length"} | LINK_FIELDS)
             if len(pts) != 2 or not all(isinstance(p, str) for p in pts):
                 self.err(f"{where}: points: the two-point form takes two point names")
                 return None
             if "length" not in t:
                 self.err(f"{where}: length: missing (the two-point form needs a length)")
                 return None
-            return Link.bar(name, pts[0], pts[1], self.num(f"{where}: length", t["length"]))
+            return Link.bar(name, pts[0], pts[1], self.num(f"{where}: length", t["length"]), **inertia)
         if isinstance(pts, dict):
-            self.fields(where, t, {"points"})
+            self.fields(where, t, {"points"} | LINK_FIELDS)
             if "length" in t:
                 self.err(f"{where}: length: only the two-point form takes a length")
-            return Link(name, {p: self.xy(f"{where}: points.{p}", xy) for p, xy in pts.items()})
+            return Link(name, {p: self.xy(f"{where}: points.{p}", xy) for p, xy in pts.items()}, **inertia)
         self.err(f"{where}: points: expected a list of two names or a table of local coordinates")
         return None
 
@@ -267,7 +300,7 @@ class _Reader:
         for i, t in enumerate(self.array("inputs")):
             where = f"[[inputs]] {i + 1}"
             self.fields(where, t, {"angle", "parameter", "slide", "value", "sweep", "rate",
-                                   "acceleration"})
+                                   "acceleration", "jerk"})
             kinds = [k for k in ("angle", "parameter", "slide") if k in t]
             if len(kinds) != 1:
                 self.err(f"{where}: give exactly one of angle, parameter or slide")
@@ -295,6 +328,8 @@ class _Reader:
                 if isinstance(n, bool) or not isinstance(n, int) or n < 1:
                     self.err(f"{where}: sweep.steps: expected a whole number >= 1, got {n!r}")
                     continue
+                if not self.affordable(f"{where}: sweep.steps", n):
+                    continue
                 a = self.value(f"{where}: sweep.from", sw["from"])
                 b = self.value(f"{where}: sweep.to", sw["to"])
                 vals = np.linspace(a, b, n)
@@ -304,10 +339,30 @@ class _Reader:
             values[inp.key] = vals * k
             rates[inp.key] = self.value(f"{where}: rate", t.get("rate", 1.0), ang)
             accs[inp.key] = self.value(f"{where}: acceleration", t.get("acceleration", 0.0), ang)
+            self.jerks[inp.key] = self.value(f"{where}: jerk", t.get("jerk", 0.0), ang)
         if len(steps) > 1:
             self.err(f"[[inputs]] sweep.steps: inputs that sweep advance together, but their "
                      f"steps differ ({sorted(steps)})")
         return inputs, values, rates, accs, written
+
+    def affordable(self, where: str, steps: int) -> bool:
+        """Whether a sweep of `steps` poses fits in memory (refused up front, before any array
+        is made). The unknowns are counted from the file: at most a point's two coordinates
+        per link point, one per slide."""
+        from . import bounds
+        links = self.doc.get("links", {})
+        nq = sum(len(t.get("points", ())) for t in links.values() if isinstance(t, dict)) \
+            if isinstance(links, dict) else 4
+        nq += len(self.doc.get("slides", [])) if isinstance(self.doc.get("slides"), list) else 0
+        out = self.doc.get("output", {})
+        report = out.get("report") if isinstance(out, dict) else None
+        nrep = len(report) if isinstance(report, list) else 2 * nq
+        try:
+            bounds.check(where, steps, bounds.per_pose(nq, nrep))
+        except ValueError as e:
+            self.err(str(e))
+            return False
+        return True
 
     def output(self):
         out = self.table("output")

@@ -34,7 +34,9 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-from .numeric import MAX_STEP, TOL, ACCEPT, Solution
+from .newton import newton
+from .numeric import Solution
+from .tolerances import ACCEPT, TOL
 
 SIGN_TOL = 1e-8  # a block whose conditioning is below this has no trustworthy sign (mode 0)
 # Newton converges only linearly onto a singular position, and stops about sqrt(TOL) from
@@ -58,8 +60,9 @@ def blocks(model) -> list[tuple[np.ndarray, np.ndarray]]:
         return memo[0]
     nq, ng = model.nq, model.ng
     own = getattr(model, "blocks", None)
-    if own is not None:
-        out = [(np.asarray(b.rows, int), np.asarray(b.cols, int)) for b in own]
+    if own is not None:  # already in solve order (kincas/core/structure.py)
+        memo.append([(np.asarray(b.rows, int), np.asarray(b.cols, int)) for b in own])
+        return memo[0]
     else:
         out = []
         if nq and ng == nq:
@@ -124,37 +127,25 @@ def modes(model, J, L) -> tuple[np.ndarray, np.ndarray]:
 # --- group by group assembly ---
 
 
-def _block_newton(model, q, u, p, L, rows, cols, max_iter=30):
-    """Newton on block (rows, cols) alone (the other unknowns fixed): (q, residual / L)."""
+def _block_newton(model, q, u, p, L, i, max_iter=30):
+    """The one Newton (kincas/core/newton.py) on group i alone, the other unknowns fixed, its
+    residual measured against its own length: (q, relative residual)."""
+    rows, cols = blocks(model)[i]
+    eq, qs = model.scales(u, p) if hasattr(model, "scales") else (np.full(model.ng, L), np.where(model.sym.is_length, L, 1.0))
     q = q.copy()
-    scale = np.where(model.sym.is_length[cols], MAX_STEP * L, MAX_STEP)
-    g, J = model.resjac(q, u, p)
-    r = np.abs(g[rows]).max(initial=0.0) / L
-    for _ in range(max_iter):
-        if r <= TOL:
-            break
-        Jb = J[np.ix_(rows, cols)]
-        try:
-            dq = np.linalg.lstsq(Jb, -g[rows], rcond=None)[0] if len(rows) != len(cols) \
-                else np.linalg.solve(Jb, -g[rows])
-        except np.linalg.LinAlgError:
-            break
-        if not np.all(np.isfinite(dq)):
-            break
-        dq /= max(1.0, np.abs(dq / scale).max())
-        t = 1.0
-        while True:
-            qn = q.copy()
-            qn[cols] += t * dq
-            gn, Jn = model.resjac(qn, u, p)
-            rn = np.abs(gn[rows]).max(initial=0.0) / L
-            if rn < (1 - 1e-4 * t) * r or t < 1 / 16:
-                break
-            t /= 2
-        if not rn < 0.999 * r:
-            break  # no progress: this start leads nowhere (or is already at rounding)
-        q, g, J, r = qn, gn, Jn, rn
-    return q, r
+    calls = model._block_calls() if hasattr(model, "_block_calls") else None
+    own = calls is not None and len(calls) == len(blocks(model))
+
+    def F(x):
+        q[cols] = x
+        if own:
+            g, J = calls[i](q, u, p)
+            return g.ravel().copy(), J.copy()
+        g, J = model.resjac(q, u, p)
+        return g[rows], J[np.ix_(rows, cols)]
+    res = newton(F, q[cols], qs[cols], eq[rows], max_iter=max_iter)
+    q[cols] = res.x
+    return q, res.residual
 
 
 def _starts(model, cols, L, near, count):
@@ -181,7 +172,7 @@ def _candidates(model, q, u, p, L, i, target, near, starts):
     for s in _starts(model, cols, L, near, starts if len(cols) <= 2 else 4 * starts):
         q0 = q.copy()
         q0[cols] = s
-        qs, r = _block_newton(model, q0, u, p, L, rows, cols)
+        qs, r = _block_newton(model, q0, u, p, L, i)
         if r > ACCEPT:
             continue
         mode = modes(model, model.jac(qs, u, p), L)[0][i]

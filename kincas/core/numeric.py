@@ -2,9 +2,11 @@
 
 `compile(m)` gives the `Model` of m's structure, built once and cached (parameter values are
 numeric inputs, so changing them does not rebuild it). Every CasADi call on a hot path goes
-through zero-copy numpy buffers. Newton aims at a residual of `TOL` times the mechanism's
-size and a pose counts as solved below `ACCEPT`; tolerances relative to the size make a
-mechanism of 1e-6 m and one of 1e6 m reach the same relative accuracy.
+through zero-copy numpy buffers (one set per thread). Newton solves the Assur groups of the
+structure one after another (kincas/core/structure.py), each aiming at a residual of `TOL`
+times its own group's length; a pose counts as solved below `ACCEPT`. Tolerances relative
+to each group make a mechanism of 1e-6 m and one of 1e6 m, or a small group beside a far
+point, reach the same relative accuracy.
 
 >>> import numpy as np, kincas
 >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
@@ -20,71 +22,83 @@ mechanism of 1e-6 m and one of 1e6 m reach the same relative accuracy.
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
 from ..model.mechanism import Mechanism
+from . import joints as _joints
+from .newton import lsolve as _lsolve, newton as _newton
+from .structure import Structure
 from .symbolic import Symbolic
-
-TOL = 1e-13  # Newton's target: residual relative to the mechanism's size
-ACCEPT = 1e-10  # a pose whose relative residual is above this is not solved
-MAX_STEP = 0.5  # largest Newton step per iteration: radians, or this times the size
+from .tolerances import ACCEPT, MAX_ITER, MAX_STEP, TOL  # noqa: F401  (their old home)
 
 
 # --- compiled models, one per structure (parameter values stay numeric inputs) ---
 
 
 def _structure_key(m: Mechanism):
-    return (tuple(k for k, _ in m.parameters), m.ground, m.links, m.slides, m.inputs)
+    return (tuple(k for k, _ in m.parameters), m.ground, m.links, m.slides, m.inputs,
+            m.gears, m.racks, m.cams)
 
 
 _CACHE: dict = {}
+_CACHE_LOCK = threading.Lock()
 
 
 def compile(m: Mechanism) -> "Model":
-    """The compiled model of `m`'s structure (cached: changing parameters does not recompile)."""
+    """The compiled model of `m`'s structure (cached: changing parameters does not recompile).
+
+    Safe from several threads: the cache is guarded by a lock, and a `Model` holds no numeric
+    state shared between calls."""
     key = _structure_key(m)
-    if key not in _CACHE:
-        if len(_CACHE) >= 64:
-            _CACHE.pop(next(iter(_CACHE)))
-        _CACHE[key] = Model(Symbolic(m))  # Symbolic never reads parameter values
-    return _CACHE[key]
+    with _CACHE_LOCK:
+        model = _CACHE.get(key)
+    if model is None:
+        model = Model(Symbolic(m))  # Symbolic never reads parameter values
+        with _CACHE_LOCK:  # another thread may have built it meanwhile: keep the first
+            model = _CACHE.setdefault(key, model)
+            while len(_CACHE) > 64:
+                _CACHE.pop(next(iter(_CACHE)))
+    return model
 
 
 class _Call:
     """A casadi Function called through zero-copy numpy buffers: no DM conversions, about
-    0.1 us of overhead instead of 10 (see shared/casadi-notes.md). Outputs are dense and
-    overwritten by the next call: copy what must be kept."""
+    0.1 us of overhead instead of 10 (see shared/casadi-notes.md).
+
+    Each thread gets its own buffers (a casadi buffer is work space: two threads sharing
+    one overwrite each other's outputs), and each call returns fresh copies of the outputs,
+    so a caller may keep them and the call is re-entrant."""
 
     def __init__(self, f: ca.Function):
         ins = f.sx_in()
         self.f = ca.Function(f.name() + "_dense", ins, [ca.densify(o) for o in f.call(ins)])
-        self._in = [np.zeros(self.f.nnz_in(i)) for i in range(self.f.n_in())]
-        self._flat = [np.zeros(self.f.nnz_out(i)) for i in range(self.f.n_out())]
-        self.out = [a.reshape(self.f.size_out(i), order="F") for i, a in enumerate(self._flat)]
-        self._buf, self._eval = self.f.buffer()  # keep both referenced (raw pointers inside)
-        for i, a in enumerate(self._in):
-            self._buf.set_arg(i, memoryview(a))
-        for i, a in enumerate(self._flat):
-            self._buf.set_res(i, memoryview(a))
+        self._local = threading.local()
+
+    def _buffers(self):
+        b = getattr(self._local, "b", None)
+        if b is None:
+            f = self.f
+            ins = [np.zeros(f.nnz_in(i)) for i in range(f.n_in())]
+            flat = [np.zeros(f.nnz_out(i)) for i in range(f.n_out())]
+            buf, ev = f.buffer()  # keep buf referenced with ev: raw pointers inside
+            for i, a in enumerate(ins):
+                buf.set_arg(i, memoryview(a))
+            for i, a in enumerate(flat):
+                buf.set_res(i, memoryview(a))
+            shapes = [f.size_out(i) for i in range(f.n_out())]
+            b = self._local.b = (ins, flat, shapes, buf, ev)
+        return b
 
     def __call__(self, *args):
-        for a, x in zip(self._in, args):
+        ins, flat, shapes, _, ev = self._buffers()
+        for a, x in zip(ins, args):
             a[:] = np.ravel(x, order="F")
-        self._eval()
-        return self.out
-
-
-def _lsolve(J, b):
-    """J^-1 b; least squares where J is tall (redundant joints) or singular."""
-    if J.shape[0] == J.shape[1]:
-        try:
-            return np.linalg.solve(J, b)
-        except np.linalg.LinAlgError:
-            pass
-    return np.linalg.lstsq(J, b, rcond=None)[0]
+        ev()
+        return [a.reshape(s, order="F").copy(order="F") for a, s in zip(flat, shapes)]
 
 
 @dataclass
@@ -110,47 +124,90 @@ class Model:
         self.f_ground = ca.Function("ground", [sym.u, sym.p], [ca.vertcat(*gxy) if gxy else ca.SX(0, 1)])
         self._nlp = None
         self._qfun: dict[tuple, ca.Function] = {}
+        self._memo: dict = {}
+        self._blocks = None
+        self._lock = threading.RLock()  # guards the lazily built members above
         self._resjac, self._tangent = _Call(sym.f_resjac), _Call(sym.f_tangent)
         self._res = _Call(sym.f_res)
+        self.structure = Structure(sym)
+
+    # --- structure: Assur groups and their scales ---
+    @property
+    def blocks(self):
+        """The Assur groups of g_q in solve order (see kincas/core/structure.py): each has
+        `.rows` (equations), `.cols` (unknowns), `.size` and `.links`; block i's equations
+        involve only unknowns of blocks 0..i."""
+        return self.structure.blocks
+
+    def scales(self, u, p):
+        """(eq_scale, q_scale): per equation, the length its residual is measured against;
+        per unknown, the scale of a step (1 for an angle, a length for a length unknown).
+        Both come from the unknown's or equation's own group (its block's bodies), not from
+        the whole drawing, so a far point elsewhere loosens nobody's tolerance."""
+        local = np.asarray(self.f_local(u, p), float).ravel()
+        ground = np.asarray(self.f_ground(u, p), float).ravel()
+        Lb = self.structure.block_lengths(local, ground, self.sym.mech.size())
+        eq, qs = np.ones(self.ng), np.ones(self.nq)
+        for b, L in zip(self.blocks, Lb):
+            eq[b.rows] = L
+            qs[b.cols] = np.where(self.sym.is_length[b.cols], L, 1.0)
+        return eq, qs
 
     # --- residuals and Newton ---
     def residual(self, q, u, p) -> np.ndarray:
-        return self._res(q, u, p)[0].ravel().copy()
+        return self._res(q, u, p)[0].ravel()
 
     def resjac(self, q, u, p):
         """(g, g_q) at a pose, as fresh numpy arrays."""
         g, J = self._resjac(q, u, p)
-        return g.ravel().copy(), J.copy()
+        return g.ravel(), J
 
-    def newton(self, q, u, p, L, max_iter=40) -> Solution:
-        """Damped Newton on g(q) = 0 with the exact Jacobian; the residual is relative to L.
+    def newton(self, q, u, p, L=None, max_iter=MAX_ITER) -> Solution:
+        """Solve g(q) = 0 near q, one Assur group after another (kincas/core/newton.py).
 
-        With redundant joints g_q is tall: the step is Gauss-Newton's, the least-squares
-        solution of g_q dq = -g, which converges quadratically on a consistent system
-        (the residual at the solution is zero) where g_q has full column rank."""
+        Each block of `self.blocks` is solved by its own damped Newton with the exact
+        Jacobian, its residual measured against its own group's length (`scales`), with the
+        unknowns of earlier blocks fixed; so the cost grows with the number of groups and a
+        far point elsewhere loosens nobody's tolerance. With redundant joints g_q is tall:
+        the step is Gauss-Newton's, the least-squares solution of g_q dq = -g, which
+        converges quadratically on a consistent system where g_q has full column rank.
+        `L` is not used (tolerances were once relative to the whole mechanism's size).
+        The residual reported is the largest over all equations, each relative to its group.
+        """
         q = np.array(q, dtype=float)
-        g, J = self.resjac(q, u, p)
-        r = np.abs(g).max(initial=0.0) / L
-        scale = np.where(self.sym.is_length, MAX_STEP * L, MAX_STEP)
-        for it in range(max_iter):
-            if r <= TOL:
-                return Solution(q, r, it, True, J)
-            dq = _lsolve(J, -g)
-            if not np.all(np.isfinite(dq)):
+        eq, qs = self.scales(u, p)
+        its, ok = 0, True
+        for b, call in zip(self.blocks, self._block_calls()):
+            def F(x, b=b, call=call):
+                q[b.cols] = x
+                g, J = call(q, u, p)
+                return g.ravel(), J
+            res = _newton(F, q[b.cols], qs[b.cols], eq[b.rows], max_iter=max_iter)
+            q[b.cols] = res.x
+            its = max(its, res.iterations)
+            if not res.ok:
+                ok = False
                 break
-            dq /= max(1.0, np.abs(dq / scale).max())  # a trust region keeps steps on the branch
-            t = 1.0
-            while True:  # backtrack until the residual decreases
-                qn = q + t * dq
-                gn, Jn = self.resjac(qn, u, p)
-                rn = np.abs(gn).max(initial=0.0) / L
-                if rn < (1 - 1e-4 * t) * r or rn <= TOL or t < 1 / 32:
-                    break
-                t /= 2
-            if not rn < r and rn > TOL:
-                break  # no progress: stagnation at a non-solution (or at rounding level)
-            q, g, J, r = qn, gn, Jn, rn
-        return Solution(q, r, max_iter, r <= ACCEPT, J)
+        g, J = self.resjac(q, u, p)
+        r = float(np.abs(g / eq).max(initial=0.0))
+        r = r if np.isfinite(r) else np.inf
+        return Solution(q, r, its, ok and r <= ACCEPT, J)
+
+    def _block_calls(self):
+        """Per block, (q, u, p) -> (its equations, their Jacobian in its unknowns)."""
+        with self._lock:
+            if self._blocks is None:
+                if len(self.blocks) == 1 and self.blocks[0].size == self.nq:
+                    self._blocks = [self._resjac]  # one group: the whole system
+                else:
+                    sym, calls = self.sym, []
+                    for k, b in enumerate(self.blocks):
+                        gb = sym.g[[int(i) for i in b.rows]]
+                        qb = sym.q[[int(j) for j in b.cols]]
+                        calls.append(_Call(ca.Function(f"block{k}", [sym.q, sym.u, sym.p],
+                                                       [gb, ca.jacobian(gb, qb)])))
+                    self._blocks = calls
+            return self._blocks
 
     def tangent(self, q, u, p) -> np.ndarray:
         """dq/du (nq x nu) at a solved pose, from the implicit function theorem:
@@ -165,7 +222,7 @@ class Model:
         return np.where(self.sym.is_length, 1.0, 1.0 / L)
 
     def jac(self, q, u, p) -> np.ndarray:
-        return self._resjac(q, u, p)[1].copy()
+        return self._resjac(q, u, p)[1]
 
     def points(self, q, u, p) -> np.ndarray:
         """World positions of the moving points, 2 x n."""
@@ -193,6 +250,7 @@ class Model:
         index = {name: i for i, (name, _) in enumerate(sym.unknowns)}
         angle_in = {i.target: u[k] for k, i in enumerate(m.inputs) if i.kind == "angle"}
         centre = np.mean(list(gv.values()), axis=0) if gv else np.zeros(2)
+        theta = {"ground": 0.0}  # angles placed so far (a relative input starts from them)
         for lname, at in m.structure.order:
             pts = [pt for pt, _ in m.link(lname).points]
             ref = [pt for pt in pts if pt in guessed or pt in known]
@@ -205,7 +263,7 @@ class Model:
                     d = pos[others[0]] - anchor
                     dl = loc[(lname, others[0])] - loc[(lname, at)]
                     th = math.atan2(d[1], d[0]) - math.atan2(dl[1], dl[0])
-                th = float(angle_in.get(lname, th))
+                th = float(angle_in.get(lname, _joints.relative_start(m, lname, u, theta, th)))
                 c, s = math.cos(th), math.sin(th)
                 R = np.array([[c, -s], [s, c]])
                 origin = known[at] - R @ loc[(lname, at)]
@@ -214,37 +272,26 @@ class Model:
                 if len(ref) >= 2:
                     d, dl = pos[ref[1]] - pos[ref[0]], loc[(lname, ref[1])] - loc[(lname, ref[0])]
                     th = math.atan2(d[1], d[0]) - math.atan2(dl[1], dl[0])
-                th = float(angle_in.get(lname, th))
+                th = float(angle_in.get(lname, _joints.relative_start(m, lname, u, theta, th)))
                 c, s = math.cos(th), math.sin(th)
                 R = np.array([[c, -s], [s, c]])
                 origin = (pos[ref[0]] - R @ loc[(lname, ref[0])]) if ref else centre
                 q[index[f"{lname}.x"]], q[index[f"{lname}.y"]] = origin
             if f"{lname}.angle" in index:
                 q[index[f"{lname}.angle"]] = th
+            theta[lname] = th
             for pt in pts:
                 known.setdefault(pt, origin + R @ loc[(lname, pt)])
-        return q
+        return _joints.place(self, q, u, p)  # cams' contact parameters; angles in (-pi, pi]
 
     # --- IPOPT: the assembly nearest to target positions ---
     def nearest_assembly(self, q0, u, p, targets: dict[str, np.ndarray], L) -> Solution:
         """min sum |P - target|^2 subject to g = 0, by IPOPT (scaled by the size L)."""
         sym, names = self.sym, list(self.sym.mech.moving_points)
-        if self._nlp is None:
-            x = ca.SX.sym("x", self.nq)
-            npt = len(names)
-            T, W = ca.SX.sym("T", 2, npt), ca.SX.sym("W", npt)
-            x0, Ls = ca.SX.sym("x0", self.nq), ca.SX.sym("L")
-            qscale = ca.if_else(ca.DM(sym.is_length.astype(float)), Ls, 1)
-            q = x * qscale
-            subst = lambda e: ca.substitute(e, sym.q, q)
-            P = subst(sym._point_matrix())
-            obj = ca.mtimes(ca.sum1((P - T) ** 2), W) / Ls ** 2 + 1e-6 * ca.sumsqr(x - x0)
-            par = ca.vertcat(sym.u, sym.p, ca.vec(T), W, x0, Ls)
-            nlp = {"x": x, "p": par, "f": obj, "g": subst(sym.g) / Ls}
-            opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
-                    "ipopt.max_iter": 200, "ipopt.tol": 1e-12, "error_on_fail": False}
-            self._nlp = (ca.nlpsol("assemble", "ipopt", nlp, opts), qscale)
-        solver, qscale = self._nlp
+        with self._lock:
+            if self._nlp is None:
+                self._nlp = self._build_nlp()
+        solver, _ = self._nlp
         T = np.zeros((2, len(names)))
         W = np.zeros(len(names))
         for k, n in enumerate(names):
@@ -256,11 +303,37 @@ class Model:
         q = np.asarray(out["x"]).ravel() * qs
         return self.newton(q, u, p, L)  # polish, and judge by the residual alone
 
+    def _build_nlp(self):
+        sym, names = self.sym, list(self.sym.mech.moving_points)
+        x = ca.SX.sym("x", self.nq)
+        npt = len(names)
+        T, W = ca.SX.sym("T", 2, npt), ca.SX.sym("W", npt)
+        x0, Ls = ca.SX.sym("x0", self.nq), ca.SX.sym("L")
+        qscale = ca.if_else(ca.DM(sym.is_length.astype(float)), Ls, 1)
+        q = x * qscale
+        subst = lambda e: ca.substitute(e, sym.q, q)
+        P = subst(sym._point_matrix())
+        obj = ca.mtimes(ca.sum1((P - T) ** 2), W) / Ls ** 2 + 1e-6 * ca.sumsqr(x - x0)
+        par = ca.vertcat(sym.u, sym.p, ca.vec(T), W, x0, Ls)
+        nlp = {"x": x, "p": par, "f": obj, "g": subst(sym.g) / Ls}
+        opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
+                "ipopt.max_iter": 200, "ipopt.tol": 1e-12, "error_on_fail": False}
+        return ca.nlpsol("assemble", "ipopt", nlp, opts), qscale
+
+    def memo(self, key, build):
+        """`build()` once per `key` for this structure (a Function that other modules derive
+        from the model), kept with the model; safe from several threads."""
+        with self._lock:
+            if key not in self._memo:
+                self._memo[key] = build()
+            return self._memo[key]
+
     # --- quantities over many poses ---
     def quantity_function(self, names: tuple[str, ...]) -> ca.Function:
-        if names not in self._qfun:
-            self._qfun[names] = self.sym.quantity_function(list(names))
-        return self._qfun[names]
+        with self._lock:
+            if names not in self._qfun:
+                self._qfun[names] = self.sym.quantity_function(list(names))
+            return self._qfun[names]
 
     def quantities(self, names, Q, U, P, Ud, Udd) -> np.ndarray:
         """Quantities (len(names) x N) at N solved poses, in one vectorised call."""

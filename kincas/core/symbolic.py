@@ -12,7 +12,11 @@ g_q' g_q x = g_q' b, which give the exact solution of a consistent g_q x = b.
 Time derivatives come from the exact Jacobians. With z = (q, u):
     g_q q' = -g_u u'                                   (velocities)
     g_q q'' = -g_u u'' - d2g/dz2 [z', z']              (accelerations)
-and a quantity E(z) has E' = E_z z', E'' = E_z z'' + d2E/dz2 [z', z'].
+    g_q q''' = -g_u u''' - (d/dt g'' at fixed z'')     (jerks)
+and a quantity E(z) has E' = E_z z', E'' = E_z z'' + d2E/dz2 [z', z'], and so on: each time
+derivative is the operator D = (d/dz) z' + (d/dz') z'' + (d/dz'') z''' (kincas/core/geometry.py).
+Efforts, reactions and shaking forces (kincas/core/dynamics.py) and the kinematic geometry
+(curvature, instant centres) are more quantities written with the same operator.
 
 >>> from kincas.model import Mechanism, Link, Input
 >>> m = Mechanism(ground={"A": (0, 0), "D": (4, 0)},
@@ -31,13 +35,23 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import GROUND, Mechanism, as_param
+from . import joints as _joints
 
 # --- quantity names ---
 
-_POINT_Q = {"x": (0, 0), "y": (1, 0), "vx": (0, 1), "vy": (1, 1), "ax": (0, 2), "ay": (1, 2)}
-_LINK_Q = {"angle": 0, "omega": 1, "alpha": 2}
-_SLIDE_Q = {"s": 0, "v": 1, "a": 2}
-_SENS = re.compile(r"^d\((?P<q>[^()]+)\)/d\((?P<p>[^()]+)\)$")
+_POINT_Q = {"x": (0, 0), "y": (1, 0), "vx": (0, 1), "vy": (1, 1), "ax": (0, 2), "ay": (1, 2),
+            "jx": (0, 3), "jy": (1, 3)}
+_LINK_Q = {"angle": 0, "omega": 1, "alpha": 2, "jerk": 3}
+_SLIDE_Q = {"s": 0, "v": 1, "a": 2, "jerk": 3}
+# d(Q)/d(p), where Q may itself hold one level of brackets: d(effort(crank.angle))/d(a1)
+_SENS = re.compile(r"^d\((?P<q>(?:[^()]|\([^()]*\))+)\)/d\((?P<p>[^()]+)\)$")
+
+
+def _extras():
+    """Modules that define more quantities (each: `check(sym, name)` -> None when the name is
+    not theirs, else a list of problems; `expression(sym, name, t)` -> SX)."""
+    from . import dynamics, geometry
+    return geometry, dynamics, _joints
 
 
 def parse_quantity(name: str):
@@ -49,12 +63,23 @@ def parse_quantity(name: str):
     return ("plain", obj, attr)
 
 
-def is_angular(name: str) -> bool:
-    """Whether a quantity is an angle or an angle's rate (converted to degrees at the edge)."""
+def is_angular(name: str, mech: Mechanism | None = None) -> bool:
+    """Whether a quantity is an angle or an angle's rate (converted to degrees at the edge).
+    `S.jerk` of a slide is a length's: give the mechanism to tell it from a link's `L.jerk`."""
     kind, a, b = parse_quantity(name)
     if kind == "sens":
-        return is_angular(a)
-    return b in _LINK_Q
+        return is_angular(a, mech)
+    if b == "jerk" and mech is not None and a in {s.name for s in mech.slides}:
+        return False
+    return b in _LINK_Q or b in _joints.ANGULAR_ATTRS
+
+
+def needs_jerk(name: str) -> bool:
+    """Whether a quantity depends on the inputs' jerks (a third time derivative)."""
+    kind, a, b = parse_quantity(name)
+    if kind == "sens":
+        return needs_jerk(a)
+    return b in ("jx", "jy", "jerk")
 
 
 def default_report(m: Mechanism) -> list[str]:
@@ -124,6 +149,7 @@ class Symbolic:
             ey = self.points[sl.point][1] - (oy + s * tx + c * ty)
             eqs.append(dx * ey - dy * ex)  # distance of the point from the line
             self.slide_s[sl.name] = dx * ex + dy * ey
+        eqs += _joints.equations(self, new)  # relative inputs, gears, racks, cams
         for k, i in enumerate(m.inputs):
             if i.kind == "slide":
                 eqs.append(self.slide_s[i.target] - self.u[k])
@@ -166,11 +192,22 @@ class Symbolic:
             return self.slide_s[obj], _SLIDE_Q[attr]
         return None, None
 
+    def extra(self, name: str):
+        """(module, problems) of the extension that knows `name`, or (None, None)."""
+        for mod in _extras():
+            problems = mod.check(self, name)
+            if problems is not None:
+                return mod, problems
+        return None, None
+
     def check_names(self, names: list[str], where: str = "[output] report") -> list[str]:
         """Problems with quantity names (unknown object or attribute)."""
         out = []
         for n in names:
             kind, a, b = parse_quantity(n)
+            if kind == "plain" and self.position_expr(a, b)[0] is None and self.extra(n)[0]:
+                out += [f"{where}: {n!r}: {msg}" for msg in self.extra(n)[1]]
+                continue
             if kind == "sens":
                 out += self.check_names([a], where)
                 if b not in self.pnames:
@@ -178,12 +215,18 @@ class Symbolic:
                 elif b in {i.target for i in self.mech.inputs if i.kind == "parameter"}:
                     out.append(f"{where}: {n!r}: {b!r} is driven by an input (use its rate instead)")
             elif self.position_expr(a, b)[0] is None:
-                out.append(f"{where}: unknown quantity {n!r} (expected P.x, P.vx, P.ax, L.angle, "
-                           f"L.omega, L.alpha, S.s, S.v, S.a or d(Q)/d(p) with declared names)")
+                out.append(f"{where}: unknown quantity {n!r} (expected P.x, P.vx, P.ax, P.jx, "
+                           f"P.curvature, P.cx, L.angle, L.omega, L.alpha, L.jerk, L.icx, A/B.angle, "
+                           f"A/B.omega, A/B.icx, S.s, S.v, S.a, S.jerk, cam.contact.x, cam.phi, "
+                           f"cam.pressure, effort(KEY), shaking.x, reaction(P, L).x "
+                           f"or d(Q)/d(p) with declared names)")
         return out
 
-    def quantity_function(self, names: list[str]) -> ca.Function:
+    def quantity_function(self, names: list[str], jerk: bool = False) -> ca.Function:
         """f(q, u, p, u', u'') -> the named quantities (only what they need is built).
+
+        With `jerk=True` the function takes the inputs' jerks u''' as a sixth argument;
+        otherwise they are zero (the default of every input's `jerk`).
 
         Sensitivities d(Q)/d(p) follow the implicit function theorem on the same Jacobian:
         dq/dp = -g_q^-1 g_p, so dQ/dp = Q_q dq/dp + Q_p, with Q written in (q, u, p, u', u'')
@@ -192,21 +235,28 @@ class Symbolic:
         bad = self.check_names(names)
         if bad:
             raise ModelError(bad)
+        from .geometry import Time
         z = ca.vertcat(self.q, self.u)
         ud, udd = ca.SX.sym("ud", self.nu), ca.SX.sym("udd", self.nu)
-        qd_s, qdd_s = ca.SX.sym("qd", self.nq), ca.SX.sym("qdd", self.nq)
+        uddd = ca.SX.sym("uddd", self.nu) if jerk else ca.SX.zeros(self.nu)
+        qd_s, qdd_s, qddd_s = (ca.SX.sym(k, self.nq) for k in ("qd", "qdd", "qddd"))
         zd, zdd = ca.vertcat(qd_s, ud), ca.vertcat(qdd_s, udd)
+        t = Time(self, z, zd, zdd, ca.vertcat(qddd_s, uddd))
         parsed = [parse_quantity(n) for n in names]
-        raw = [self._order_expr(*(parse_quantity(a)[1:] if k == "sens" else (a, b)), z, zd, zdd)
-               for k, a, b in parsed]
+        raw = [self._expr(a if k == "sens" else n, t) for n, (k, a, b) in zip(names, parsed)]
         out = ca.vertcat(*raw) if raw else ca.SX(0, 1)
-        orders = self._needs(out, qd_s, qdd_s)
+        orders = 3 if ca.depends_on(out, qddd_s) else self._needs(out, qd_s, qdd_s)
         if orders >= 1:  # only build the linear solves that the report needs
             qd = ca.densify(-self.lsolve(ca.mtimes(self.Ju, ud)))  # dense even with no input
             qdd = ca.SX.zeros(self.nq)
             if orders >= 2:
                 gam = ca.jtimes(ca.jtimes(self.g, z, zd), z, zd)
                 qdd = ca.densify(ca.substitute(-self.lsolve(ca.mtimes(self.Ju, udd) + gam), qd_s, qd))
+            if orders >= 3:  # g''' = g_q q''' + (the rest, at q''' = 0), with q'' and q' known
+                g2 = ca.jtimes(self.g, z, zdd) + gam
+                rest = t.d(g2, 1, third=ca.vertcat(ca.SX.zeros(self.nq), uddd))
+                rest = ca.substitute(ca.substitute(rest, qdd_s, qdd), qd_s, qd)
+                out = ca.substitute(out, qddd_s, ca.densify(-self.lsolve(rest)))
             out = ca.substitute(ca.substitute(out, qdd_s, qdd), qd_s, qd)
         rows = [out[i] for i in range(out.numel())]
         sens = [(i, b) for i, (k, _, b) in enumerate(parsed) if k == "sens"]
@@ -221,14 +271,15 @@ class Symbolic:
                     miss = ca.mmax(ca.fabs(ca.mtimes(self.Jq, dq_dp[:, j]) + gp[:, j]))
                     rows[i] = ca.if_else(miss > 1e-8 * (1 + ca.mmax(ca.fabs(gp[:, j]))), np.nan, rows[i])
         out = ca.vertcat(*rows) if rows else ca.SX(0, 1)
-        return ca.Function("quantities", [self.q, self.u, self.p, ud, udd], [out])
+        args = [self.q, self.u, self.p, ud, udd] + ([uddd] if jerk else [])
+        return ca.Function("quantities", args, [out])
 
-    def _order_expr(self, obj, attr, z, zd, zdd):
+    def _expr(self, name, t):
+        _, obj, attr = parse_quantity(name)
         e, order = self.position_expr(obj, attr)
-        if order >= 1:
-            ed = ca.jtimes(e, z, zd)
-            e = ed if order == 1 else ca.jtimes(ed, z, zd) + ca.jtimes(e, z, zdd)
-        return e
+        if e is None:
+            return self.extra(name)[0].expression(self, name, t)
+        return t.d(e, order)
 
     @staticmethod
     def _needs(expr, qd_s, qdd_s) -> int:

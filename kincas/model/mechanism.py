@@ -25,6 +25,8 @@ from dataclasses import dataclass, field, replace
 from typing import Iterable, Mapping, Union
 
 from ..errors import ModelError
+from . import joints as _joints
+from .loads import Inertia, Load, check_loads
 
 # --- numbers that may name a parameter ---
 
@@ -40,6 +42,7 @@ class Param:
 Num = Union[float, int, str, Param]
 GROUND = "ground"
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
+NAME_RULE = "a name starts with an ASCII letter or _, then ASCII letters, digits, _ or -"
 
 
 def as_param(v: Num) -> Param | None:
@@ -65,7 +68,9 @@ class Link:
 
     `Link.bar(name, P, Q, length)` is the two-point form: origin at P, x axis towards Q.
     `Link(name, {"A": (0, 0), "E": (550, 0)})` is the local-coordinates form; the link's
-    angle is the angle of its frame's x axis.
+    angle is the angle of its frame's x axis. Optional `mass`, `inertia` (about the centre
+    of gravity) and `cg` (in the link's frame; default the mean of its points) give its
+    inertia for efforts and shaking forces (kincas/model/loads.py).
 
     >>> Link.bar("rod", "E", "F", 360).local("F")
     (360, 0.0)
@@ -74,17 +79,20 @@ class Link:
     name: str
     points: tuple[tuple[str, tuple[Num, Num]], ...]
     two_point: bool = False
+    inertial: Inertia = Inertia()
 
-    def __init__(self, name: str, points, two_point: bool = False):
+    def __init__(self, name: str, points, two_point: bool = False, *, mass: Num = 0.0,
+                 inertia: Num = 0.0, cg=None):
         items = points.items() if isinstance(points, Mapping) else points
         object.__setattr__(self, "name", name)
         object.__setattr__(self, "points", tuple((p, _pair(xy)) for p, xy in items))
         object.__setattr__(self, "two_point", two_point)
+        object.__setattr__(self, "inertial", Inertia(mass, inertia, None if cg is None else _pair(cg)))
 
     @classmethod
-    def bar(cls, name: str, p: str, q: str, length: Num) -> "Link":
+    def bar(cls, name: str, p: str, q: str, length: Num, **inertia) -> "Link":
         """Two-point link P-Q of the given length (a number or a parameter name)."""
-        return cls(name, ((p, (0.0, 0.0)), (q, (length, 0.0))), two_point=True)
+        return cls(name, ((p, (0.0, 0.0)), (q, (length, 0.0))), two_point=True, **inertia)
 
     @property
     def point_names(self) -> tuple[str, ...]:
@@ -131,7 +139,18 @@ class Input:
 
     @classmethod
     def angle(cls, link: str) -> "Input":
+        """The absolute angle of a link, or with "A/B" the angle of link A relative to body B
+        (a motor on B turning A; key "A/B.angle")."""
         return cls("angle", link)
+
+    @classmethod
+    def relative(cls, link: str, body: str) -> "Input":
+        """The angle of `link` relative to `body`: `Input.angle("link/body")`.
+
+        >>> Input.relative("forearm", "upper").key
+        'forearm/upper.angle'
+        """
+        return cls("angle", f"{link}/{body}")
 
     @classmethod
     def slide(cls, slide: str) -> "Input":
@@ -224,6 +243,11 @@ class Mechanism:
     slides: tuple[Slide, ...] = ()
     inputs: tuple[Input, ...] = ()
     guess: tuple[tuple[str, tuple[Num, Num]], ...] = ()
+    gears: tuple = ()  # of kincas.model.joints.Gear
+    racks: tuple = ()  # of kincas.model.joints.Rack
+    cams: tuple = ()  # of kincas.model.joints.Cam
+    gravity: tuple[Num, Num] = (0.0, 0.0)  # acceleration vector, length/time²
+    loads: tuple[Load, ...] = ()
     structure: Structure = field(init=False, repr=False, compare=False)
     redundant: int = field(init=False, repr=False, compare=False, default=0)
 
@@ -236,11 +260,17 @@ class Mechanism:
         object.__setattr__(self, "links", tuple(self.links))
         object.__setattr__(self, "slides", tuple(self.slides))
         object.__setattr__(self, "inputs", tuple(self.inputs))
+        for k in ("gears", "racks", "cams"):
+            object.__setattr__(self, k, tuple(getattr(self, k)))
+        object.__setattr__(self, "gravity", _pair(self.gravity))
+        object.__setattr__(self, "loads", tuple(self.loads))
         problems = _check(self)
         if problems:
             raise ModelError(problems)
-        object.__setattr__(self, "structure",
-                           _structure([g for g, _ in self.ground], self.links, len(self.slides)))
+        st = _structure([g for g, _ in self.ground], self.links, len(self.slides))
+        extra_q, extra_g = _joints.counts(self)  # gears, racks, cams: one freedom each
+        object.__setattr__(self, "structure", replace(st, n_unknowns=st.n_unknowns + extra_q,
+                                                      n_equations=st.n_equations + extra_g))
         problems, redundant = _check_mobility(self)
         if problems:
             raise ModelError(problems)
@@ -324,20 +354,20 @@ def _check(m: Mechanism) -> list[str]:
 
     for k, v in m.parameters:
         if not _NAME.match(k):
-            out.append(f"[parameters] {k}: not a valid name")
+            out.append(f"[parameters] {k}: not a valid name ({NAME_RULE})")
         if not math.isfinite(v):
             out.append(f"[parameters] {k}: {v} is not a finite number")
     gnames = set()
     for g, (x, y) in m.ground:
         if g == GROUND or not _NAME.match(g):
-            out.append(f"[ground] {g}: not a valid point name")
+            out.append(f"[ground] {g}: not a valid point name ({NAME_RULE})")
         gnames.add(g)
         num(f"[ground] {g}", x), num(f"[ground] {g}", y)
     lnames: set[str] = set()
     for lk in m.links:
         where = f"[links] {lk.name}"
         if lk.name == GROUND or not _NAME.match(lk.name):
-            out.append(f"{where}: not a valid link name")
+            out.append(f"{where}: not a valid link name ({NAME_RULE})")
         if lk.name in lnames:
             out.append(f"{where}: declared twice")
         lnames.add(lk.name)
@@ -348,7 +378,7 @@ def _check(m: Mechanism) -> list[str]:
             out.append(f"{where}: points: a point is named twice")
         for p, (x, y) in lk.points:
             if not _NAME.match(p):
-                out.append(f"{where}: points: {p!r} is not a valid point name")
+                out.append(f"{where}: points: {p!r} is not a valid point name ({NAME_RULE})")
             num(f"{where}: points.{p}" if not lk.two_point else f"{where}: length", x)
             num(f"{where}: points.{p}", y)
         if len([p for p in names if p in gnames]) > 1:
@@ -360,8 +390,10 @@ def _check(m: Mechanism) -> list[str]:
         if s.name in snames:
             out.append(f"{where}: name: two slides are named {s.name!r} (give each a `name`)")
         snames.add(s.name)
-        if s.point not in moving:
-            what = "is a ground point" if s.point in gnames else "is not a point of any link"
+        if s.point not in moving and not (s.point in gnames and s.along != GROUND):
+            # a ground point in the slot of a moving link is fine (a quick-return guide)
+            what = ("is a ground point on a ground line" if s.point in gnames
+                    else "is not a point of any link")
             out.append(f"{where}: point: {s.point!r} {what}")
         if s.along != GROUND and s.along not in lnames:
             out.append(f"{where}: along: unknown body {s.along!r} (a link's name or \"ground\")")
@@ -373,7 +405,16 @@ def _check(m: Mechanism) -> list[str]:
     for i, inp in enumerate(m.inputs):
         where = f"[[inputs]] {i + 1}"
         ok = {"angle": lnames, "slide": snames, "parameter": set(params)}.get(inp.kind)
-        if ok is None:
+        rel = _joints.split_relative(inp.target) if inp.kind == "angle" else None
+        if rel is not None:  # "A/B": link A relative to body B
+            a, b = rel
+            if a not in lnames:
+                out.append(f"{where}: angle: unknown link {a!r} in {inp.target!r}")
+            if b != GROUND and b not in lnames:
+                out.append(f"{where}: angle: unknown body {b!r} in {inp.target!r}")
+            if a == b:
+                out.append(f"{where}: angle: {inp.target!r} relates a link to itself")
+        elif ok is None:
             out.append(f"{where}: unknown kind {inp.kind!r} (angle, slide or parameter)")
         elif inp.target not in ok:
             what = {"angle": "link", "slide": "slide", "parameter": "parameter"}[inp.kind]
@@ -386,6 +427,8 @@ def _check(m: Mechanism) -> list[str]:
             what = "is a ground point (fixed)" if p in gnames else "is not a point of any link"
             out.append(f"[guess] {p}: {what}")
         num(f"[guess] {p}", x), num(f"[guess] {p}", y)
+    out += _joints.problems(m, lnames, snames, num)
+    out += check_loads(m, num)
     if out:
         return out  # the numeric checks below need every name to resolve
     for lk in m.links:
@@ -394,7 +437,7 @@ def _check(m: Mechanism) -> list[str]:
             out.append(f"[links] {lk.name}: length must be positive")
         elif all(math.dist(loc[0], b) == 0 for b in loc[1:]):
             out.append(f"[links] {lk.name}: points: all its points coincide")
-    return out
+    return out + _joints.value_problems(m)
 
 
 def _check_mobility(m: Mechanism) -> tuple[list[str], int]:

@@ -34,6 +34,8 @@ so the rocker from D = (4, 0) is c = sqrt((sqrt(10) - 4)^2 + 2.5^2).)
 from __future__ import annotations
 
 import math
+import sys
+import types
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -88,6 +90,27 @@ class OptimizeResult:
     problems: list[str] = field(default_factory=list)
     sweep: Sweep | None = None
     info: dict = field(default_factory=dict)
+
+    # --- scipy.optimize.OptimizeResult's familiar names ---
+    @property
+    def x(self) -> np.ndarray:
+        """The varied parameters' optimised values, in the order `vary` gave them."""
+        return np.array(list(self.varied.values()), dtype=float)
+
+    @property
+    def fun(self) -> float:
+        """The objective at the optimum (`objective`)."""
+        return self.objective
+
+    @property
+    def success(self) -> bool:
+        """Converged and every check passed (`ok`)."""
+        return self.ok
+
+    @property
+    def nit(self) -> int:
+        """IPOPT's iterations (`iterations`)."""
+        return int(self.iterations)
 
 
 def _as_constraint(c, i) -> Constraint:
@@ -324,7 +347,7 @@ def report(sc, r: OptimizeResult) -> dict:
     from ..core.symbolic import is_angular
 
     deg = sc.study.deg
-    user = lambda n, v: np.degrees(v) if deg and is_angular(n) else np.asarray(v, float)
+    user = lambda n, v: np.degrees(v) if deg and is_angular(n, sc.mechanism) else np.asarray(v, float)
     bounds = sc.study.raw["optimize"]["vary"]
     key = sc.mechanism.inputs[0].key
     num = lambda v: float(v) if math.isfinite(v) else None
@@ -383,3 +406,18 @@ def _print(sc, r: OptimizeResult, doc: dict):
     print("\n[parameters]   # the optimised design" + ("" if r.ok else " (NOT optimal, see above)"))
     for p, v in r.parameters.items():
         print(f"{p} = {v:.12g}")
+
+
+# --- `kincas.optimize(...)`: the function, also reachable by its 0.1 module path ---
+
+
+class _CallableModule(types.ModuleType):
+    """`kincas.optimize` is both this module (scripts of 0.1 import `kincas.optimize` and call
+    `kincas.optimize.optimize`) and the function: calling the module calls `optimize`, so
+    importing the module path never hides the function."""
+
+    def __call__(self, *args, **kwargs) -> OptimizeResult:
+        return optimize(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

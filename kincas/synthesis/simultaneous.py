@@ -178,7 +178,7 @@ class Problem(Checks):
         ca, sym = self.ca, self.sym
         if kind == "quantity":
             e = self.model.quantity_function((name,))(sym.q, sym.u, sym.p, self.ud, self.udd)
-            return SAMPLE, (e * (180 / math.pi) if self.deg and is_angular(name) else e)
+            return SAMPLE, (e * (180 / math.pi) if self.deg and is_angular(name, self.m) else e)
         if kind == "data":
             return SAMPLE, self.ds[list(self.data).index(name)]
         v = sym.val(name)

@@ -1,0 +1,253 @@
+"""Efforts, shaking forces and joint reactions from the exact kinematics (kinetostatics).
+
+Every expression here is written in (q, u, p) and the motion's symbols (z', z''), so the
+quantity function substitutes the exact velocities and accelerations, and sensitivities
+d(effort(KEY))/d(p) follow by the implicit function theorem like any other quantity.
+
+Efforts, by virtual work. A virtual change du of the inputs moves the chain by
+dq = T du, T = dq/du = -g_q^-1 g_u (the same Jacobians as the velocities). With d'Alembert's
+inertia forces, the generalized force Q_k the input k must supply makes the virtual work of
+everything vanish:
+    Q_k = sum_links [ m (a_G - g) . dr_G/du_k + J alpha dtheta/du_k ]
+          - sum_forces F . dr_P/du_k - sum_torques tau dtheta/du_k + sum_springs k (d - d0) dd/du_k
+(a torque for an angle input, a force for a slide or a parameter input such as a length).
+
+Shaking force and moment on the ground (about the origin): -sum m a_G, -sum (r_G x m a_G + J alpha).
+
+Joint reactions, by Newton-Euler per link: each moving link has three equations
+    sum F = m a_G,   sum (r x F) + sum tau = r_G x m a_G + J alpha
+with unknowns the pin forces (at a point shared by bodies b0, b1, ..., one unknown force on each
+of b1, ... and their opposite sum on b0: the pin carries nothing itself), one normal force per
+slide, the torque of each angle input (from the ground on its link) and the force of each slide
+input (along its line). A parameter input (an actuator's length) is held rigid at its value:
+its force is internal to its link. The system is square for a mechanism without redundant
+joints, and its solution is the g_q^T lambda of the same constraints; it is solved exactly
+(symbolic LU) only when a report asks for a reaction.
+
+A point load, a spring's end, and a slide's point act on the first body (in declaration order,
+the ground first) that carries the point.
+"""
+from __future__ import annotations
+
+import re
+
+import casadi as ca
+
+from ..model.mechanism import GROUND
+
+_EFFORT = re.compile(r"^effort\((?P<key>[^()]+)\)$")
+_REACTION = re.compile(r"^reaction\(\s*(?P<a>[^,()]+?)\s*(?:,\s*(?P<b>[^,()]+?)\s*)?\)\.(?P<attr>x|y)$")
+_SHAKING = {"shaking.x": 0, "shaking.y": 1, "shaking.moment": 2}
+
+
+# --- names ---
+
+
+def bodies_at(mech, point: str) -> list[str]:
+    """The bodies that carry a point: the ground first, then links in declaration order."""
+    out = [GROUND] if point in mech.ground_points else []
+    return out + [lk.name for lk in mech.links if point in lk.point_names]
+
+
+def check(sym, name: str):
+    """None when `name` is not a force quantity; else the problems with it ([] if fine)."""
+    m = _EFFORT.match(name)
+    if m:
+        return [] if m["key"] in sym.ukeys else [f"no input {m['key']!r} (inputs: {sym.ukeys})"]
+    if name in _SHAKING:
+        return []
+    m = _REACTION.match(name)
+    if not m:
+        return None
+    mech, a, b = sym.mech, m["a"], m["b"]
+    if b is None:
+        if a not in {s.name for s in mech.slides}:
+            return [f"no slide named {a!r} (reaction(SLIDE).x, or reaction(POINT, BODY).x at a pin)"]
+    elif len(bodies_at(mech, a)) < 2:
+        return [f"{a!r} is not a joint (a point carried by two bodies or more)"]
+    elif b not in bodies_at(mech, a):
+        return [f"{b!r} does not carry point {a!r} (bodies there: {bodies_at(mech, a)})"]
+    return _newton_euler(sym, None)[0]
+
+
+# --- bodies: mass, centre of gravity, angle ---
+
+
+def _to_global(sym, body, lx, ly):
+    ox, oy, th = sym.frames[body]
+    c, s = ca.cos(th), ca.sin(th)
+    return ox + c * lx - s * ly, oy + s * lx + c * ly
+
+
+def _masses(sym):
+    """(link, m, J, (x_G, y_G), theta) for each link with a mass or an inertia."""
+    out = []
+    for lk in sym.mech.links:
+        i = lk.inertial
+        m, J = sym.val(i.mass), sym.val(i.inertia)
+        if ca.is_equal(m, 0) and ca.is_equal(J, 0):
+            continue
+        if i.cg is not None:
+            lx, ly = sym.val(i.cg[0]), sym.val(i.cg[1])
+        else:  # the mean of the link's points
+            n = len(lk.points)
+            lx = sum((sym.val(x) for _, (x, _y) in lk.points), ca.SX(0)) / n
+            ly = sum((sym.val(y) for _, (_x, y) in lk.points), ca.SX(0)) / n
+        out.append((lk.name, m, J, _to_global(sym, lk.name, lx, ly), sym.frames[lk.name][2]))
+    return out
+
+
+def _gravity(sym):
+    gx, gy = sym.mech.gravity
+    return sym.val(gx), sym.val(gy)
+
+
+def _applied(sym):
+    """Applied loads as (body, kind, data): ("force", (x, y), (fx, fy)) or ("torque", tau)."""
+    mech, out = sym.mech, []
+    for ld in mech.loads:
+        if ld.kind == "force":
+            out.append((bodies_at(mech, ld.at)[0], "force", sym.points[ld.at],
+                        (sym.val(ld.value[0]), sym.val(ld.value[1]))))
+        elif ld.kind == "torque":
+            out.append((ld.at, "torque", sym.val(ld.value)))
+        else:  # spring: -k (d - d0) along P - Q on P, the opposite on Q
+            (p, q), k, d0 = ld.points, sym.val(ld.stiffness), sym.val(ld.free_length)
+            (px, py), (qx, qy) = sym.points[p], sym.points[q]
+            d = ca.sqrt((px - qx) ** 2 + (py - qy) ** 2)
+            f = -k * (d - d0) / d
+            out.append((bodies_at(mech, p)[0], "force", (px, py), (f * (px - qx), f * (py - qy))))
+            out.append((bodies_at(mech, q)[0], "force", (qx, qy), (-f * (px - qx), -f * (py - qy))))
+    return out
+
+
+# --- efforts, shaking ---
+
+
+def expression(sym, name: str, t):
+    m = _EFFORT.match(name)
+    if m:
+        if "efforts" not in t.cache:
+            t.cache["efforts"] = _efforts(sym, t)
+        return t.cache["efforts"][sym.ukeys.index(m["key"])]
+    if name in _SHAKING:
+        return _shaking(sym, t)[_SHAKING[name]]
+    m = _REACTION.match(name)
+    return _reaction(sym, t, m["a"], m["b"], m["attr"])
+
+
+def _efforts(sym, t):
+    """Q (one per input) by virtual work, with dr/du = r_z (T; I)."""
+    Z = ca.vertcat(-sym.lsolve(sym.Ju), ca.SX.eye(sym.nu))
+
+    def du(e):  # d e / d u along the constraints: a row of nu entries
+        return ca.mtimes(ca.jacobian(e, t.z), Z)
+
+    gx, gy = _gravity(sym)
+    Q = ca.SX.zeros(1, sym.nu)
+    for _, m, J, (x, y), th in _masses(sym):
+        Q += m * (t.d(x, 2) - gx) * du(x) + m * (t.d(y, 2) - gy) * du(y) + J * t.d(th, 2) * du(th)
+    for lk in sym.mech.loads:
+        if lk.kind == "spring":  # potential k/2 (d - d0)^2: the input must supply its gradient
+            (px, py), (qx, qy) = sym.points[lk.points[0]], sym.points[lk.points[1]]
+            d = ca.sqrt((px - qx) ** 2 + (py - qy) ** 2)
+            Q += sym.val(lk.stiffness) * (d - sym.val(lk.free_length)) * du(d)
+        elif lk.kind == "torque":
+            Q -= sym.val(lk.value) * du(sym.frames[lk.at][2])
+        else:
+            (x, y), (fx, fy) = sym.points[lk.at], (sym.val(lk.value[0]), sym.val(lk.value[1]))
+            Q -= fx * du(x) + fy * du(y)
+    return [Q[k] for k in range(sym.nu)]
+
+
+def _shaking(sym, t):
+    fx = fy = mz = ca.SX(0)
+    for _, m, J, (x, y), th in _masses(sym):
+        ax, ay = t.d(x, 2), t.d(y, 2)
+        fx, fy = fx - m * ax, fy - m * ay
+        mz -= m * (x * ay - y * ax) + J * t.d(th, 2)
+    return fx, fy, mz
+
+
+# --- joint reactions: Newton-Euler per link ---
+
+
+def _newton_euler(sym, t):
+    """(problems, unknowns by name) of the kinetostatic system; with a Time t, also solved."""
+    mech = sym.mech
+    if sym.ng > sym.nq:
+        return ["joint reactions are not determined where joints are redundant"], None
+    kinds = {i.kind for i in mech.inputs} - {"angle", "slide", "parameter"}
+    if kinds or any("/" in i.target for i in mech.inputs):
+        return ["joint reactions are not available for this kind of input"], None
+    unknowns = {}  # (kind, names...) -> symbol(s)
+    forces = []  # (body, (x, y), (fx, fy)) and torques (body, None, tau)
+    for p in list(mech.ground_points) + list(mech.moving_points):
+        at = bodies_at(mech, p)
+        if len(at) < 2:
+            continue
+        xy = sym.points[p]
+        total = [ca.SX(0), ca.SX(0)]
+        for b in at[1:]:
+            f = ca.SX.sym(f"R_{p}_{b}", 2)
+            unknowns[("pin", p, b)] = f
+            forces.append((b, xy, (f[0], f[1])))
+            total = [total[0] + f[0], total[1] + f[1]]
+        forces.append((at[0], xy, (-total[0], -total[1])))
+    for sl in mech.slides:
+        a = sym.frames[sl.along][2] + sym.val(sl.angle)
+        n, d, xy = (-ca.sin(a), ca.cos(a)), (ca.cos(a), ca.sin(a)), sym.points[sl.point]
+        lam = unknowns[("slide", sl.name)] = ca.SX.sym(f"N_{sl.name}")
+        F = ca.SX(0)
+        if any(i.kind == "slide" and i.target == sl.name for i in mech.inputs):
+            F = unknowns[("input", sl.name)] = ca.SX.sym(f"F_{sl.name}")
+        fx, fy = lam * n[0] + F * d[0], lam * n[1] + F * d[1]
+        forces += [(bodies_at(mech, sl.point)[0], xy, (fx, fy)), (sl.along, xy, (-fx, -fy))]
+    for i in mech.inputs:
+        if i.kind == "angle":
+            T = unknowns[("input", i.target)] = ca.SX.sym(f"T_{i.target}")
+            forces.append((i.target, None, T))
+    x = ca.vertcat(*unknowns.values()) if unknowns else ca.SX(0, 1)
+    n_links = len(mech.links)
+    if x.numel() != 3 * n_links:
+        return [f"joint reactions: {x.numel()} unknown forces for {3 * n_links} equations "
+                f"of motion (the kinetostatic system is not square)"], None
+    if t is None:
+        return [], None
+    forces += [(b, *rest) for b, kind, *rest in _applied(sym) if kind == "force"]
+    forces += [(b, None, data[0]) for b, kind, *data in _applied(sym) if kind == "torque"]
+    gx, gy = _gravity(sym)
+    eqs = {lk.name: [ca.SX(0), ca.SX(0), ca.SX(0)] for lk in mech.links}
+    for name, m, J, (x_, y_), th in _masses(sym):  # gravity minus d'Alembert's inertia force
+        ax, ay = t.d(x_, 2), t.d(y_, 2)
+        fx, fy = m * (gx - ax), m * (gy - ay)
+        e = eqs[name]
+        e[0], e[1], e[2] = e[0] + fx, e[1] + fy, e[2] + x_ * fy - y_ * fx - J * t.d(th, 2)
+    for body, xy, f in forces:
+        if body == GROUND:
+            continue
+        e = eqs[body]
+        if xy is None:  # a torque
+            e[2] += f
+        else:
+            e[0], e[1], e[2] = e[0] + f[0], e[1] + f[1], e[2] + xy[0] * f[1] - xy[1] * f[0]
+    E = ca.vertcat(*[c for lk in mech.links for c in eqs[lk.name]])
+    A = ca.jacobian(E, x)
+    sol = -ca.solve(A, ca.substitute(E, x, ca.SX.zeros(x.numel())))
+    values = {k: ca.substitute(v, x, sol) for k, v in unknowns.items()}
+    return [], values
+
+
+def _reaction(sym, t, a, b, attr):
+    if "reactions" not in t.cache:  # one solve serves every reaction of the report
+        t.cache["reactions"] = _newton_euler(sym, t)[1]
+    values = t.cache["reactions"]
+    j = 0 if attr == "x" else 1
+    if b is None:  # the slide's normal force, on the body carrying its point
+        sl = sym.mech.slide(a)
+        ang = sym.frames[sl.along][2] + sym.val(sl.angle)
+        return values[("slide", a)] * (-ca.sin(ang) if j == 0 else ca.cos(ang))
+    at = bodies_at(sym.mech, a)
+    if b != at[0]:
+        return values[("pin", a, b)][j]
+    return -sum((values[("pin", a, o)][j] for o in at[1:]), ca.SX(0))

@@ -1,0 +1,19 @@
+"""The one set of numerical thresholds of kincas's solvers (careful Newton, compiled kernel,
+assembly modes, tolerance sampling, redundant joints, branch tests).
+
+Residuals are relative: each equation's residual is divided by the length of its own Assur
+group (`Model.scales`), so a mechanism of 1e-6 m and one of 1e6 m, or a small group beside a
+far point, reach the same relative accuracy.
+
+>>> TOL < ACCEPT < BRANCH
+True
+"""
+
+TOL = 1e-13  # Newton's target: max |g| of a group over that group's length
+ACCEPT = 1e-10  # a pose whose relative residual is above this is not solved
+MAX_STEP = 0.5  # largest Newton step per iteration: radians, or this times the group's length
+MAX_ITER = 40  # Newton iterations per group before giving up
+BACKTRACK = 1 / 32  # shortest fraction of a Newton step tried while backtracking
+DECREASE = 1e-4  # a backtracked step must lower the residual by this times its fraction
+BRANCH = 1e-8  # |det| of the column-scaled g_q below this: too close to singular to tell a branch
+RANK = 1e-8  # a scaled singular value below this times the largest counts as zero
