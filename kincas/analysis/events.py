@@ -31,41 +31,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.assembly import NEAR, group_links, polish_singular
+from ..core.assembly import NEAR, group_links, modes, polish_singular
 from ..core.symbolic import parse_quantity
 from .singular import FLAG_SIGMA, classify, locate_singular, scaled_jacobians
 
 MAX_GROUPS_AT_GAP = 8  # groups tried for a limit next to a gap (the worst conditioned first)
 
 
-# --- measures of a tall g_q (redundant joints) ---
-
-
-def tall_orientation(Js: np.ndarray) -> np.ndarray:
-    """A +-1 orientation per pose for column-scaled tall g_q's (n, ng, nq), which have no
-    determinant: det(Q_k' J_next) and det R_k (J_k = Q_k R_k) of opposite signs mean a
-    singular position was crossed between pose k and the next, as a sign change of det g_q
-    does for a square system."""
-    n = Js.shape[0]
-    out = np.ones(n)
-    if n == 0:
-        return out
-    Qk, Rk = np.linalg.qr(Js)
-    dR = np.prod(np.diagonal(Rk, axis1=1, axis2=2), axis=1)
-    o = 1.0
-    for a in range(n):
-        out[a] = o
-        if a + 1 < n:
-            flip = np.sign(dR[a]) * np.sign(np.linalg.det(Qk[a].T @ Js[a + 1]))
-            o = o * flip if flip != 0 else o
-    return out
-
-
 # --- the events of a sweep ---
 
 
-def sweep_events(model, m, U, Q, ok, p, L, flags, modes, cond):
-    """Events and flags of a sweep from per-pose group measures.
+def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma):
+    """Events and flags of a sweep from the per-pose measures the solve gives.
 
     Parameters
     ----------
@@ -78,8 +55,12 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, modes, cond):
         Which poses are solved.
     flags : list
         One entry per pose, filled in place.
-    modes, cond : numpy.ndarray
-        (n, groups): each group's mode (+1, -1, 0 if undefined) and conditioning.
+    signs : numpy.ndarray
+        (n, groups): each group's mode, the sign of its block's determinant (for a tall g_q,
+        one relative orientation per pose, see `tall_orientation`).
+    sigma : numpy.ndarray
+        (n,): a lower bound of the groups' conditioning; only poses where it is small, and
+        the ends of a change, get the exact per-group measures (`modes`) here.
 
     Returns
     -------
@@ -92,9 +73,16 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, modes, cond):
     events: list[dict] = []
     if model.nq == 0 or not m.inputs or n == 0:
         return events, at
-    modes, cond = np.array(modes, int), np.array(cond, float)
+    signs = np.nan_to_num(np.asarray(signs, float)).astype(int)
+    sigma = np.asarray(sigma, float)
     names = group_links(model)
     keys = [i.key for i in m.inputs]
+    exact: dict = {}
+
+    def measure(k):  # (modes, conditioning) of every group at pose k, from g_q there
+        if k not in exact:
+            exact[k] = modes(model, model.jac(Q[k], U[k], p), L)
+        return exact[k]
 
     def event(kind, pose, u, group):
         flags[pose] = flags[pose] or kind
@@ -105,27 +93,30 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, modes, cond):
         return classify(*scaled_jacobians(model, q, u, p, L), tol=tol) or "singular"
 
     # poses at a singular position: exactly onto it, flagged, one event per group
-    for k in np.flatnonzero(ok & (cond.min(axis=1, initial=np.inf) < NEAR)):
-        groups = [int(i) for i in np.flatnonzero(cond[k] < NEAR)]
-        q = polish_singular(model, Q[k], U[k], p, L, groups)
+    for k in np.flatnonzero(ok & ~(sigma > NEAR)):
+        groups = [int(i) for i in np.flatnonzero(measure(k)[1] < NEAR)]
+        q = polish_singular(model, Q[k], U[k], p, L, groups) if groups else None
         if q is None:
             continue
         Q[k], at[k] = q, True
-        modes[k, groups] = 0
+        exact.pop(k)
+        signs[k, groups if signs.shape[1] == len(names) else 0] = 0
         kind = kind_at(q, U[k])
         flags[k] = kind
         for i in groups:
             event(kind, k, U[k], i)
     # poses whose g_q is numerically singular as a whole, flagged where they stand
-    for k in np.flatnonzero(ok & ~at & (cond.min(axis=1, initial=np.inf) <= FLAG_SIGMA)):
+    for k in np.flatnonzero(ok & ~at & ~(sigma > 1e3 * FLAG_SIGMA)):
         J, Gu = scaled_jacobians(model, Q[k], U[k], p, L)
-        flags[k] = flags[k] or classify(J, Gu)
+        sv = np.linalg.svd(J, compute_uv=False)
+        if sv[-1] <= FLAG_SIGMA * max(sv[0], 1.0):
+            flags[k] = flags[k] or classify(J, Gu)
     # a group changing mode between two solved poses crossed a singular position of its own
-    pairs = np.flatnonzero(ok[:-1] & ok[1:])
-    for k in pairs:
-        a, b = modes[k], modes[k + 1]
+    for k in np.flatnonzero(ok[:-1] & ok[1:]):
+        a, b = signs[k], signs[k + 1]
         for i in np.flatnonzero((a != b) & (a != 0) & (b != 0)):
-            start, other = (k, k + 1) if cond[k, i] <= cond[k + 1, i] else (k + 1, k)
+            c0, c1 = measure(k)[1][i], measure(k + 1)[1][i]
+            start, other = (k, k + 1) if c0 <= c1 else (k + 1, k)
             found = locate_singular(model, Q[start], U[start], p, L, U[other] - U[start], group=int(i))
             if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
                 pose = start if found[2] <= 0.5 else other
@@ -137,7 +128,7 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, modes, cond):
         for nb in (k - 1, k + 1):
             if not 0 <= nb < n or ok[nb] or np.allclose(U[nb], U[k]):
                 continue
-            for i in np.argsort(cond[k])[:MAX_GROUPS_AT_GAP]:
+            for i in np.argsort(measure(k)[1])[:MAX_GROUPS_AT_GAP]:
                 found = locate_singular(model, Q[k], U[k], p, L, U[nb] - U[k], group=int(i))
                 if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
                     event(kind_at(found[0], found[1]), k, found[1], int(i))

@@ -109,17 +109,17 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     # (a tall system, with redundant joints, has no compiled pass: its g_q is not square)
     fast = sweeper_for(model, tuple(report), compile) if method == "fast" and model.square else None
     if fast is not None and (compile is False or fast.worth_it(n)):
-        run = fast.sweep(U, p, L, careful, Ud=Ud, Udd=Udd, progress=progress, jacobians=True)
+        run = fast.sweep(U, p, L, careful, Ud=Ud, Udd=Udd, progress=progress)
     elif method in ("fast", "careful"):  # "fast" for a kernel too large to pay for itself
-        run = _careful_only(model, report, U, Ud, Udd, p, careful, progress)
+        run = _careful_only(model, report, U, Ud, Udd, p, L, careful, progress)
     else:
         raise ModelError(f"method: {method!r} is neither \"fast\" nor \"careful\"")
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
     if ok.any():  # gear centre distances at the first solved pose
         check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
-    status = ["ok" if s else NO_ASSEMBLY for s in ok]
+    status = ["ok"] * n if ok.all() else ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
-    found, at = _singular_events(model, m, U, Q, ok, p, L, flags, J=run.jacobian)
+    found, at = _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma)
     events += found
     values = run.values
     if jerks is not None:  # the inputs' jerks enter only the third derivatives
@@ -154,7 +154,7 @@ class _CarefulRun:
         self.values, self.jacobian = np.full((nr, n), np.nan), np.full((n, ng, nq), np.nan)
 
 
-def _careful_only(model, report, U, Ud, Udd, p, careful, progress) -> _CarefulRun:
+def _careful_only(model, report, U, Ud, Udd, p, L, careful, progress) -> _CarefulRun:
     n = U.shape[0]
     run, j = _CarefulRun(n, model.nq, len(report), model.ng), None
     for k in range(n):
@@ -169,7 +169,40 @@ def _careful_only(model, report, U, Ud, Udd, p, careful, progress) -> _CarefulRu
         progress(n, n)
     ok = run.solved
     run.values[:, ok] = model.quantities(report, run.Q[ok], U[ok], p, Ud[ok], Udd[ok])
+    run.signs, run.sigma = _measures(model, run.jacobian, ok, L)
     return run
+
+
+def _measures(model: Model, J, ok, L):
+    """What the fast kernel gives per pose, from g_q at every pose: each group's mode (N,
+    groups), or for a tall g_q an orientation that changes sign where the sweep crosses a
+    singular position ((N, 1)), 0 where unsolved; and the smallest singular value of the
+    scaled g_q relative to max(1, its largest) (a group's conditioning, for a square one)."""
+    n, idx = len(ok), np.flatnonzero(ok)
+    dets, sigma = np.zeros(n), np.full(n, np.nan)
+    if model.nq == 0 or not len(idx):
+        return dets[:, None], sigma
+    if model.square:  # each Assur group's mode, as the kernel gives it (see core/assembly.py)
+        from ..core.assembly import modes
+        signs = np.zeros((n, len(model.blocks)))
+        signs[idx], cond = modes(model, J[idx], L)
+        sigma[idx] = cond.min(axis=1, initial=1.0)
+        return signs, sigma
+    # tall (redundant joints): no determinant, so chain the relative test of _same_branch
+    # along the sweep: the orientation flips from pose k to the next where det(Q_k' J_next)
+    # and det R_k differ in sign (J_k = Q_k R_k).
+    J = J[idx] * model.column_scale(L)
+    Qk, Rk = np.linalg.qr(J)
+    dR = np.prod(np.diagonal(Rk, axis1=1, axis2=2), axis=1)
+    o = 1.0
+    for a in range(len(idx)):
+        dets[idx[a]] = o * abs(dR[a])
+        if a + 1 < len(idx):
+            flip = np.sign(dR[a]) * np.sign(np.linalg.det(Qk[a].T @ J[a + 1]))
+            o = o * flip if flip != 0 else o
+    sv = np.linalg.svd(J, compute_uv=False)
+    sigma[idx] = sv[:, -1] / np.maximum(sv[:, 0], 1.0)
+    return np.sign(dets)[:, None], sigma
 
 
 def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,
@@ -182,19 +215,15 @@ def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 # --- singular positions met by a sweep ---
 
 
-def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, J):
-    """Each Assur group's mode and conditioning at every solved pose (from g_q per pose), then
-    the events and flags they imply (kincas/analysis/events.py). Returns (events, at: the
-    poses exactly at a singular position, moved onto it)."""
-    from ..core.assembly import modes
-    from .events import sweep_events, tall_orientation
-    n = len(ok)
-    if model.nq == 0 or m.inputs == () or n == 0:
-        return [], np.zeros(n, dtype=bool)
-    idx = np.flatnonzero(ok)
-    sign, cond = modes(model, J[idx], L)
-    if not model.square and len(idx):  # tall (redundant joints): a relative orientation
-        sign = tall_orientation(J[idx] * model.column_scale(L))[:, None].astype(int)
-    S, C = np.zeros((n, sign.shape[1]), int), np.ones((n, sign.shape[1]))
-    S[idx], C[idx] = sign, cond
-    return sweep_events(model, m, U, Q, ok, p, L, flags, S, C)
+def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, signs, sigma):
+    """Flag solved poses at or next to a singular position and locate it exactly, one event
+    per Assur group (kincas/analysis/events.py). Returns (events, at: the poses exactly at a
+    singular position, which it moved onto it).
+
+    `signs` (N, groups) and `sigma` (N) come with the solve (the fast kernel computes them at
+    every pose, kincas/core/blocks.py): sigma is a lower bound of the smallest singular value
+    of a group's scaled block, so only the few poses where it is small, and the ends of a
+    change of a group's sign, get exact per-group measures.
+    """
+    from .events import sweep_events
+    return sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma)
