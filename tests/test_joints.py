@@ -460,3 +460,17 @@ def test_optimize_a_cam_eccentricity(capsys, tmp_path):
     n = np.stack([-d[1], d[0]]) / L
     F = A + a * d / L - h * n
     assert np.ptp(F[1]) == pytest.approx(30, abs=1e-6)
+
+
+def test_study_refuses_designs_whose_gears_do_not_mesh(capsys, tmp_path):
+    """`kincas study` over the ring's radius: only rr = 60 (|60 - 15| = 45, the arm) meshes;
+    its arm turns at a third of the sun's rate 3 (Willis)."""
+    import csv
+    sc = scene("planetary")
+    sc["study"] = {"vary": {"rr": [59, 61]}, "grid": [3], "report": ["max(arm.omega)"]}
+    out_csv = tmp_path / "study.csv"
+    code, out, err = run_cli(capsys, "study", write_scene(tmp_path, sc), "--out", out_csv)
+    rows = list(csv.DictReader(open(out_csv, encoding="utf-8")))
+    assert [r["status"].split(" at ")[0] for r in rows] == ["gears do not mesh", "ok", "gears do not mesh"]
+    assert float(rows[1]["max(arm.omega)"]) == pytest.approx(1.0, abs=1e-12)
+    assert rows[0]["max(arm.omega)"] in ("", "nan")
