@@ -89,7 +89,7 @@ class Sweep:
         # object dtype: a longer status assigned later is kept whole, not truncated
         self.status = np.array(list(self.status), dtype=object)
         for k in list(self.values):
-            if k.endswith(".angle") and not k.startswith("d("):
+            if k.endswith((".angle", ".phi")) and not k.startswith("d("):  # cam.phi too
                 self.values[k] = wrap_angle(self.values[k])
 
     def __len__(self) -> int:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
+from ..core.joints import settle_first
 from ..core.numeric import Model, Solution
 from ..model.mechanism import Mechanism
 
@@ -53,7 +54,7 @@ def _first(model: Model, u, p, L, guess) -> Solution:
     sol = model.newton(q0, u, p, L)
     if not sol.ok:  # IPOPT: the assembly nearest the guessed points
         sol = model.nearest_assembly(q0, u, p, {k: np.array(v) for k, v in guess.items()}, L)
-    return sol
+    return settle_first(model, sol, u, p, L)  # gears relate angles taken in (-pi, pi]
 
 
 def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:

@@ -27,6 +27,7 @@ from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
 from ..core.symbolic import default_report, needs_jerk
 from .continuation import careful_pose
+from ..core.joints import check_first_pose
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
 
@@ -113,6 +114,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     else:
         raise ModelError(f"method: {method!r} is neither \"fast\" nor \"careful\"")
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
+    if ok.any():  # gear centre distances at the first solved pose
+        check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
     status = ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
     events += _singular_events(model, m, U, Q, ok, p, L, flags, J=run.jacobian)

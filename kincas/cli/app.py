@@ -127,7 +127,8 @@ def _solve(args) -> int:
         from .outputs import check_outputs
         check_outputs(args, sc.mechanism, len(next(iter(sc.study.inputs.values()))))
     sw = sc.run(progress=progress_for(args))
-    inputs, values = sc.user_inputs(sw), sc.user_values(sw)
+    from .numbers import clean  # zero to the solve's accuracy is printed as 0, not as noise
+    inputs, values = sc.user_inputs(sw), clean(sc.user_values(sw), sc, sw)
     if args.json:
         doc = {"title": sc.study.title, "units": sc.study.units,
                "inputs": {k: _list(v) for k, v in inputs.items()},
@@ -176,20 +177,44 @@ def _unit(sc, name: str) -> str:
     u = sc.study.units
     L, A, T = u.get("length", ""), u.get("angle", "deg"), u.get("time", "s")
     kind, obj, attr = parse_quantity(name)
-    if kind == "sens":
-        return f"{_unit(sc, obj) or '1'} per {attr}"
+    if kind == "sens":  # Q's unit per the parameter's: mm/mm, deg/mm
+        uq, up = _unit(sc, obj), _param_unit(sc, attr)
+        return f"{uq or '1'}/{up}" if up else (f"{uq} per {attr}" if uq else "")
     if name in sc.mechanism.param_values:  # a driven parameter: a length, or an angle
-        angular = any(isinstance(sl.angle, Param) and sl.angle.name == name and sl.angle.scale != 1
-                      for sl in sc.mechanism.slides)
-        return A if angular else L
+        return _param_unit(sc, name)
     base = A if is_angular(name, sc.mechanism) else L  # input keys L.angle included
     order = {"vx": 1, "vy": 1, "omega": 1, "v": 1, "ax": 2, "ay": 2, "alpha": 2, "a": 2,
              "jx": 3, "jy": 3, "jerk": 3}.get(attr, 0)
     return base + ("" if order == 0 else f"/{T}" if order == 1 else f"/{T}^{order}")
 
 
+def _param_unit(sc, name: str) -> str:
+    """A parameter's unit: the scene's angle unit where it gives a slide's angle, else length."""
+    u = sc.study.units
+    angular = any(isinstance(sl.angle, Param) and sl.angle.name == name and abs(sl.angle.scale) != 1
+                  for sl in sc.mechanism.slides)
+    return u.get("angle", "deg") if angular else u.get("length", "")
+
+
+def rate_line(sc, sw) -> str:
+    """The inputs' rates and accelerations, which every velocity and acceleration follows."""
+    T = sc.study.units.get("time", "s")
+    parts = []
+    for k in sw.inputs:
+        u = _unit(sc, k)
+        r, a = (np.asarray(d.get(k, 0.0), float) for d in (sw.rates, sw.accelerations))
+        if k.endswith(".angle") and sc.study.deg:
+            r, a = np.degrees(r), np.degrees(a)
+        show = lambda v: f"{v.flat[0]:.6g}" if v.size and np.ptp(v) == 0 else "varies"
+        parts.append(f"{k} rate {show(r)} {u}/{T}, acceleration {show(a)} {u}/{T}^2")
+    return "inputs: " + "; ".join(parts) + " (velocities and accelerations follow these)"
+
+
 def _table(sc, sw, inputs, values):
     print(sc.study.title or "kincas")
+    if sw.inputs:
+        print(rate_line(sc, sw))
+    values = {k: v for k, v in values.items() if k not in inputs}  # an input reported: once
     cols = list(inputs) + list(values)
     heads = [c if not _unit(sc, c) else f"{c} [{_unit(sc, c)}]" for c in cols]
     width = [max(12, len(h)) for h in heads]

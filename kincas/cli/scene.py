@@ -37,7 +37,8 @@ from ..results import Sweep
 
 LARGEST = 1e100  # beyond it, squared lengths overflow double precision
 SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
-            "output", "optimize", "tolerance", "gravity", "loads", "study"}
+            "output", "optimize", "tolerance", "gravity", "loads", "study", "gears", "racks",
+            "cams", "cam_design"}
 
 
 @dataclass
@@ -219,6 +220,8 @@ class _Reader:
             self.err("[ground] ground: the name `ground` means the fixed frame")
         links = [self.link(k, v) for k, v in self.table("links").items()]
         slides = [self.slide(i, s) for i, s in enumerate(self.array("slides"))]
+        from .scene_joints import read as read_joints
+        gears, racks, cams = read_joints(self)
         inputs, values, rates, accs, written = self.inputs()
         from . import scene_loads
         grav, loads = scene_loads.gravity(self, doc), scene_loads.read_loads(self)
@@ -231,7 +234,8 @@ class _Reader:
             raise SceneError(self.problems)
         try:
             m = Mechanism(parameters=self.params, ground=ground, links=[lk for lk in links if lk],
-                          slides=slides, inputs=inputs, guess=guess, gravity=grav, loads=loads)
+                          slides=slides, inputs=inputs, guess=guess, gravity=grav, loads=loads,
+                          gears=gears, racks=racks, cams=cams)
         except KincasError as e:
             raise SceneError(e.problems) from None
         if report is None:

@@ -29,6 +29,7 @@ import casadi as ca
 import numpy as np
 
 from ..model.mechanism import Mechanism
+from . import joints as _joints
 from .newton import lsolve as _lsolve, newton as _newton
 from .structure import Structure
 from .symbolic import Symbolic
@@ -39,7 +40,8 @@ from .tolerances import ACCEPT, MAX_ITER, MAX_STEP, TOL  # noqa: F401  (their ol
 
 
 def _structure_key(m: Mechanism):
-    return (tuple(k for k, _ in m.parameters), m.ground, m.links, m.slides, m.inputs)
+    return (tuple(k for k, _ in m.parameters), m.ground, m.links, m.slides, m.inputs,
+            m.gears, m.racks, m.cams)
 
 
 _CACHE: dict = {}
@@ -248,6 +250,7 @@ class Model:
         index = {name: i for i, (name, _) in enumerate(sym.unknowns)}
         angle_in = {i.target: u[k] for k, i in enumerate(m.inputs) if i.kind == "angle"}
         centre = np.mean(list(gv.values()), axis=0) if gv else np.zeros(2)
+        theta = {"ground": 0.0}  # angles placed so far (a relative input starts from them)
         for lname, at in m.structure.order:
             pts = [pt for pt, _ in m.link(lname).points]
             ref = [pt for pt in pts if pt in guessed or pt in known]
@@ -260,7 +263,7 @@ class Model:
                     d = pos[others[0]] - anchor
                     dl = loc[(lname, others[0])] - loc[(lname, at)]
                     th = math.atan2(d[1], d[0]) - math.atan2(dl[1], dl[0])
-                th = float(angle_in.get(lname, th))
+                th = float(angle_in.get(lname, _joints.relative_start(m, lname, u, theta, th)))
                 c, s = math.cos(th), math.sin(th)
                 R = np.array([[c, -s], [s, c]])
                 origin = known[at] - R @ loc[(lname, at)]
@@ -269,16 +272,17 @@ class Model:
                 if len(ref) >= 2:
                     d, dl = pos[ref[1]] - pos[ref[0]], loc[(lname, ref[1])] - loc[(lname, ref[0])]
                     th = math.atan2(d[1], d[0]) - math.atan2(dl[1], dl[0])
-                th = float(angle_in.get(lname, th))
+                th = float(angle_in.get(lname, _joints.relative_start(m, lname, u, theta, th)))
                 c, s = math.cos(th), math.sin(th)
                 R = np.array([[c, -s], [s, c]])
                 origin = (pos[ref[0]] - R @ loc[(lname, ref[0])]) if ref else centre
                 q[index[f"{lname}.x"]], q[index[f"{lname}.y"]] = origin
             if f"{lname}.angle" in index:
                 q[index[f"{lname}.angle"]] = th
+            theta[lname] = th
             for pt in pts:
                 known.setdefault(pt, origin + R @ loc[(lname, pt)])
-        return q
+        return _joints.place(self, q, u, p)  # cams' contact parameters; angles in (-pi, pi]
 
     # --- IPOPT: the assembly nearest to target positions ---
     def nearest_assembly(self, q0, u, p, targets: dict[str, np.ndarray], L) -> Solution:

@@ -35,6 +35,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import GROUND, Mechanism, as_param
+from . import joints as _joints
 
 # --- quantity names ---
 
@@ -50,7 +51,7 @@ def _extras():
     """Modules that define more quantities (each: `check(sym, name)` -> None when the name is
     not theirs, else a list of problems; `expression(sym, name, t)` -> SX)."""
     from . import dynamics, geometry
-    return geometry, dynamics
+    return geometry, dynamics, _joints
 
 
 def parse_quantity(name: str):
@@ -70,7 +71,7 @@ def is_angular(name: str, mech: Mechanism | None = None) -> bool:
         return is_angular(a, mech)
     if b == "jerk" and mech is not None and a in {s.name for s in mech.slides}:
         return False
-    return b in _LINK_Q
+    return b in _LINK_Q or b in _joints.ANGULAR_ATTRS
 
 
 def needs_jerk(name: str) -> bool:
@@ -148,6 +149,7 @@ class Symbolic:
             ey = self.points[sl.point][1] - (oy + s * tx + c * ty)
             eqs.append(dx * ey - dy * ex)  # distance of the point from the line
             self.slide_s[sl.name] = dx * ex + dy * ey
+        eqs += _joints.equations(self, new)  # relative inputs, gears, racks, cams
         for k, i in enumerate(m.inputs):
             if i.kind == "slide":
                 eqs.append(self.slide_s[i.target] - self.u[k])
@@ -214,8 +216,9 @@ class Symbolic:
                     out.append(f"{where}: {n!r}: {b!r} is driven by an input (use its rate instead)")
             elif self.position_expr(a, b)[0] is None:
                 out.append(f"{where}: unknown quantity {n!r} (expected P.x, P.vx, P.ax, P.jx, "
-                           f"P.curvature, P.cx, L.angle, L.omega, L.alpha, L.jerk, L.icx, A/B.icx, "
-                           f"S.s, S.v, S.a, S.jerk, effort(KEY), shaking.x, reaction(P, L).x "
+                           f"P.curvature, P.cx, L.angle, L.omega, L.alpha, L.jerk, L.icx, A/B.angle, "
+                           f"A/B.omega, A/B.icx, S.s, S.v, S.a, S.jerk, cam.contact.x, cam.phi, "
+                           f"cam.pressure, effort(KEY), shaking.x, reaction(P, L).x "
                            f"or d(Q)/d(p) with declared names)")
         return out
 
