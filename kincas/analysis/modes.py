@@ -114,7 +114,8 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
     from .sweeps import sweep  # the assembly a sweep from the mechanism's guess starts on
     first = sweep(m, {k: [v] for k, v in zip([i.key for i in m.inputs], u)}, report=[])
     picked = first.q[0] if first.ok[0] else None
-    return _distinct(m, model, found + ([picked] if picked is not None else []), u, p, L, picked)
+    from ..frames import Modes  # a list, with to_pandas() and to_xarray()
+    return Modes(_distinct(m, model, found + ([picked] if picked is not None else []), u, p, L, picked))
 
 
 def _input_vector(m: Mechanism, inputs) -> np.ndarray:

@@ -31,6 +31,7 @@ COMMANDS = {
     "optimize": ("kincas.synthesis.optimize", "optimise parameters as the scene's [optimize] section says"),
     "tolerance": ("kincas.analysis.tolerance", "first-order and Monte-Carlo spread of outputs from parameter tolerances"),
     "study": ("kincas.cli.study", "many designs at once: the scene's [study] section, one row per design"),
+    "cam": ("kincas.cli.cam", "design a disc cam from the scene's [cam_design] section (profile, pressure angle, curvature)"),
 }
 
 
@@ -45,6 +46,9 @@ def _parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
     s.add_argument("--plot", metavar="OUT.png", help="draw the mechanism with the paths of its points")
     s.add_argument("--animate", metavar="OUT.gif", help="animate the sweep")
     s.add_argument("--plot-quantities", metavar="OUT.png", help="plot the reported quantities against the input")
+    s.add_argument("--html", metavar="OUT.html", help="one self-contained page: the mechanism animated, a slider, the quantities plotted")
+    s.add_argument("--svg", metavar="OUT.svg", help="the drawing and the paths as vector graphics")
+    s.add_argument("--dxf", metavar="OUT.dxf", help="links, pivots, slides and paths as DXF entities, a layer per body (kincas[cad])")
     s.add_argument("--paths", metavar="P,Q", help="points whose paths --plot and --animate draw (default: every moving point)")
     s.add_argument("--pose", type=int, metavar="I", help="the pose --plot draws, by index (default: the first solved; -1: the last)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar, even on a terminal")
@@ -122,7 +126,8 @@ def _check_args(args) -> None:
 def _solve(args) -> int:
     from .scene import load
     sc = load(args.scene)
-    wants_files = args.csv or args.plot or args.animate or args.plot_quantities
+    wants_files = (args.csv or args.plot or args.animate or args.plot_quantities or args.html
+                   or args.svg or args.dxf)
     if wants_files or args.pose is not None:  # wrong options fail before a long solve
         from .outputs import check_outputs
         check_outputs(args, sc.mechanism, len(next(iter(sc.study.inputs.values()))))
