@@ -50,6 +50,8 @@ def _parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
     s.add_argument("--svg", metavar="OUT.svg", help="the drawing and the paths as vector graphics")
     s.add_argument("--dxf", metavar="OUT.dxf", help="links, pivots, slides and paths as DXF entities, a layer per body (kincas[cad])")
     s.add_argument("--paths", metavar="P,Q", help="points whose paths --plot and --animate draw (default: every moving point)")
+    s.add_argument("--evolute", metavar="P,Q", help="with --plot: draw the evolutes (centres of curvature) of these points' paths")
+    s.add_argument("--centrodes", metavar="L,M", help="with --plot: draw the fixed and moving centrodes of these links")
     s.add_argument("--pose", type=int, metavar="I", help="the pose --plot draws, by index (default: the first solved; -1: the last)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar, even on a terminal")
     chosen = next((a for a in (argv or []) if not a.startswith("-")), None)
@@ -128,7 +130,7 @@ def _solve(args) -> int:
     sc = load(args.scene)
     wants_files = (args.csv or args.plot or args.animate or args.plot_quantities or args.html
                    or args.svg or args.dxf)
-    if wants_files or args.pose is not None:  # wrong options fail before a long solve
+    if wants_files or args.pose is not None or args.evolute or args.centrodes:  # fail before a long solve
         from .outputs import check_outputs
         check_outputs(args, sc.mechanism, len(next(iter(sc.study.inputs.values()))))
     sw = sc.run(progress=progress_for(args))
