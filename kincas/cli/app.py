@@ -203,10 +203,30 @@ def _unit(sc, name: str) -> str:
         return f"{uq or '1'}/{up}" if up else (f"{uq} per {attr}" if uq else "")
     if name in sc.mechanism.param_values:  # a driven parameter: a length, or an angle
         return _param_unit(sc, name)
+    force = _force_unit(sc, name, L)
+    if force is not None:
+        return force
     base = A if is_angular(name, sc.mechanism) else L  # input keys L.angle included
     order = {"vx": 1, "vy": 1, "omega": 1, "v": 1, "ax": 2, "ay": 2, "alpha": 2, "a": 2,
              "jx": 3, "jy": 3, "jerk": 3}.get(attr, 0)
     return base + ("" if order == 0 else f"/{T}" if order == 1 else f"/{T}^{order}")
+
+
+def _force_unit(sc, name: str, L: str) -> str | None:
+    """Units of force quantities and curvature (None for others). The scene names no mass
+    unit, so a force is written `force` (N with masses in kg and SI lengths, or in t and mm)."""
+    from ..core.dynamics import _EFFORT
+    m = _EFFORT.match(name)
+    if m:
+        angular = m["key"].endswith(".angle")
+        return f"force·{L}" if angular and L else "force"
+    if name.startswith("reaction(") or name in ("shaking.x", "shaking.y"):
+        return "force"
+    if name == "shaking.moment":
+        return f"force·{L}" if L else "force"
+    if name.endswith(".curvature"):
+        return f"1/{L}" if L else ""
+    return None
 
 
 def _param_unit(sc, name: str) -> str:
