@@ -139,6 +139,7 @@ def _solve(args) -> int:
     if args.json:
         doc = {"title": sc.study.title, "units": sc.study.units,
                "inputs": {k: _list(v) for k, v in inputs.items()},
+               "rates": _user_rates(sc, sw.rates), "accelerations": _user_rates(sc, sw.accelerations),
                "status": sw.status.tolist(), "flags": list(sw.flags),
                "values": {k: _list(v) for k, v in values.items()},
                "events": [_user_event(sc, e) for e in sw.events]}
@@ -161,6 +162,19 @@ def progress_for(args):
     except ModuleNotFoundError:
         return None
     return Progress(stream=sys.stderr)
+
+
+def _user_rates(sc, rates: dict) -> dict:
+    """Each input's rate (or acceleration) in the scene's units: one number when it is the
+    same at every pose, else a list."""
+    out = {}
+    for k, v in rates.items():
+        v = np.atleast_1d(np.asarray(v, float))
+        if k.endswith(".angle") and sc.study.deg:
+            v = np.degrees(v)
+        v = np.array([float(f"{x:.15g}") for x in v])  # through radians: 60.00000000000001 is 60
+        out[k] = float(v[0]) if v.size and np.ptp(v) == 0 else _list(v)
+    return out
 
 
 def _user_event(sc, e: dict) -> dict:
@@ -189,10 +203,30 @@ def _unit(sc, name: str) -> str:
         return f"{uq or '1'}/{up}" if up else (f"{uq} per {attr}" if uq else "")
     if name in sc.mechanism.param_values:  # a driven parameter: a length, or an angle
         return _param_unit(sc, name)
+    force = _force_unit(sc, name, L)
+    if force is not None:
+        return force
     base = A if is_angular(name, sc.mechanism) else L  # input keys L.angle included
     order = {"vx": 1, "vy": 1, "omega": 1, "v": 1, "ax": 2, "ay": 2, "alpha": 2, "a": 2,
              "jx": 3, "jy": 3, "jerk": 3}.get(attr, 0)
     return base + ("" if order == 0 else f"/{T}" if order == 1 else f"/{T}^{order}")
+
+
+def _force_unit(sc, name: str, L: str) -> str | None:
+    """Units of force quantities and curvature (None for others). The scene names no mass
+    unit, so a force is written `force` (N with masses in kg and SI lengths, or in t and mm)."""
+    from ..core.dynamics import _EFFORT
+    m = _EFFORT.match(name)
+    if m:
+        angular = m["key"].endswith(".angle")
+        return f"force·{L}" if angular and L else "force"
+    if name.startswith("reaction(") or name in ("shaking.x", "shaking.y"):
+        return "force"
+    if name == "shaking.moment":
+        return f"force·{L}" if L else "force"
+    if name.endswith(".curvature"):
+        return f"1/{L}" if L else ""
+    return None
 
 
 def _param_unit(sc, name: str) -> str:
