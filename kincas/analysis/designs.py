@@ -242,9 +242,8 @@ class _Job:
         self.info = np.full((nd, 5, n), np.nan)
         self.code = np.full((nd, n), NOT_SOLVED, dtype=np.int8)
         self.fast = np.zeros((nd, n), dtype=bool)  # values computed by the kernel
-        nu = model.nu
-        self.S = np.full((nd, nq + nq * nq + 2 * (nq * nu + nu)), np.nan)  # kernel states
         self.kernel = DesignKernel(model, report, compile) if model.square and model.nq and model.nu else None
+        self.S = np.full((nd, self.kernel.sweeper.state_size if self.kernel else 0), np.nan)  # kernel states
 
     def check_gears(self):
         """A design whose gear centres are not r1 + r2 (or |r2 - r1|) apart at its first
@@ -285,7 +284,8 @@ class _Job:
             _, J, Ju, _ = BatchEvaluator(model).derivatives(self.Q[idx, 0], u, self.P[idx])
             T = -_solve(J, Ju)
             cm = lambda a: a.transpose(0, 2, 1).reshape(len(idx), -1)  # column-major rows
-            self.S[idx] = np.concatenate([self.Q[idx, 0], cm(J), cm(T), u, cm(T), u], axis=1)
+            Jd = self.kernel.sweeper.diagonal(J)  # g_q's diagonal blocks, as the kernel keeps them
+            self.S[idx] = np.concatenate([self.Q[idx, 0], Jd, cm(T), u, cm(T), u], axis=1)
 
     def _continue_in_parameters(self, q0, p0, sign0) -> np.ndarray:
         model, P, Ls = self.model, self.P, self.Ls
