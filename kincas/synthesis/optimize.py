@@ -333,6 +333,9 @@ def cli_arguments(parser) -> None:
     """Arguments of `kincas optimize`."""
     parser.add_argument("scene", help="the scene file (TOML) with an [optimize] section")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--starts", type=int, metavar="N", help="optimise from N starting designs drawn in the bounds; report the best distinct optima")
+    parser.add_argument("--seed", type=int, help="random seed of the starts (default 0)")
+    parser.add_argument("--scheduler", metavar="ADDRESS", help="run the starts on the Dask cluster at this scheduler address")
 
 
 def cli_run(args) -> int:
@@ -343,6 +346,9 @@ def cli_run(args) -> int:
     from ..cli.scene import load
 
     sc = load(args.scene)
+    if getattr(args, "starts", None) is not None:
+        from .multistart import cli_run as multistart_run
+        return multistart_run(sc, args)
     r = run_scene(sc)
     doc = report(sc, r)
     if args.json:
