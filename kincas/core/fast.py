@@ -50,9 +50,11 @@ from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, NEAR, RESIDUAL, STEP, SW
 # Kernel size, in casadi instructions, beyond which compiling costs more than it saves: gcc
 # -O3 took 1.7 s at 11k instructions, 13 s at 39k and 200 s (3.5 GB) at 150k.
 COMPILE_MAX = 40_000
-# Beyond this size the virtual machine is slower than the careful path (measured on chains
-# of four-bars: equal near 7k instructions, twice as slow at 11k).
-VM_MAX = 6_000
+# Beyond this size the virtual machine would be slower than the careful path. Since the kernel
+# solves group by group it grows linearly, and on 40 chained four-bars (7.9k instructions) the
+# virtual machine took 0.3 ms a pose against 26 ms on the careful path: only a far larger
+# kernel could lose (and it is never compiled either).
+VM_MAX = 200_000
 INFO = ("residual", "step", "jac_change", "correction", "steps")
 BLOCK = 65536  # poses per call when a progress callback wants news
 _I, _V = ctypes.c_longlong, ctypes.c_void_p
