@@ -93,7 +93,8 @@ def study_api(cfg, log) -> dict:
              ("scipy fsolve", fsolve_peer, {"jacobian": True}), ("python-solvespace", solvespace_peer, {})]
     out: dict = {}
     for name in CASES:
-        res, cache = out[name] = {}, Path(tempfile.mkdtemp(prefix=f"kincas-cli-{name}-"))
+        res = out[name] = {}
+        cache = Path(tempfile.mkdtemp(prefix=f"kincas-cli-{name}-"))
         for n in cfg["api_lengths"]:
             case = getattr(cases, name)(n)
             P, V = reference(case)
