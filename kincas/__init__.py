@@ -17,7 +17,7 @@ from . import _aliases
 from .errors import KincasError, ModelError, SceneError
 from .model import Input, Link, Load, Mechanism, Param, Slide
 from .results import Pose, Sweep
-from .core.numeric import compile
+from .core.numeric import compile, model_of
 from .analysis.sweeps import solve, sweep
 
 _aliases.install()  # `import kincas.modes` and other paths of the flat 0.1 layout
@@ -27,6 +27,6 @@ def __getattr__(name):
     return _aliases.attribute(name)
 
 
-__all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "sweep", "compile",
+__all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "sweep", "model_of", "compile",
            "Pose", "Sweep", "KincasError", "ModelError", "SceneError"]
 __version__ = "0.1.0"
