@@ -49,11 +49,7 @@ def careful_pose(model: Model, m: Mechanism, U, p, L, guess, k: int, j: int | No
 
 
 def _first(model: Model, u, p, L, guess) -> Solution:
-    q0 = model.initial_q(u, p, guess, L)
-    sol = model.newton(q0, u, p, L)
-    if not sol.ok:  # IPOPT: the assembly nearest the guessed points
-        sol = model.nearest_assembly(q0, u, p, {k: np.array(v) for k, v in guess.items()}, L)
-    return sol
+    return model.assemble(u, p, guess, L)  # Newton from the guess, else IPOPT (nearest)
 
 
 def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:

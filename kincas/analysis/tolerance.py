@@ -28,14 +28,15 @@ reported beside the Monte-Carlo sampling error, 1 / sqrt(2 (N - 1)) relative.
 """
 from __future__ import annotations
 
-import json
 import math
-import sys
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import ModelError, SceneError
+from ..core.batch import sample_function
+from ..core.numeric import model_of
+from ..core.tolerances import ACCEPT
 from ..model.mechanism import Mechanism
 
 NEWTON_STEPS = 5  # after the first-order predictor; quadratic convergence needs few
@@ -151,9 +152,7 @@ def _check_std(m: Mechanism, std, where: str) -> list[str]:
 
 def _monte_carlo(m: Mechanism, sw, report, to, dp):
     """Monte-Carlo std and mean shift (poses x outputs), failures per pose, samples retried."""
-    from ..core.numeric import ACCEPT, compile
-
-    model = compile(m)
+    model = model_of(m)
     sym, nq = model.sym, model.nq
     n_s, n_pose = dp.shape[0], len(sw)
     p0 = np.array([v for _, v in m.parameters], dtype=float)
@@ -169,7 +168,9 @@ def _monte_carlo(m: Mechanism, sw, report, to, dp):
     ok_poses = np.flatnonzero(sw.ok)
     if not len(ok_poses):
         return mc, shift, failed, 0
-    F = _sample_function(model, tuple(report))
+    F = sample_function(model, tuple(report), NEWTON_STEPS)
+    # each equation's residual relative to its own group's length, at each pose
+    EQ = np.stack([model.scales(U[k], p0)[0] for k in range(n_pose)]) if n_pose else None
     det_scale = model.column_scale(L)  # columns to O(1): det signs comparable
     # Columns: sample-major within each solved pose, so each pose is one contiguous block.
     Pall = p0[:, None] + np.zeros((len(p0), n_s))
@@ -187,9 +188,9 @@ def _monte_carlo(m: Mechanism, sw, report, to, dp):
         f = F.map(len(idx))
         q, r, J, vals = (np.asarray(a) for a in f(
             sw.q[pose].T, U[pose].T, np.repeat(p0[:, None], len(idx), 1), DP[:, samp],
-            Ud[pose].T, Udd[pose].T))
+            Ud[pose].T, Udd[pose].T, EQ[pose].T))
         J = J.T.reshape(len(idx), nq, nq).transpose(0, 2, 1) if nq else np.zeros((len(idx), 0, 0))
-        qs[:, idx], res[idx], Qv[:, idx] = q, r.ravel() / L, vals
+        qs[:, idx], res[idx], Qv[:, idx] = q, r.ravel(), vals
         dets[idx] = np.linalg.det(J * det_scale) if nq else 1.0
     # The nominal branch: the sign of det(g_q) at each nominal pose.
     ref = np.array([np.sign(np.linalg.det(model.jac(sw.q[k], U[k], p0) * det_scale))
@@ -225,42 +226,11 @@ def _monte_carlo(m: Mechanism, sw, report, to, dp):
     return mc, shift, failed, retried
 
 
-def _sample_function(model, report: tuple[str, ...]):
-    """F(q0, u, p0, dp, u', u'') -> (q, |g|max, g_q, quantities): first-order predictor from
-    the nominal pose, then NEWTON_STEPS Newton steps, all as one CasADi expression graph."""
-    return model.memo(("tolerance.sample", report), lambda: _build_sample_function(model, report))
-
-
-def _build_sample_function(model, report):
-    import casadi as ca
-
-    sym = model.sym
-    q0, u, p0, dp = (ca.SX.sym(n, k) for n, k in
-                     (("q0", sym.nq), ("u", sym.nu), ("p0", sym.np), ("dp", sym.np)))
-    ud, udd = ca.SX.sym("ud", sym.nu), ca.SX.sym("udd", sym.nu)
-    p = p0 + dp
-    gp = ca.Function("gp", [sym.q, sym.u, sym.p], [ca.jacobian(sym.g, sym.p)])
-    if sym.nq:
-        # Predictor: the tangent of the solution manifold, dq/dp = -g_q^-1 g_p, at the nominal.
-        _, J0 = sym.f_resjac(q0, u, p0)
-        q = q0 - ca.solve(J0, ca.mtimes(gp(q0, u, p0), dp))
-        for _ in range(NEWTON_STEPS):  # Newton with the exact Jacobian: g_q dq = -g
-            g, J = sym.f_resjac(q, u, p)
-            q = q - ca.solve(J, g)
-        g, J = sym.f_resjac(q, u, p)
-        r = ca.mmax(ca.fabs(g))
-    else:
-        q, J, r = ca.SX(0, 1), ca.SX(0, 0), ca.SX(0)
-    vals = model.quantity_function(report)(q, u, p, ud, udd)
-    return ca.Function("tolerance_sample", [q0, u, p0, dp, ud, udd], [q, r, ca.vec(J), vals])
-
-
 # --- scenes: the [tolerance] section ---
 
 
 def read_section(sc) -> dict:
     """The `[tolerance]` section as analyse()'s keywords; SceneError naming the field."""
-    from ..core.numeric import compile
     from ..core.symbolic import parse_quantity
 
     t = sc.study.raw.get("tolerance")
@@ -282,81 +252,10 @@ def read_section(sc) -> dict:
     if not isinstance(report, list) or not all(isinstance(n, str) for n in report):
         problems.append("[tolerance] report: expected a list of quantity names")
     else:
-        problems += compile(sc.mechanism).sym.check_names(report, "[tolerance] report")
+        problems += model_of(sc.mechanism, check=False).sym.check_names(report, "[tolerance] report")
         problems += [f"[tolerance] report: {n!r}: a sensitivity has no spread to analyse"
                      for n in report if parse_quantity(n)[0] == "sens"]
     if problems:
         raise SceneError(problems)
     return {"std": {k: float(v) for k, v in t["std"].items()}, "samples": samples,
             "seed": seed, "report": report}
-
-
-# --- the command line: kincas tolerance SCENE.toml ---
-
-
-def cli_arguments(parser) -> None:
-    """Arguments of `kincas tolerance`."""
-    parser.add_argument("scene", help="the scene file (TOML) with a [tolerance] section")
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--samples", type=int, help="Monte-Carlo samples (overrides the scene)")
-    parser.add_argument("--seed", type=int, help="random seed (overrides the scene)")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
-
-
-def cli_run(args) -> int:
-    """Run `kincas tolerance`: 0 when every pose and sample was solved, 3 otherwise."""
-    from ..cli.app import _list, _unit, progress_for
-    from ..core.symbolic import is_angular
-
-    from ..cli.scene import load
-
-    sc = load(args.scene)
-    kw = read_section(sc)
-    for k in ("samples", "seed"):
-        if getattr(args, k) is not None:
-            kw[k] = getattr(args, k)
-    if kw["samples"] < 2:
-        raise SceneError(f"--samples: expected a whole number >= 2, got {kw['samples']}")
-    st = sc.study
-    r = analyse(sc.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
-                progress=progress_for(args), **kw)
-    user = lambda n, v: np.degrees(v) if is_angular(n, sc.mechanism) and st.deg else np.asarray(v, float)
-    inputs = {k: user(k, v) for k, v in r.inputs.items()}
-    fo = {n: user(n, r.first_order[n]) for n in r.names}
-    mc = {n: user(n, r.monte_carlo[n]) for n in r.names}
-    if args.json:
-        doc = {"title": st.title, "units": st.units, "samples": r.samples, "seed": r.seed,
-               "std": r.std, "inputs": {k: _list(v) for k, v in inputs.items()},
-               "status": r.status, "failed": r.failed.tolist(),
-               "nominal": {n: _list(user(n, r.nominal[n])) for n in r.names},
-               "first_order": {n: _list(v) for n, v in fo.items()},
-               "monte_carlo": {n: _list(v) for n, v in mc.items()},
-               "agreement": {n: _list(v) for n, v in r.agreement.items()},
-               "standard_error": r.standard_error, "agrees": r.agrees()}
-        json.dump(doc, sys.stdout, allow_nan=False)
-        sys.stdout.write("\n")
-    else:
-        _print(sc, r, inputs, fo, mc, lambda n: _unit(sc, n))
-    unsolved = any(s != "ok" for s in r.status) or int(r.failed.sum()) > 0
-    return 3 if unsolved else 0
-
-
-def _print(sc, r: ToleranceResult, inputs, fo, mc, unit):
-    stds = ", ".join(f"{p} {s:g}" for p, s in r.std.items())
-    print(f"{sc.study.title or 'kincas'}: tolerance analysis, {r.samples} samples (seed {r.seed})")
-    print(f"standard deviations: {stds}")
-    print("first-order std (exact sensitivities) and Monte-Carlo std, per pose:")
-    cols = [(k, v, unit(k)) for k, v in inputs.items()]
-    for n in r.names:
-        cols += [(f"std {n}", fo[n], unit(n)), (f"mc {n}", mc[n], unit(n))]
-    heads = [f"{h} [{u}]" if u else h for h, _, u in cols]
-    width = [max(12, len(h)) for h in heads]
-    print("  ".join(h.rjust(w) for h, w in zip(heads, width)) + "  failed")
-    for i in range(len(r.status)):
-        cells = [("-" if not math.isfinite(v[i]) else f"{v[i]:.6g}").rjust(w)
-                 for (_, v, _), w in zip(cols, width)]
-        tail = f"  {r.failed[i]}" if r.status[i] == "ok" else f"  ({r.status[i]})"
-        print("  ".join(cells) + tail)
-    verdict = "agree" if r.agrees() else "differ (the outputs are not linear over the tolerances)"
-    print(f"Monte Carlo and first order {verdict}: sampling error {100 * r.standard_error:.2g} %; "
-          f"{int(r.failed.sum())} sample poses did not assemble on the nominal branch")

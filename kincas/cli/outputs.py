@@ -48,7 +48,7 @@ def heading(name: str, scene=None) -> str:
     >>> heading("rocker.alpha")
     'rocker.alpha [rad/s^2]'
     """
-    from .app import _unit
+    from .common import _unit
     u = _unit(_units_of(scene), name)
     return f"{name} [{u}]" if u else name
 
@@ -317,7 +317,7 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
 
 
 def _caption(scene, sweep, inputs, i) -> str:
-    from .app import _unit
+    from .common import _unit
     parts = []
     for k, v in inputs.items():
         u = _unit(scene, k)

@@ -1,0 +1,25 @@
+"""What every command of the command line shares: exit statuses, the progress bar, units and
+JSON lists of the scene's quantities."""
+from __future__ import annotations
+
+import sys
+
+from ..units import json_list as _list, unit_label  # noqa: F401  (_list: JSON arrays, NaN -> null)
+
+EXIT_OK, EXIT_SCENE, EXIT_UNSOLVED, EXIT_INTERRUPTED = 0, 2, 3, 130
+
+
+def progress_for(args):
+    """A progress callback for long runs on a terminal; None when piped or with --json."""
+    if getattr(args, "json", False) or getattr(args, "no_progress", False) or not sys.stderr.isatty():
+        return None
+    try:
+        from .progress import Progress
+    except ModuleNotFoundError:
+        return None
+    return Progress(stream=sys.stderr)
+
+
+def _unit(sc, name: str) -> str:
+    """The unit of quantity `name` in the scene's units (kincas/units.py)."""
+    return unit_label(sc.study.units, sc.mechanism, name)

@@ -1,0 +1,97 @@
+"""`kincas optimize SCENE.toml`: the scene's [optimize] section solved by IPOPT, the design
+reported in the scene's units (kincas/synthesis/optimize.py does the work)."""
+from __future__ import annotations
+
+import json
+import math
+import sys
+
+import numpy as np
+
+from ..model.names import is_angular
+from ..synthesis.optimize import OptimizeResult, run_scene
+from ..units import json_list as _list
+from .scene import load
+
+
+def cli_arguments(parser) -> None:
+    """Arguments of `kincas optimize`."""
+    parser.add_argument("scene", help="the scene file (TOML) with an [optimize] section")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def cli_run(args) -> int:
+    """Run `kincas optimize`: 0 for an optimal design that passed every check, 3 otherwise."""
+    sc = load(args.scene)
+    r = run_scene(sc)
+    doc = report(sc, r)
+    if args.json:
+        json.dump(doc, sys.stdout, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        _print(sc, r, doc)
+    return 0 if r.ok else 3
+
+
+def report(sc, r: OptimizeResult) -> dict:
+    """The result as the JSON object of `kincas optimize --json`, in the scene's units."""
+    deg = sc.study.deg
+    user = lambda n, v: np.degrees(v) if deg and is_angular(n, sc.mechanism) else np.asarray(v, float)
+    bounds = sc.study.raw["optimize"]["vary"]
+    key = sc.mechanism.inputs[0].key
+    num = lambda v: float(v) if math.isfinite(v) else None
+    curve = {}
+    if "curve" in r.info:  # the fitted input at each target and the distance left there
+        c = r.info["curve"]
+        curve = {"curve": {"point": c["point"], "targets": c["targets"].tolist(),
+                           "inputs": {key: _list(user(key, r.samples[key]))},
+                           "distances": _list(c["distances"])}}
+    return {
+        "title": sc.study.title, "units": sc.study.units, "ok": r.ok, "converged": r.converged,
+        "status": r.status, "message": r.message, "problems": r.problems,
+        "iterations": r.iterations, "objective": num(r.objective),
+        "initial_objective": num(r.initial_objective),
+        "parameters": r.parameters, "varied": r.varied,
+        "initial": {p: sc.mechanism.parameter(p) for p in r.varied},
+        "bounds": {p: list(bounds[p]) for p in r.varied},
+        "samples": {k: _list(user(k, v)) for k, v in r.samples.items()},
+        "values": {n: _list(user(n, v)) for n, v in r.values.items()},
+        "constraints": [{**{k: c[k] for k in ("expr", "min", "max", "satisfied")},
+                         "value": _list(np.atleast_1d(c["value"]))} for c in r.constraints],
+        "extremes": [{"kind": e["kind"], "expr": e["expr"], "value": num(e["value"]),
+                      "input": {key: num(float(user(key, e["input"])))}} for e in r.extremes],
+        **curve,
+    }
+
+
+def _print(sc, r: OptimizeResult, doc: dict):
+    print(f"{sc.study.title or 'kincas'}: optimisation by IPOPT ({r.status}, "
+          f"{r.iterations} iterations)")
+    print(r.message)
+    for p in r.problems[1:]:
+        print(f"  also: {p}")
+    print(f"objective: {r.initial_objective:.8g} (initial design) -> {r.objective:.8g}")
+    print(f"{'parameter':>12}  {'initial':>14}  {'optimised':>14}  {'low':>10}  {'high':>10}")
+    for p, v in r.varied.items():
+        lo, hi = doc["bounds"][p]
+        print(f"{p:>12}  {doc['initial'][p]:>14.8g}  {v:>14.8g}  {lo:>10.6g}  {hi:>10.6g}")
+    for c in doc["constraints"]:
+        v = [x for x in c["value"] if x is not None]
+        shown = f"{v[0]:.8g}" if len(v) == 1 else f"from {min(v):.8g} to {max(v):.8g} over the samples"
+        lo, hi = c["min"], c["max"]
+        want = (f"= {lo:g}" if lo == hi else f">= {lo:g}" if hi is None else f"<= {hi:g}"
+                if lo is None else f"in [{lo:g}, {hi:g}]")
+        print(f"constraint {c['expr']} {want}: {shown}, {'holds' if c['satisfied'] else 'VIOLATED'}")
+    for e in doc["extremes"]:
+        (k, u), = e["input"].items()
+        print(f"{e['kind']}({e['expr']}) = {e['value']:.8g} at {k} = {u:.6g}")
+    if "curve" in doc:
+        c = doc["curve"]
+        (k, u), = c["inputs"].items()
+        print(f"{'target x':>12}  {'target y':>12}  {k + ' (fitted)':>20}  {'distance':>12}")
+        for (x, y), ui, d in zip(c["targets"], u, c["distances"]):
+            shown = lambda v, f: format(v, f) if v is not None else "-"
+            print(f"{x:>12.6g}  {y:>12.6g}  {shown(ui, '>20.8g')}  {shown(d, '>12.4g')}")
+    print("\n[parameters]   # the optimised design" + ("" if r.ok else " (NOT optimal, see above)"))
+    for p, v in r.parameters.items():
+        print(f"{p} = {v:.12g}")
