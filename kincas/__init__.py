@@ -19,6 +19,8 @@ from .model import Input, Link, Load, Mechanism, Param, Slide
 from .results import Pose, Sweep
 from .core.numeric import compile, model_of
 from .analysis.sweeps import solve, sweep
+from .analysis.designs import sweep_designs
+from .synthesis.study import study
 
 _aliases.install()  # `import kincas.modes` and other paths of the flat 0.1 layout
 
@@ -27,6 +29,8 @@ def __getattr__(name):
     return _aliases.attribute(name)
 
 
-__all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "sweep", "model_of", "compile",
+__all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "sweep",
+           "sweep_designs", "study", "model_of", "compile",
+           "sensitivities", "analyse", "optimize", "find_modes", "input_range",
            "Pose", "Sweep", "KincasError", "ModelError", "SceneError"]
 __version__ = "0.1.0"

@@ -47,8 +47,16 @@ def install() -> None:
         sys.meta_path.append(_Finder())
 
 
+# functions exported from `kincas`, loaded on first use (`kincas.optimize` is the module of
+# 0.1's path and, being callable, the function too: see synthesis/optimize.py)
+FUNCTIONS = {"sensitivities": "analysis.sensitivity", "analyse": "analysis.tolerance",
+             "find_modes": "analysis.modes", "input_range": "analysis.singular"}
+
+
 def attribute(name: str):
     """`kincas.modes` and the like as attributes of the package (loaded on first use)."""
+    if name in FUNCTIONS:
+        return getattr(importlib.import_module(f"kincas.{FUNCTIONS[name]}"), name)
     if name in OLD:
         return importlib.import_module(f"kincas.{OLD[name]}")
     raise AttributeError(f"module 'kincas' has no attribute {name!r}")

@@ -11,6 +11,10 @@ wrapped to (-pi, pi].
 ...           residual=np.zeros(2), iterations=np.zeros(2, int), unknowns=["q"], size=1.0)
 >>> float(s["C.x"][0]), s.ok.tolist(), s.pose(1).status
 (1.5, [True, False], 'no assembly')
+>>> (s.status == "ok").tolist(), "C.x" in s, list(s)
+([True, False], True, ['crank.angle', 'C.x'])
+>>> s
+<Sweep: 2 poses, 1 solved, 1 not solved; inputs crank.angle; reported C.x>
 """
 from __future__ import annotations
 
@@ -25,7 +29,7 @@ def wrap_angle(a: np.ndarray) -> np.ndarray:
     return np.where(w == -np.pi, np.pi, w)
 
 
-@dataclass
+@dataclass(repr=False)
 class Pose:
     """One solved (or unsolved) pose: `pose["C.x"]` is a float (NaN when not solved)."""
 
@@ -42,15 +46,35 @@ class Pose:
     def __getitem__(self, name: str) -> float:
         return self.values[name] if name in self.values else self.inputs[name]
 
+    def __contains__(self, name) -> bool:
+        return name in self.values or name in self.inputs
 
-@dataclass
+    def __iter__(self):
+        return iter([*self.inputs, *self.values])
+
+    def __repr__(self) -> str:
+        at = ", ".join(f"{k}={v:.6g}" for k, v in self.inputs.items())
+        flag = f" ({self.flag})" if self.flag else ""
+        return f"<Pose {at}: {self.status}{flag}; {len(self.values)} values>"
+
+
+@dataclass(repr=False)
 class Sweep:
-    """Poses over a sweep of the inputs: `sweep["C.x"]` is an array with one entry per pose."""
+    """Poses over a sweep of the inputs: `sweep["C.x"]` is an array with one entry per pose.
+
+    A sweep is a container of names (the inputs', then the reported quantities'): `"C.x" in
+    sweep`, `list(sweep)`, `for name in sweep`. `status` is a numpy array of strings, one per
+    pose ("ok", or why the pose was not solved, such as "no assembly"), so `sweep.status ==
+    "ok"` is a boolean mask, the same as `sweep.ok`; `flags` names poses at or near a singular
+    position ("limit", "change point", "singular", else None). Values are radians for angles,
+    whatever the scene's unit (`Scene.user_values` converts). `to_pandas()` and `to_xarray()`
+    give the same data as a DataFrame or a Dataset (extra `kincas[data]`).
+    """
 
     inputs: dict[str, np.ndarray]
     rates: dict[str, np.ndarray]
     accelerations: dict[str, np.ndarray]
-    status: list[str]
+    status: np.ndarray  # strings, one per pose (a list given is made an array)
     flags: list[str | None]
     values: dict[str, np.ndarray]
     q: np.ndarray  # the unknowns at each pose (NaN when not solved)
@@ -62,8 +86,10 @@ class Sweep:
     info: dict = field(default_factory=dict)
 
     def __post_init__(self):
+        # object dtype: a longer status assigned later is kept whole, not truncated
+        self.status = np.array(list(self.status), dtype=object)
         for k in list(self.values):
-            if k.endswith(".angle") and not k.startswith("d("):
+            if k.endswith((".angle", ".phi")) and not k.startswith("d("):  # cam.phi too
                 self.values[k] = wrap_angle(self.values[k])
 
     def __len__(self) -> int:
@@ -76,10 +102,49 @@ class Sweep:
             return self.inputs[name]
         raise KeyError(f"{name!r} was not reported (reported: {list(self.values)})")
 
+    def __contains__(self, name) -> bool:
+        return name in self.values or name in self.inputs
+
+    def __iter__(self):
+        return iter([*self.inputs, *self.values])
+
+    def keys(self) -> list[str]:
+        """The names: inputs, then reported quantities (so `dict(sweep)` works)."""
+        return list(self)
+
+    def __repr__(self) -> str:
+        return f"<Sweep: {self._counts()}; inputs {_names(self.inputs)}; reported {_names(self.values)}>"
+
+    def __str__(self) -> str:
+        return "\n".join(self.summary_lines())
+
+    def _counts(self) -> str:
+        n, good = len(self), int(self.ok.sum())
+        return f"{n} pose{'s' if n != 1 else ''}, {good} solved" + (f", {n - good} not solved" if good < n else "")
+
+    def summary_lines(self) -> list[str]:
+        """A few lines: poses, solved, flags, events, the inputs' ranges, the quantities."""
+        out = [f"Sweep: {self._counts()}"]
+        bad = {str(s): int(c) for s, c in zip(*np.unique(self.status[~self.ok].astype(str), return_counts=True))}
+        if bad:
+            out.append("  not solved: " + ", ".join(f"{c} {s}" for s, c in bad.items()))
+        flags = [f for f in self.flags if f]
+        if flags:
+            kinds = dict.fromkeys(flags)
+            out.append("  flagged: " + ", ".join(f"{flags.count(k)} {k}" for k in kinds))
+        if self.events:
+            kinds = [e.get("kind", "event") for e in self.events]
+            out.append("  events: " + ", ".join(f"{kinds.count(k)} {k}" for k in dict.fromkeys(kinds)))
+        for k, v in self.inputs.items():
+            v = np.asarray(v, float)
+            out.append(f"  input {k}: {v.min():.6g} to {v.max():.6g}" if v.size else f"  input {k}")
+        out.append(f"  reported: {_names(self.values, 8) or 'nothing'}")
+        return out
+
     @property
     def ok(self) -> np.ndarray:
-        """Boolean mask of the solved poses."""
-        return np.array([s == "ok" for s in self.status], dtype=bool)
+        """Boolean mask of the solved poses (the same as `status == "ok"`)."""
+        return np.asarray(self.status == "ok", dtype=bool).reshape(len(self.status))
 
     @property
     def names(self) -> list[str]:
@@ -87,6 +152,14 @@ class Sweep:
 
     def pose(self, i: int) -> Pose:
         return Pose(inputs={k: float(v[i]) for k, v in self.inputs.items()},
-                    status=self.status[i], flag=self.flags[i],
+                    status=str(self.status[i]), flag=self.flags[i],
                     values={k: float(v[i]) for k, v in self.values.items()},
                     residual=float(self.residual[i]))
+
+
+def _names(d, most: int = 4) -> str:
+    """'a, b, c' or 'a, b, c, d and 5 more'."""
+    names = list(d)
+    if len(names) <= most:
+        return ", ".join(names)
+    return ", ".join(names[:most]) + f" and {len(names) - most} more"

@@ -408,6 +408,7 @@ CLOSED_FORMS = {
     "fairbairn": (fairbairn_poses, 2),
     "slider_crank": (slider_crank_poses, 1),
     "fourbar_coupler": (fourbar_poses, 1),
+    "study_fourbar": (fourbar_poses, 1),  # the nominal design of the study example
     "vtwin": (vtwin_poses, 2),
     "sixbar": (sixbar_poses, 2),
     "actuator_bellcrank": (actuator_bellcrank_poses, 2),

@@ -69,7 +69,7 @@ def test_counted_rigid_but_accepted_with_one_redundant_equation():
 
 def test_full_turn_stays_a_parallelogram_through_both_change_points(full_turn):
     t, sw = full_turn
-    assert sw.status == ["ok"] * len(t)
+    assert sw.status.tolist() == ["ok"] * len(t)
     assert sw.residual.max() < 1e-12
     ref = closed(t)
     # g_q is singular at the change points (all links in line): the root is double there, so

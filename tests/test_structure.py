@@ -75,10 +75,13 @@ def unknown_links(model, cols) -> frozenset[str]:
 def test_blocks_are_the_assur_groups(path):
     m = load(path).mechanism
     model = kincas.compile(m)
-    expected = [g for g in assur_groups(m) if model.nq and any(
-        name.split(".")[0] in g for name, _ in model.sym.unknowns)]
-    got = [unknown_links(model, b.cols) for b in model.blocks]
-    assert sorted(map(sorted, got)) == sorted(map(sorted, expected))
+    # the count above knows pins, slides and absolute inputs only: with gears, racks, cams
+    # or relative inputs, only the blocks' own properties below are checked
+    if not (m.gears or m.racks or m.cams or any("/" in i.target for i in m.inputs)):
+        expected = [g for g in assur_groups(m) if model.nq and any(
+            name.split(".")[0] in g for name, _ in model.sym.unknowns)]
+        got = [unknown_links(model, b.cols) for b in model.blocks]
+        assert sorted(map(sorted, got)) == sorted(map(sorted, expected))
     # every unknown and equation in exactly one block, square blocks
     assert sorted(np.concatenate([b.cols for b in model.blocks]).tolist()) == list(range(model.nq))
     assert sorted(np.concatenate([b.rows for b in model.blocks]).tolist()) == list(range(model.ng))

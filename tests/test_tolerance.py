@@ -72,7 +72,7 @@ def test_monte_carlo_equals_the_closed_form_on_the_same_draws():
     n = 3000
     r = analyse(m, {"crank.angle": th}, std, report=["C.x", "C.y", "rocker.angle"],
                 samples=n, seed=7)
-    assert r.status == ["ok"] * len(th) and r.failed.tolist() == [0] * len(th)
+    assert r.status.tolist() == ["ok"] * len(th) and r.failed.tolist() == [0] * len(th)
     dp = draws(std, n, 7)
     a, b, c, d = (1.0 + dp[:, 0], 3.5 + dp[:, 1], 3.0 + dp[:, 2], 4.0 + dp[:, 3])
     cx, cy, psi, _ = closed_fourbar(th[:, None], a, b, c, d)
@@ -112,7 +112,7 @@ def test_samples_that_cannot_assemble_are_counted_and_left_out():
     std = {"a": 0.02, "b": 0.02, "c": 0.02, "d": 0.02}
     n = 1000
     r = analyse(m, {"crank.angle": th}, std, report=["C.y"], samples=n, seed=3)
-    assert r.status == ["ok"] * 3
+    assert r.status.tolist() == ["ok"] * 3
     dp = draws(std, n, 3)
     pars = (1.0 + dp[:, 0], 1.9 + dp[:, 1], 3.0 + dp[:, 2], 4.0 + dp[:, 3])
     _, cy, _, disc = closed_fourbar(th[:, None], *pars)

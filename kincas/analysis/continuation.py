@@ -49,7 +49,7 @@ def careful_pose(model: Model, m: Mechanism, U, p, L, guess, k: int, j: int | No
 
 
 def _first(model: Model, u, p, L, guess) -> Solution:
-    return model.assemble(u, p, guess, L)  # Newton from the guess, else IPOPT (nearest)
+    return model.assemble(u, p, guess, L)  # Newton from the guess, else IPOPT; gears settled
 
 
 def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:

@@ -39,7 +39,7 @@ import numpy as np
 from ..errors import ModelError, SceneError
 from ..model.mechanism import Mechanism
 from ..results import wrap_angle
-from ..core.batch import newton_starts
+from ..core.scatter import newton_starts
 from ..core.numeric import model_of
 from ..core.tolerances import ACCEPT, BRANCH
 from .inputs import input_table

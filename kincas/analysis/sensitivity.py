@@ -53,9 +53,27 @@ class Sensitivities:
     matrix: np.ndarray
     sweep: Sweep
 
-    def __getitem__(self, key: tuple[str, str]) -> np.ndarray:
-        q, p = key
+    def __getitem__(self, key) -> np.ndarray:
+        """`s["C.x", "a"]` or `s["d(C.x)/d(a)"]`: d(C.x)/d(a) over the poses."""
+        if isinstance(key, str):
+            from ..core.symbolic import parse_quantity
+            kind, q, p = parse_quantity(key)
+            if kind != "sens" or q not in self.of or p not in self.to:
+                raise KeyError(f"{key!r} is not one of these sensitivities ({', '.join(self)})")
+        else:
+            q, p = key
         return self.matrix[:, self.of.index(q), self.to.index(p)]
+
+    def __iter__(self):
+        return iter(names(self.of, self.to))
+
+    def __contains__(self, key) -> bool:
+        return key in names(self.of, self.to) or (isinstance(key, tuple) and len(key) == 2
+                                                 and key[0] in self.of and key[1] in self.to)
+
+    def __repr__(self) -> str:
+        return (f"<Sensitivities: {len(self.of)} quantities x {len(self.to)} parameters over "
+                f"{self.matrix.shape[0]} poses: {', '.join(list(self)[:3])}{' ...' if len(list(self)) > 3 else ''}>")
 
     @property
     def ok(self) -> np.ndarray:

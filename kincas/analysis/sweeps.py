@@ -11,7 +11,7 @@ one before along the exact tangent dq/du = -g_q^-1 g_u, so the branch is kept.
 ...            kincas.Link.bar("rocker", "D", "C", 3)],
 ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
 >>> r = kincas.sweep(m, {"crank.angle": np.linspace(0, 2 * np.pi, 7)}, report=["C.x", "C.y"])
->>> r.status[:2], bool(r.residual.max() < 1e-12)
+>>> r.status[:2].tolist(), bool(r.residual.max() < 1e-12)
 (['ok', 'ok'], True)
 """
 from __future__ import annotations
@@ -26,6 +26,7 @@ from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
 from ..core.symbolic import default_report, needs_jerk
 from .continuation import careful_pose
+from ..core.joints import check_first_pose
 from .inputs import input_table as _input_table
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
@@ -85,6 +86,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     else:
         raise ModelError(f"method: {method!r} is neither \"fast\" nor \"careful\"")
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
+    if ok.any():  # gear centre distances at the first solved pose
+        check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
     status = ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
     events += _singular_events(model, m, U, Q, ok, p, L, flags, J=run.jacobian)

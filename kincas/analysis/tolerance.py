@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError, SceneError
-from ..core.batch import sample_function
+from ..core.scatter import sample_function
 from ..core.numeric import model_of
 from ..core.tolerances import ACCEPT
 from ..model.mechanism import Mechanism

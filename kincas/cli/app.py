@@ -28,6 +28,7 @@ COMMANDS = {
     "modes": ("kincas.cli.modes", "the distinct assembly modes at the scene's input, as [guess] blocks"),
     "optimize": ("kincas.cli.optimize", "optimise parameters as the scene's [optimize] section says"),
     "tolerance": ("kincas.cli.tolerance", "first-order and Monte-Carlo spread of outputs from parameter tolerances"),
+    "study": ("kincas.cli.study", "many designs at once: the scene's [study] section, one row per design"),
 }
 
 

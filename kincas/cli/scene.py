@@ -19,7 +19,7 @@ in a scene is gathered into one `SceneError` naming the section and the field.
 ... C = [3.6, 2.9]
 ... ''')
 >>> out = sc.run()
->>> out.status, round(float(sc.user_values(out)["rocker.angle"][0]), 4)
+>>> out.status.tolist(), round(float(sc.user_values(out)["rocker.angle"][0]), 4)
 (['ok'], 109.7303)
 """
 from __future__ import annotations
@@ -38,7 +38,8 @@ from ..results import Sweep
 
 LARGEST = 1e100  # beyond it, squared lengths overflow double precision
 SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
-            "output", "optimize", "tolerance", "gravity", "loads"}
+            "output", "optimize", "tolerance", "gravity", "loads", "study", "gears", "racks",
+            "cams", "cam_design"}
 
 
 @dataclass
@@ -71,6 +72,9 @@ class Scene:
         return self.study.report + [q for q in self.study.sensitivity if q not in self.study.report]
 
     def run(self, **kw) -> Sweep:
+        """Sweep the mechanism as the scene says. The Sweep is Python's: angles in RADIANS
+        whatever the scene's unit (like every kincas result); `user_inputs(sweep)` and
+        `user_values(sweep)` give the numbers in the scene's units, as `kincas solve` prints."""
         from ..analysis.sweeps import sweep  # casadi stays out of scene parsing
         st = self.study
         if any(st.jerks.values()):
@@ -217,6 +221,8 @@ class _Reader:
             self.err("[ground] ground: the name `ground` means the fixed frame")
         links = [self.link(k, v) for k, v in self.table("links").items()]
         slides = [self.slide(i, s) for i, s in enumerate(self.array("slides"))]
+        from .scene_joints import read as read_joints
+        gears, racks, cams = read_joints(self)
         inputs, values, rates, accs, written = self.inputs()
         from . import scene_loads
         grav, loads = scene_loads.gravity(self, doc), scene_loads.read_loads(self)
@@ -229,7 +235,8 @@ class _Reader:
             raise SceneError(self.problems)
         try:
             m = Mechanism(parameters=self.params, ground=ground, links=[lk for lk in links if lk],
-                          slides=slides, inputs=inputs, guess=guess, gravity=grav, loads=loads)
+                          slides=slides, inputs=inputs, guess=guess, gravity=grav, loads=loads,
+                          gears=gears, racks=racks, cams=cams)
         except KincasError as e:
             raise SceneError(e.problems) from None
         if report is None:

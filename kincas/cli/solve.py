@@ -38,7 +38,7 @@ def cli_run(args) -> int:
     if args.json:
         doc = {"title": sc.study.title, "units": sc.study.units,
                "inputs": {k: _list(v) for k, v in inputs.items()},
-               "status": sw.status, "flags": sw.flags,
+               "status": sw.status.tolist(), "flags": list(sw.flags),
                "values": {k: _list(v) for k, v in values.items()},
                "events": [_user_event(sc, e) for e in sw.events]}
         # dumps, not dump: json.dump streams through the pure-Python encoder, 4x slower

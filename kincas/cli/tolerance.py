@@ -43,7 +43,7 @@ def cli_run(args) -> int:
     if args.json:
         doc = {"title": st.title, "units": st.units, "samples": r.samples, "seed": r.seed,
                "std": r.std, "inputs": {k: _list(v) for k, v in inputs.items()},
-               "status": r.status, "failed": r.failed.tolist(),
+               "status": [str(s) for s in r.status], "failed": r.failed.tolist(),
                "nominal": {n: _list(user(n, r.nominal[n])) for n in r.names},
                "first_order": {n: _list(v) for n, v in fo.items()},
                "monte_carlo": {n: _list(v) for n, v in mc.items()},

@@ -1,114 +1,124 @@
-"""Many solves in one vectorised CasADi call: Newton from scattered starts (assembly modes)
-and from a first-order predictor over parameter samples (tolerance Monte Carlo).
+"""Many designs of one structure at once: batched evaluation and one compiled call per block.
 
-Both are the scatter phase of their analysis: what they accept is measured with the same
-per-group residual as the careful Newton (`Model.scales`, kincas/core/tolerances.py), and
-what they do not accept goes through the careful Newton (kincas/core/newton.py).
+A *design* is one set of parameter values for a compiled model (`kincas.compile(m)`: the
+structure is built once, the parameters stay numeric inputs). Two tools live here:
+
+* `BatchEvaluator`: g, g_q, g_u, g_p and the reported quantities at many (q, u, p) columns
+  in one mapped CasADi call each, and damped-free Newton steps for all of them with numpy's
+  batched linear algebra (no symbolic inverse, so it scales with the mechanism);
+* `DesignKernel`: the fast sweep kernel of `kincas.core.fast` (the same casadi functions and
+  the same C loop, `kincas_sweep`) with one more C entry point, `kincas_designs`, that sweeps
+  a block of designs one after the other in a single call. A ctypes call releases the GIL and
+  the loop keeps its work arrays on its own stack, so blocks of designs run on several
+  threads at once when each has its own output rows.
 
 >>> import numpy as np, kincas
->>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
-...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+>>> m = kincas.Mechanism(parameters={"a": 1.0}, ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", 3.5),
 ...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
->>> model = kincas.model_of(m)
->>> Q, r = newton_starts(model, np.array([[1.0, 2.0], [-1.0, -2.0]]), np.array([0.5]), np.zeros(0), 60)
->>> bool(np.all(r <= 1e-13))
-True
+>>> ev = BatchEvaluator(kincas.compile(m))
+>>> g, J, Ju, Jp = ev.derivatives(np.zeros((2, 2)), np.zeros((2, 1)), np.array([[1.0], [2.0]]))
+>>> g.shape, J.shape, Jp[:, :, 0].round(6).tolist()
+((2, 2), (2, 2, 2), [[1.0, 0.0], [1.0, 0.0]])
 """
 from __future__ import annotations
+
+import ctypes
 
 import casadi as ca
 import numpy as np
 
-from .tolerances import MAX_STEP, TOL
+from .compiled import Backend, Library
+from .fast import _SWEEP_C, sweeper_for
+
+_I, _V = ctypes.c_longlong, ctypes.c_void_p
+
+# --- the C loop over designs: design d's poses 1..n-1 from its state row S[d] ---
+
+_DESIGNS_C = """
+int kincas_designs(casadi_int nd, casadi_int n, const casadi_real* U, const casadi_real* P,
+                   casadi_int np_, const casadi_real* Ls, const casadi_real* thr,
+                   casadi_int max_evals, casadi_real* S, casadi_int ns, casadi_real* Q,
+                   casadi_real* info, const casadi_real* Ud, casadi_int sud,
+                   const casadi_real* Udd, casadi_int sudd, casadi_real* vals,
+                   casadi_real* stops) {
+  casadi_int d;
+  for (d = 0; d < nd; ++d) {
+    int k = kincas_sweep(n - 1, U + NU, P + d*np_, Ls + d, thr, max_evals, S + d*ns,
+                         Q + d*n*NQ + NQ, info + d*5*n + 1, n, Ud + sud, sud, Udd + sudd, sudd,
+                         vals + d*(NO > 0 ? NO : 0)*n + 1, 0);
+    stops[d] = (casadi_real) (k + 1);
+  }
+  return (int) nd;
+}
+"""
+_SWEEP_SIG = [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V, _V]
+_DESIGNS_SIG = [_I, _I, _V, _V, _I, _V, _V, _I, _V, _I, _V, _V, _V, _I, _V, _I, _V, _V]
 
 
-# --- Newton from every start at once ---
+class DesignKernel:
+    """The compiled sweep kernel of a model and report, with a loop over designs.
 
-
-def _step_function(model) -> ca.Function:
-    """(q, u, p, eq_scale, q_scale) -> (q after one Newton step, relative residual at q).
-
-    The step solves g_q dq = -g with the exact Jacobian and is shortened so that no unknown
-    moves by more than MAX_STEP of its scale (radians, or its group's length): a trust region
-    that keeps a start from being thrown across the workspace by a near-singular Jacobian.
-    Where g_q is singular the step is NaN and that start is dropped."""
-    def build():
-        sym = model.sym
-        eq, qs = ca.SX.sym("eq", sym.ng), ca.SX.sym("qs", sym.nq)
-        dq = -ca.solve(sym.Jq, sym.g)
-        shrink = ca.fmax(1, ca.mmax(ca.fabs(dq) / (MAX_STEP * qs))) if sym.nq else ca.SX(1)
-        r = ca.mmax(ca.fabs(sym.g / eq)) if sym.nq else ca.SX(0)
-        return ca.Function("newton_step", [sym.q, sym.u, sym.p, eq, qs], [sym.q + dq / shrink, r])
-    return model.memo("batch.newton_step", build)
-
-
-def newton_starts(model, Q, u, p, iterations: int):
-    """Trust-region Newton on every row of Q (starts, n x nq) at once, at inputs u and
-    parameters p; returns the iterates and their relative residuals (NaN where a start
-    diverged). A start stops where its residual reaches TOL.
-
-    Parameters
-    ----------
-    model : kincas.core.numeric.Model
-    Q : numpy.ndarray
-        One start per row.
-    u, p : numpy.ndarray
-        Inputs and parameters (the same for every start).
-    iterations : int
-        Newton steps at most.
-
-    Returns
-    -------
-    (numpy.ndarray, numpy.ndarray)
-        The iterates (n x nq) and their residuals, each equation relative to its group.
+    `lib(n)` is the loaded library for n poses in all (None: no compiler, or not worth it,
+    as `kincas.core.compiled.Backend` decides); `sweeper` is the `FastSweeper` whose
+    functions it compiles (and whose virtual-machine path serves when there is no library).
     """
-    n = Q.shape[0]
-    eq, qs = model.scales(u, p)
-    if model.nq == 0:
-        return Q, np.full(n, np.abs(model.residual(np.zeros(0), u, p) / eq).max(initial=0.0))
-    step = _step_function(model).map(n)
-    U, P = np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)
-    X, r = Q.T.copy(), np.full(n, np.inf)
-    for _ in range(iterations):
-        Xn, rn = (np.asarray(a) for a in step(X, U, P, eq, qs))
-        r = rn.ravel()
-        done = ~np.isfinite(r) | (r <= TOL)
-        X = np.where(done, X, Xn)  # a converged start stays where it is
-        if done.all():
-            break
-    r = np.where(np.all(np.isfinite(X), axis=0), r, np.nan)
-    return X.T, r
+
+    def __init__(self, model, report=(), compile=None):
+        self.sweeper = sweeper_for(model, tuple(report), compile)
+        self.nq, self.nu, self.no = model.nq, model.nu, len(tuple(report))
+        self.backend = Backend(compile, self._library, "design sweep kernel")
+
+    def _library(self) -> Library:
+        return Library("kincas_designs", self.sweeper.functions, _SWEEP_C + _DESIGNS_C,
+                       {"NQ": self.nq, "NU": self.nu, "NO": self.no},
+                       {"kincas_sweep": _SWEEP_SIG, "kincas_designs": _DESIGNS_SIG})
+
+    def lib(self, n: int):
+        if self.sweeper.size > 40_000:  # as FastSweeper.worth_it: too large to compile
+            return None
+        return self.backend.compiled(n)
 
 
-# --- parameter samples: predictor and Newton steps ---
+# --- g and its derivatives at many columns ---
 
 
-def sample_function(model, report: tuple[str, ...], newton_steps: int) -> ca.Function:
-    """F(q0, u, p0, dp, u', u'', eq_scale) -> (q, relative residual, g_q, quantities): from the
-    nominal pose q0 a first-order predictor along dq/dp = -g_q^-1 g_p, then `newton_steps`
-    Newton steps with the exact Jacobian, all as one CasADi expression graph (map it over
-    samples); the residual is max |g / eq_scale| as everywhere in the core."""
-    return model.memo(("batch.sample", report, newton_steps),
-                      lambda: _build_sample_function(model, report, newton_steps))
+class BatchEvaluator:
+    """Residuals, Jacobians and quantities at N columns (q, u, p) of one model, mapped.
 
+    Arrays are numpy, one row per column: Q (N, nq), U (N, nu), P (N, np). Not shared
+    between threads (the mapped functions are, and casadi's call is re-entrant)."""
 
-def _build_sample_function(model, report, newton_steps):
-    sym = model.sym
-    q0, u, p0, dp = (ca.SX.sym(n, k) for n, k in
-                     (("q0", sym.nq), ("u", sym.nu), ("p0", sym.np), ("dp", sym.np)))
-    ud, udd, eq = ca.SX.sym("ud", sym.nu), ca.SX.sym("udd", sym.nu), ca.SX.sym("eq", sym.ng)
-    p = p0 + dp
-    gp = ca.Function("gp", [sym.q, sym.u, sym.p], [ca.jacobian(sym.g, sym.p)])
-    if sym.nq:
-        # Predictor: the tangent of the solution manifold, dq/dp = -g_q^-1 g_p, at the nominal.
-        _, J0 = sym.f_resjac(q0, u, p0)
-        q = q0 - ca.solve(J0, ca.mtimes(gp(q0, u, p0), dp))
-        for _ in range(newton_steps):  # Newton with the exact Jacobian: g_q dq = -g
-            g, J = sym.f_resjac(q, u, p)
-            q = q - ca.solve(J, g)
-        g, J = sym.f_resjac(q, u, p)
-        r = ca.mmax(ca.fabs(g / eq))
-    else:
-        q, J, r = ca.SX(0, 1), ca.SX(0, 0), ca.SX(0)
-    vals = model.quantity_function(report)(q, u, p, ud, udd)
-    return ca.Function("tolerance_sample", [q0, u, p0, dp, ud, udd, eq], [q, r, ca.vec(J), vals])
+    def __init__(self, model):
+        self.model, sym = model, model.sym
+        self.nq, self.nu, self.np = sym.nq, sym.nu, sym.np
+        d = ca.densify
+        self._f = ca.Function("derivs", [sym.q, sym.u, sym.p],
+                              [d(sym.g), d(sym.Jq), d(sym.Ju), d(ca.jacobian(sym.g, sym.p))])
+        self._maps: dict = {}
+
+    def _mapped(self, f, n):
+        key = (f.name(), n)
+        if key not in self._maps:
+            self._maps[key] = f.map(n)
+        return self._maps[key]
+
+    def derivatives(self, Q, U, P):
+        """g (N, ng), g_q (N, ng, nq), g_u (N, ng, nu), g_p (N, ng, np)."""
+        n = Q.shape[0]
+        outs = self._mapped(self._f, n)(np.asarray(Q, float).T, np.asarray(U, float).T,
+                                        np.asarray(P, float).T)
+        g = np.asarray(outs[0]).T
+        mats = []
+        for a, w in zip(outs[1:], (self.nq, self.nu, self.np)):
+            a = np.asarray(a)  # (ng, n * w): column blocks per design
+            mats.append(a.reshape(a.shape[0], n, w).transpose(1, 0, 2))
+        return (g, *mats)
+
+    def quantities(self, names, Q, U, P, Ud, Udd) -> np.ndarray:
+        """(len(names), N) quantities at N solved columns, each with its own parameters."""
+        n = Q.shape[0]
+        if n == 0 or not names:
+            return np.zeros((len(names), n))
+        f = self.model.quantity_function(tuple(names))
+        return np.asarray(self._mapped(f, n)(Q.T, U.T, P.T, Ud.T, Udd.T))

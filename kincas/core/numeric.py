@@ -30,6 +30,7 @@ import numpy as np
 
 from ..model import mechanism as _mechanism
 from ..model.mechanism import Mechanism, needs_rank_test
+from . import joints as _joints
 from .newton import lsolve as _lsolve, newton as _newton
 from .redundant import decide
 from .structure import Structure
@@ -41,7 +42,8 @@ from .tolerances import ACCEPT, MAX_ITER, MAX_STEP, TOL  # noqa: F401  (their ol
 
 
 def _structure_key(m: Mechanism):
-    return (tuple(k for k, _ in m.parameters), m.ground, m.links, m.slides, m.inputs)
+    return (tuple(k for k, _ in m.parameters), m.ground, m.links, m.slides, m.inputs,
+            m.gears, m.racks, m.cams)
 
 
 _CACHE: dict = {}
@@ -287,6 +289,7 @@ class Model:
         index = {name: i for i, (name, _) in enumerate(sym.unknowns)}
         angle_in = {i.target: u[k] for k, i in enumerate(m.inputs) if i.kind == "angle"}
         centre = np.mean(list(gv.values()), axis=0) if gv else np.zeros(2)
+        theta = {"ground": 0.0}  # angles placed so far (a relative input starts from them)
         for lname, at in m.structure.order:
             pts = [pt for pt, _ in m.link(lname).points]
             ref = [pt for pt in pts if pt in guessed or pt in known]
@@ -299,7 +302,7 @@ class Model:
                     d = pos[others[0]] - anchor
                     dl = loc[(lname, others[0])] - loc[(lname, at)]
                     th = math.atan2(d[1], d[0]) - math.atan2(dl[1], dl[0])
-                th = float(angle_in.get(lname, th))
+                th = float(angle_in.get(lname, _joints.relative_start(m, lname, u, theta, th)))
                 c, s = math.cos(th), math.sin(th)
                 R = np.array([[c, -s], [s, c]])
                 origin = known[at] - R @ loc[(lname, at)]
@@ -308,26 +311,28 @@ class Model:
                 if len(ref) >= 2:
                     d, dl = pos[ref[1]] - pos[ref[0]], loc[(lname, ref[1])] - loc[(lname, ref[0])]
                     th = math.atan2(d[1], d[0]) - math.atan2(dl[1], dl[0])
-                th = float(angle_in.get(lname, th))
+                th = float(angle_in.get(lname, _joints.relative_start(m, lname, u, theta, th)))
                 c, s = math.cos(th), math.sin(th)
                 R = np.array([[c, -s], [s, c]])
                 origin = (pos[ref[0]] - R @ loc[(lname, ref[0])]) if ref else centre
                 q[index[f"{lname}.x"]], q[index[f"{lname}.y"]] = origin
             if f"{lname}.angle" in index:
                 q[index[f"{lname}.angle"]] = th
+            theta[lname] = th
             for pt in pts:
                 known.setdefault(pt, origin + R @ loc[(lname, pt)])
-        return q
+        return _joints.place(self, q, u, p)  # cams' contact parameters; angles in (-pi, pi]
 
     def assemble(self, u, p, guess: dict[str, tuple[float, float]], L: float) -> Solution:
         """The assembly the guessed points lead to: Newton from the placement they give
-        (`initial_q`), and where that fails IPOPT's assembly nearest the guessed points.
-        This is where every sweep starts."""
+        (`initial_q`), and where that fails IPOPT's assembly nearest the guessed points;
+        gears' angles then settled in (-pi, pi] (kincas/core/joints.py). This is where
+        every sweep starts."""
         q0 = self.initial_q(u, p, guess, L)
         sol = self.newton(q0, u, p, L)
         if not sol.ok:
             sol = self.nearest_assembly(q0, u, p, {k: np.array(v) for k, v in guess.items()}, L)
-        return sol
+        return _joints.settle_first(self, sol, u, p, L)
 
     # --- IPOPT: the assembly nearest to target positions ---
     def nearest_assembly(self, q0, u, p, targets: dict[str, np.ndarray], L) -> Solution:

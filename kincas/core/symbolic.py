@@ -34,6 +34,7 @@ import numpy as np
 from ..errors import ModelError
 from ..model.mechanism import GROUND, Mechanism, as_param
 from ..model.names import LINK_Q, POINT_Q, SENS, SLIDE_Q, is_angular, parse_quantity  # noqa: F401
+from . import joints as _joints
 
 # --- quantity names (kincas/model/names.py: parsed without the solver) ---
 
@@ -44,7 +45,7 @@ def _extras():
     """Modules that define more quantities (each: `check(sym, name)` -> None when the name is
     not theirs, else a list of problems; `expression(sym, name, t)` -> SX)."""
     from . import dynamics, geometry
-    return geometry, dynamics
+    return geometry, dynamics, _joints
 
 
 def needs_jerk(name: str) -> bool:
@@ -122,6 +123,7 @@ class Symbolic:
             ey = self.points[sl.point][1] - (oy + s * tx + c * ty)
             eqs.append(dx * ey - dy * ex)  # distance of the point from the line
             self.slide_s[sl.name] = dx * ex + dy * ey
+        eqs += _joints.equations(self, new)  # relative inputs, gears, racks, cams
         for k, i in enumerate(m.inputs):
             if i.kind == "slide":
                 eqs.append(self.slide_s[i.target] - self.u[k])
@@ -188,8 +190,9 @@ class Symbolic:
                     out.append(f"{where}: {n!r}: {b!r} is driven by an input (use its rate instead)")
             elif self.position_expr(a, b)[0] is None:
                 out.append(f"{where}: unknown quantity {n!r} (expected P.x, P.vx, P.ax, P.jx, "
-                           f"P.curvature, P.cx, L.angle, L.omega, L.alpha, L.jerk, L.icx, A/B.icx, "
-                           f"S.s, S.v, S.a, S.jerk, effort(KEY), shaking.x, reaction(P, L).x "
+                           f"P.curvature, P.cx, L.angle, L.omega, L.alpha, L.jerk, L.icx, A/B.angle, "
+                           f"A/B.omega, A/B.icx, S.s, S.v, S.a, S.jerk, cam.contact.x, cam.phi, "
+                           f"cam.pressure, effort(KEY), shaking.x, reaction(P, L).x "
                            f"or d(Q)/d(p) with declared names)")
         return out
 

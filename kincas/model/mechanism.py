@@ -25,6 +25,7 @@ from dataclasses import dataclass, field, replace
 from typing import Iterable, Mapping, Union
 
 from ..errors import ModelError
+from . import joints as _joints
 from .loads import Inertia, Load, check_loads
 
 # --- numbers that may name a parameter ---
@@ -141,7 +142,18 @@ class Input:
 
     @classmethod
     def angle(cls, link: str) -> "Input":
+        """The absolute angle of a link, or with "A/B" the angle of link A relative to body B
+        (a motor on B turning A; key "A/B.angle")."""
         return cls("angle", link)
+
+    @classmethod
+    def relative(cls, link: str, body: str) -> "Input":
+        """The angle of `link` relative to `body`: `Input.angle("link/body")`.
+
+        >>> Input.relative("forearm", "upper").key
+        'forearm/upper.angle'
+        """
+        return cls("angle", f"{link}/{body}")
 
     @classmethod
     def slide(cls, slide: str) -> "Input":
@@ -234,6 +246,9 @@ class Mechanism:
     slides: tuple[Slide, ...] = ()
     inputs: tuple[Input, ...] = ()
     guess: tuple[tuple[str, tuple[Num, Num]], ...] = ()
+    gears: tuple = ()  # of kincas.model.joints.Gear
+    racks: tuple = ()  # of kincas.model.joints.Rack
+    cams: tuple = ()  # of kincas.model.joints.Cam
     gravity: tuple[Num, Num] = (0.0, 0.0)  # acceleration vector, length/time²
     loads: tuple[Load, ...] = ()
     structure: Structure = field(init=False, repr=False, compare=False)
@@ -247,13 +262,17 @@ class Mechanism:
         object.__setattr__(self, "links", tuple(self.links))
         object.__setattr__(self, "slides", tuple(self.slides))
         object.__setattr__(self, "inputs", tuple(self.inputs))
+        for k in ("gears", "racks", "cams"):
+            object.__setattr__(self, k, tuple(getattr(self, k)))
         object.__setattr__(self, "gravity", _pair(self.gravity))
         object.__setattr__(self, "loads", tuple(self.loads))
         problems = _check(self)
         if problems:
             raise ModelError(problems)
-        object.__setattr__(self, "structure",
-                           _structure([g for g, _ in self.ground], self.links, len(self.slides)))
+        st = _structure([g for g, _ in self.ground], self.links, len(self.slides))
+        extra_q, extra_g = _joints.counts(self)  # gears, racks, cams: one freedom each
+        object.__setattr__(self, "structure", replace(st, n_unknowns=st.n_unknowns + extra_q,
+                                                      n_equations=st.n_equations + extra_g))
         problems = _check_mobility(self)
         if problems:
             raise ModelError(problems)
@@ -384,8 +403,10 @@ def _check(m: Mechanism) -> list[str]:
         if s.name in snames:
             out.append(f"{where}: name: two slides are named {s.name!r} (give each a `name`)")
         snames.add(s.name)
-        if s.point not in moving:
-            what = "is a ground point" if s.point in gnames else "is not a point of any link"
+        if s.point not in moving and not (s.point in gnames and s.along != GROUND):
+            # a ground point in the slot of a moving link is fine (a quick-return guide)
+            what = ("is a ground point on a ground line" if s.point in gnames
+                    else "is not a point of any link")
             out.append(f"{where}: point: {s.point!r} {what}")
         if s.along != GROUND and s.along not in lnames:
             out.append(f"{where}: along: unknown body {s.along!r} (a link's name or \"ground\")")
@@ -397,7 +418,16 @@ def _check(m: Mechanism) -> list[str]:
     for i, inp in enumerate(m.inputs):
         where = f"[[inputs]] {i + 1}"
         ok = {"angle": lnames, "slide": snames, "parameter": set(params)}.get(inp.kind)
-        if ok is None:
+        rel = _joints.split_relative(inp.target) if inp.kind == "angle" else None
+        if rel is not None:  # "A/B": link A relative to body B
+            a, b = rel
+            if a not in lnames:
+                out.append(f"{where}: angle: unknown link {a!r} in {inp.target!r}")
+            if b != GROUND and b not in lnames:
+                out.append(f"{where}: angle: unknown body {b!r} in {inp.target!r}")
+            if a == b:
+                out.append(f"{where}: angle: {inp.target!r} relates a link to itself")
+        elif ok is None:
             out.append(f"{where}: unknown kind {inp.kind!r} (angle, slide or parameter)")
         elif inp.target not in ok:
             what = {"angle": "link", "slide": "slide", "parameter": "parameter"}[inp.kind]
@@ -410,6 +440,7 @@ def _check(m: Mechanism) -> list[str]:
             what = "is a ground point (fixed)" if p in gnames else "is not a point of any link"
             out.append(f"[guess] {p}: {what}")
         num(f"[guess] {p}", x), num(f"[guess] {p}", y)
+    out += _joints.problems(m, lnames, snames, num)
     out += check_loads(m, num)
     if out:
         return out  # the numeric checks below need every name to resolve
@@ -419,7 +450,7 @@ def _check(m: Mechanism) -> list[str]:
             out.append(f"[links] {lk.name}: length must be positive")
         elif all(math.dist(loc[0], b) == 0 for b in loc[1:]):
             out.append(f"[links] {lk.name}: points: all its points coincide")
-    return out
+    return out + _joints.value_problems(m)
 
 
 def counted_freedoms(m: Mechanism) -> int:

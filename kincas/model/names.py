@@ -19,6 +19,7 @@ POINT_Q = {"x": (0, 0), "y": (1, 0), "vx": (0, 1), "vy": (1, 1), "ax": (0, 2), "
            "jx": (0, 3), "jy": (1, 3)}
 LINK_Q = {"angle": 0, "omega": 1, "alpha": 2, "jerk": 3}
 SLIDE_Q = {"s": 0, "v": 1, "a": 2, "jerk": 3}
+ANGULAR_ATTRS = {"phi", "pressure"}  # cam quantities (kincas/core/joints.py) are angles too
 # d(Q)/d(p), where Q may itself hold one level of brackets: d(effort(crank.angle))/d(a1)
 SENS = re.compile(r"^d\((?P<q>(?:[^()]|\([^()]*\))+)\)/d\((?P<p>[^()]+)\)$")
 
@@ -44,7 +45,7 @@ def is_angular(name: str, mech=None) -> bool:
         return is_angular(a, mech)
     if b == "jerk" and mech is not None and a in {s.name for s in mech.slides}:
         return False
-    return b in LINK_Q
+    return b in LINK_Q or b in ANGULAR_ATTRS
 
 
 def plain_quantity(m, name: str) -> bool:

@@ -34,6 +34,8 @@ so the rocker from D = (4, 0) is c = sqrt((sqrt(10) - 4)^2 + 2.5^2).)
 from __future__ import annotations
 
 import math
+import sys
+import types
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -88,6 +90,27 @@ class OptimizeResult:
     problems: list[str] = field(default_factory=list)
     sweep: Sweep | None = None
     info: dict = field(default_factory=dict)
+
+    # --- scipy.optimize.OptimizeResult's familiar names ---
+    @property
+    def x(self) -> np.ndarray:
+        """The varied parameters' optimised values, in the order `vary` gave them."""
+        return np.array(list(self.varied.values()), dtype=float)
+
+    @property
+    def fun(self) -> float:
+        """The objective at the optimum (`objective`)."""
+        return self.objective
+
+    @property
+    def success(self) -> bool:
+        """Converged and every check passed (`ok`)."""
+        return self.ok
+
+    @property
+    def nit(self) -> int:
+        """IPOPT's iterations (`iterations`)."""
+        return int(self.iterations)
 
 
 def _as_constraint(c, i) -> Constraint:
@@ -289,3 +312,18 @@ def run_scene(sc) -> OptimizeResult:
                         accelerations=sc.study.accelerations, **kw)
     except ModelError as e:
         raise SceneError([f"[optimize] {p}" for p in e.problems]) from None
+
+
+# --- `kincas.optimize(...)`: the function, also reachable by its 0.1 module path ---
+
+
+class _CallableModule(types.ModuleType):
+    """`kincas.optimize` is both this module (scripts of 0.1 import `kincas.optimize` and call
+    `kincas.optimize.optimize`) and the function: calling the module calls `optimize`, so
+    importing the module path never hides the function."""
+
+    def __call__(self, *args, **kwargs) -> OptimizeResult:
+        return optimize(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

@@ -1,0 +1,451 @@
+"""Many designs at once: one structure swept for a table of parameter values.
+
+`sweep_designs(m, params, inputs)` solves the mechanism m with each row of `params` (one
+design: values of some of its parameters, the others as declared) at every pose of `inputs`,
+every design on the branch of m's guess:
+
+1. the nominal design's first pose is assembled from the guess (as `kincas.sweep` does);
+2. each design's first pose is continued from it in the parameters, all designs together:
+   along p(t) = p0 + t (p_d - p0), a predictor dq = -g_q^-1 g_p dp, then Newton, in a few
+   steps of t; a step is kept only when its residual is accepted and det(g_q) kept the
+   nominal's sign (the assembly branch). A design that fails is assembled from the guess
+   instead and kept if det(g_q) has the nominal's sign;
+3. each design is swept over the poses by the compiled fast pass of `kincas.sweep` (the same
+   kernel and checks), blocks of designs in one C call each, the blocks on several threads
+   (the C loop releases the GIL and shares no buffers); a pose the fast pass rejects is
+   continued carefully (step halving, as `kincas.sweep`'s careful path) and the fast pass goes
+   on after it.
+
+Where a design cannot be continued to a pose, `gaps="stop"` (the default) ends it there:
+that pose gets "no assembly" (or "branch lost" when Newton finds an assembly there that the
+continuation could not reach without leaving the branch) and the later poses "not solved".
+`gaps="resume"` instead finishes such a design with `kincas.sweep` from its first pose (which
+resumes after gaps, more slowly). Statuses are per design and pose, never an exception.
+
+>>> import numpy as np, kincas
+>>> m = kincas.Mechanism(parameters={"a": 1.0, "d": 4.0}, ground={"A": (0, 0), "D": ("d", 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", 3.5),
+...            kincas.Link.bar("rocker", "D", "C", 3)],
+...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+>>> r = kincas.sweep_designs(m, {"a": [0.9, 1.0, 1.1], "d": [4.0, 4.1, 3.9]},
+...                          {"crank.angle": np.linspace(0, 2 * np.pi, 73)}, report=["C.y"])
+>>> r.values["C.y"].shape, r.design_ok.tolist()
+((3, 73), [True, True, True])
+"""
+from __future__ import annotations
+
+import math
+import os
+import threading
+import weakref
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from typing import Mapping
+
+import numpy as np
+
+from ..errors import ModelError
+from ..core.batch import BatchEvaluator, DesignKernel
+from ..core.compiled import ptr, rows
+from ..core.fast import FastRun
+from ..core.numeric import ACCEPT, compile as compile_model
+from ..core.symbolic import default_report
+from ..model.mechanism import Mechanism, as_param
+from .continuation import _continue, _det_sign, _first
+from .sweeps import _input_table
+
+OK, NO_ASSEMBLY, NOT_SOLVED, BRANCH_LOST = 0, 1, 2, 3
+STATUS = ("ok", "no assembly", "not solved", "branch lost")
+BLOCK = 32  # designs per C call (a thread's unit of work)
+STEP = 0.05  # largest parameter change per continuation step, relative to the size
+NEWTON = 8  # Newton iterations per continuation step at most
+
+
+# --- the result ---
+
+
+@dataclass
+class DesignSweep:
+    """Designs x poses. `values[Q]` (n_designs, n_poses) in radians for angles, NaN where a
+    pose is not solved; `code` (n_designs, n_poses) indexes STATUS ("ok", "no assembly",
+    "not solved", "branch lost"); `params` (n_designs, len(names)) the varied values;
+    `inputs` key -> values per pose."""
+
+    names: list[str]
+    params: np.ndarray
+    inputs: dict[str, np.ndarray]
+    values: dict[str, np.ndarray]
+    code: np.ndarray
+
+    @property
+    def status(self) -> np.ndarray:
+        """Status strings per design and pose."""
+        return np.array(STATUS, dtype=object)[self.code]
+
+    @property
+    def ok(self) -> np.ndarray:
+        return self.code == OK
+
+    @property
+    def design_ok(self) -> np.ndarray:
+        """Whether each design was solved at every pose."""
+        return self.ok.all(axis=1)
+
+    def failure(self, d: int) -> tuple[str, int] | None:
+        """(status, pose) of design d's first pose that was not solved; None if all were."""
+        bad = np.flatnonzero(self.code[d] != OK)
+        return None if not len(bad) else (STATUS[self.code[d, bad[0]]], int(bad[0]))
+
+    def to_xarray(self):
+        """An xarray Dataset with dimensions (design, pose): the varied parameters along
+        design, the inputs along pose, each quantity and `status` over both."""
+        import xarray as xr
+
+        data = {n: (("design", "pose"), v) for n, v in self.values.items()}
+        data["status"] = (("design", "pose"), self.status.astype(str))
+        coords = {n: ("design", self.params[:, j]) for j, n in enumerate(self.names)}
+        coords.update({k: ("pose", v) for k, v in self.inputs.items()})
+        return xr.Dataset(data, coords=coords)
+
+
+# --- the designs' table ---
+
+
+def design_table(m: Mechanism, params, names=None) -> tuple[list[str], np.ndarray]:
+    """(names, (n_designs, len(names)) values) from a mapping name -> values or a table."""
+    if isinstance(params, Mapping):
+        names = list(params)
+        cols = [np.atleast_1d(np.asarray(params[k], dtype=float)) for k in names]
+        if len({len(c) for c in cols}) > 1 or any(c.ndim != 1 for c in cols):
+            raise ModelError("params: every parameter needs one value per design")
+        X = np.stack(cols, axis=1) if cols else np.zeros((0, 0))
+    else:
+        X = np.atleast_2d(np.asarray(params, dtype=float))
+        names = list(names) if names is not None else [k for k, _ in m.parameters]
+        if X.shape[1] != len(names):
+            raise ModelError(f"params: {X.shape[1]} columns for {len(names)} names {names}")
+    driven = {i.target for i in m.inputs if i.kind == "parameter"}
+    problems = [f"params: {k!r}: no such parameter" for k in names if k not in m.param_values]
+    problems += [f"params: {k!r}: driven by an input" for k in names if k in driven]
+    if not np.isfinite(X).all():
+        problems.append("params: expected finite numbers")
+    if problems:
+        raise ModelError(problems)
+    return names, X
+
+
+def _sizes(m: Mechanism, P: np.ndarray, pnames: list[str]) -> np.ndarray:
+    """`Mechanism.size()` of every design (rows of P), vectorised."""
+    idx = {k: j for j, k in enumerate(pnames)}
+
+    def val(v):
+        p = as_param(v)
+        return np.full(len(P), float(v)) if p is None else p.scale * P[:, idx[p.name]]
+    ext = np.zeros(len(P))
+    for lk in m.links:
+        loc = [(val(x), val(y)) for _, (x, y) in lk.points]
+        for a in loc:
+            for b in loc:
+                ext = np.maximum(ext, np.hypot(a[0] - b[0], a[1] - b[1]))
+    if m.ground:
+        xs = np.stack([val(x) for _, (x, _) in m.ground])
+        ys = np.stack([val(y) for _, (_, y) in m.ground])
+        ext = np.maximum(ext, np.hypot(xs.max(0) - xs.min(0), ys.max(0) - ys.min(0)))
+    return np.where(ext > 0, ext, 1.0)
+
+
+# --- one lock per compiled model for the Python-side numerics (Model keeps work buffers) ---
+
+_LOCKS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_LOCKS_LOCK = threading.Lock()
+
+
+def _lock(model) -> threading.Lock:
+    with _LOCKS_LOCK:
+        return _LOCKS.setdefault(model, threading.RLock())
+
+
+# --- the sweep ---
+
+
+def sweep_designs(m: Mechanism, params, inputs=None, *, names=None, rates=None,
+                  accelerations=None, report=None, guess=None, workers: int | None = None,
+                  gaps: str = "stop", compile: bool | None = None, progress=None) -> DesignSweep:
+    """Sweep the structure of `m` for many parameter sets, each on the branch of the guess.
+
+    Parameters
+    ----------
+    m : Mechanism
+        The nominal design; its guess picks the assembly branch.
+    params : mapping or array
+        name -> one value per design, or an (n_designs, n_names) table with `names`
+        (default: all of m's parameters in order). Parameters not given keep m's values.
+    inputs, rates, accelerations, report, guess
+        As for `kincas.sweep`.
+    workers : int, optional
+        Threads for the compiled pass (default: every core).
+    gaps : {"stop", "resume"}
+        What happens to a design after a pose it cannot reach (see the module's text).
+    compile : bool, optional
+        As for `kincas.sweep` (None: compile when cached or at least 50,000 poses in all).
+    progress : callable, optional
+        Called as progress(designs done, designs).
+
+    Returns
+    -------
+    DesignSweep
+        Values and a status per design and pose (`to_xarray()` for a Dataset).
+
+    Examples
+    --------
+    See the module's text.
+    """
+    if gaps not in ("stop", "resume"):
+        raise ModelError(f"gaps: {gaps!r} is neither \"stop\" nor \"resume\"")
+    model = compile_model(m)
+    report = list(default_report(m) if report is None else report)
+    model.quantity_function(tuple(report))  # unknown names fail here
+    names, X = design_table(m, params, names)
+    U = _input_table(m, inputs, "inputs", None)
+    n, nd = U.shape[0], X.shape[0]
+    Ud = np.ascontiguousarray(np.broadcast_to(_input_table(m, rates, "rates", 1.0), U.shape))
+    Udd = np.ascontiguousarray(np.broadcast_to(_input_table(m, accelerations, "accelerations", 0.0), U.shape))
+    pnames = [k for k, _ in m.parameters]
+    p0 = np.array([v for _, v in m.parameters], dtype=float)
+    P = np.repeat(p0[None, :], nd, axis=0)
+    P[:, [pnames.index(k) for k in names]] = X
+    P = np.ascontiguousarray(P)
+    Ls = np.ascontiguousarray(_sizes(m, P, pnames))
+    g = {k: (m.value(x), m.value(y)) for k, (x, y) in {**dict(m.guess), **dict(guess or {})}.items()}
+    job = _Job(model, m, report, U, Ud, Udd, P, Ls, g, compile)
+    with _lock(model):
+        job.first_poses(p0, m.size())
+    job.sweep_all(workers or os.cpu_count() or 1, progress)
+    if gaps == "resume":
+        job.resume_gaps(names)
+    job.fill_values()
+    keys = [i.key for i in m.inputs]
+    return DesignSweep(names=names, params=X, inputs={k: U[:, j].copy() for j, k in enumerate(keys)},
+                       values={nm: job.vals[:, i, :] for i, nm in enumerate(report)}, code=job.code)
+
+
+class _Job:
+    """The arrays of one call of `sweep_designs` and its three stages."""
+
+    def __init__(self, model, m, report, U, Ud, Udd, P, Ls, guess, compile):
+        self.model, self.m, self.report, self.guess = model, m, report, guess
+        self.U, self.Ud, self.Udd, self.P, self.Ls = U, Ud, Udd, P, Ls
+        nd, n, nq = P.shape[0], U.shape[0], model.nq
+        self.Q = np.full((nd, n, nq), np.nan)
+        self.vals = np.full((nd, len(report), n), np.nan)
+        self.info = np.full((nd, 5, n), np.nan)
+        self.code = np.full((nd, n), NOT_SOLVED, dtype=np.int8)
+        self.fast = np.zeros((nd, n), dtype=bool)  # values computed by the kernel
+        nu = model.nu
+        self.S = np.full((nd, nq + nq * nq + 2 * (nq * nu + nu)), np.nan)  # kernel states
+        self.kernel = DesignKernel(model, report, compile) if model.square and model.nq and model.nu else None
+
+    # --- 1. first poses: continuation in the parameters from the nominal design ---
+    def first_poses(self, p0, L0):
+        model, nd, u0 = self.model, self.P.shape[0], self.U[0]
+        if nd == 0:
+            return
+        nominal = _first(model, u0, p0, L0, self.guess)
+        sign0 = _det_sign(model, nominal, L0) if nominal.ok else 0
+        ok = np.zeros(nd, dtype=bool)
+        if nominal.ok and model.nq:
+            ok = self._continue_in_parameters(nominal.q, p0, sign0)
+        elif nominal.ok:  # nothing to solve for: every design assembles as the nominal
+            ok[:] = True
+        for d in np.flatnonzero(~ok):  # Newton from the guess, on the nominal's branch
+            q = model.initial_q(u0, self.P[d], self.guess, self.Ls[d])
+            sol = model.newton(q, u0, self.P[d], self.Ls[d])
+            if sol.ok and (sign0 == 0 or _det_sign(model, sol, self.Ls[d]) in (0, sign0)):
+                self.Q[d, 0], ok[d] = sol.q, True
+            else:
+                self.code[d, 0] = BRANCH_LOST if sol.ok else NO_ASSEMBLY
+        self.code[ok, 0] = OK
+        if self.kernel is not None and ok.any():  # the fast pass's starting states, batched
+            idx = np.flatnonzero(ok)
+            u = np.repeat(self.U[:1], len(idx), axis=0)
+            _, J, Ju, _ = BatchEvaluator(model).derivatives(self.Q[idx, 0], u, self.P[idx])
+            T = -_solve(J, Ju)
+            cm = lambda a: a.transpose(0, 2, 1).reshape(len(idx), -1)  # column-major rows
+            self.S[idx] = np.concatenate([self.Q[idx, 0], cm(J), cm(T), u, cm(T), u], axis=1)
+
+    def _continue_in_parameters(self, q0, p0, sign0) -> np.ndarray:
+        model, P, Ls = self.model, self.P, self.Ls
+        nd, u = P.shape[0], np.repeat(self.U[:1], P.shape[0], axis=0)
+        ev = BatchEvaluator(model)
+        scale = np.where(model.sym.is_length[None, :], 1.0, 1.0 / Ls[:, None])
+        dP = P - p0
+        steps = int(min(64, max(1, math.ceil(np.abs(dP).max(initial=0.0) / (STEP * min(Ls.min(), 1e300))))))
+        q, pc = np.repeat(q0[None, :], nd, axis=0), np.repeat(p0[None, :], nd, axis=0)
+        ok = np.ones(nd, dtype=bool)
+        for i in range(1, steps + 1):
+            pt = p0 + dP * (i / steps)
+            _, J, _, Gp = ev.derivatives(q, u, pc)
+            q = q - _solve(J, np.einsum("dij,dj->di", Gp, pt - pc))
+            for _ in range(NEWTON):
+                gv, J, _, _ = ev.derivatives(q, u, pt)
+                q = q - _solve(J, gv)
+            gv, J, _, _ = ev.derivatives(q, u, pt)
+            r = np.abs(gv).max(axis=1) / Ls
+            with np.errstate(all="ignore"):
+                s = np.sign(np.linalg.det(J * scale[:, None, :]))
+            ok &= (r <= ACCEPT) & np.isfinite(q).all(axis=1) & ((s == sign0) | (sign0 == 0))
+            pc = pt
+        self.Q[ok, 0] = q[ok]
+        return ok
+
+    # --- 2. the poses: compiled blocks of designs on threads, careful where rejected ---
+    def sweep_all(self, workers, progress):
+        nd, n = self.P.shape[0], self.U.shape[0]
+        todo = np.flatnonzero(self.code[:, 0] == OK)
+        lib = self.kernel.lib(len(todo) * n) if self.kernel is not None and n > 1 else None
+        blocks = [todo[i:i + BLOCK] for i in range(0, len(todo), BLOCK)]
+        done = [nd - len(todo)]
+        tick = threading.Lock()
+
+        def run(block):
+            if lib is not None:
+                stops = self._kernel_block(lib, block)
+            else:  # the virtual machine (or no fast pass): design by design
+                stops = [self._fast_from(None, d, 0) for d in block]
+            for d, k in zip(block, stops):
+                self._finish(lib, int(d), int(k))
+            if progress is not None:
+                with tick:
+                    done[0] += len(block)
+                    progress(done[0], nd)
+        if progress is not None:
+            progress(done[0], nd)
+        if workers > 1 and len(blocks) > 1 and lib is not None:
+            with ThreadPoolExecutor(workers) as ex:
+                list(ex.map(run, blocks))
+        else:
+            for b in blocks:
+                run(b)
+        if progress is not None:
+            progress(nd, nd)
+
+    def _kernel_block(self, lib, block) -> np.ndarray:
+        """One C call: the designs of `block` from their first poses, until each is rejected."""
+        sw, n, nq, nu = self.kernel.sweeper, self.U.shape[0], self.model.nq, self.model.nu
+        nb = len(block)
+        S = np.ascontiguousarray(self.S[block])
+        P, Ls = np.ascontiguousarray(self.P[block]), np.ascontiguousarray(self.Ls[block])
+        Q, info = np.empty((nb, n, nq)), np.empty((nb, 5, n))
+        vals, stops = np.empty((nb, len(self.report), n)), np.empty(nb)
+        (Ud, sud), (Udd, sudd) = rows(self.Ud, n, nu), rows(self.Udd, n, nu)
+        lib.kincas_designs(nb, n, ptr(self.U), ptr(P), P.shape[1], ptr(Ls), ptr(_thresholds()), sw.max_evals,
+                           ptr(S), S.shape[1], ptr(Q), ptr(info), ptr(Ud), sud, ptr(Udd), sudd,
+                           ptr(vals), ptr(stops))
+        stops = stops.astype(int)
+        for j, d in enumerate(block):
+            k = stops[j]  # poses 1..k-1 accepted; k rejected (if < n)
+            self.Q[d, 1:k], self.vals[d, :, 1:k], self.info[d, :, 1:k] = Q[j, 1:k], vals[j, :, 1:k], info[j, :, 1:k]
+            self.code[d, 1:k], self.fast[d, 1:k] = OK, True
+        return stops
+
+    def _finish(self, lib, d: int, k: int):
+        """Design d from pose k on (poses before k solved): careful pose, then the fast pass
+        again, until the end or a pose that cannot be reached."""
+        model, U, n, p, L = self.model, self.U, self.U.shape[0], self.P[d], self.Ls[d]
+        while k < n:
+            with _lock(model):
+                prev = (self.Q[d, k - 2], U[k - 2]) if k >= 2 else None
+                sol = _continue(model, self.Q[d, k - 1], U[k - 1], U[k], p, L, depth=8, prev=prev)
+                if sol is None or not sol.ok:
+                    lost = model.newton(self.Q[d, k - 1], U[k], p, L).ok
+                    self.code[d, k] = BRANCH_LOST if lost else NO_ASSEMBLY
+                    return
+                self.Q[d, k], self.code[d, k] = sol.q, OK
+            k = self._fast_from(lib, d, k)
+
+    def _fast_from(self, lib, d: int, j: int) -> int:
+        """The fast pass for design d from its solved pose j; returns the pose it stopped at
+        (the poses between are solved)."""
+        n = self.U.shape[0]
+        if j + 1 >= n or self.kernel is None:
+            return j + 1
+        if lib is not None:
+            stop = self._kernel_from(lib, d, j)
+        else:  # the virtual machine: its buffers are the sweeper's, so one at a time
+            with _lock(self.model):
+                run = FastRun(self.kernel.sweeper, self.U, self.P[d], self.Ls[d], self.Ud, self.Udd)
+                stop = run.advance(j + 1, self.Q[d, j], self.U[j])
+            sl = slice(j + 1, stop)
+            self.Q[d, sl], self.vals[d, :, sl] = run.Q[sl], run.values[:, sl]
+        self.code[d, j + 1:stop], self.fast[d, j + 1:stop] = OK, True
+        return stop
+
+    def _kernel_from(self, lib, d, k) -> int:
+        """The fast pass for design d from its solved pose k; returns the pose it stopped at."""
+        sw, n, nq, nu = self.kernel.sweeper, self.U.shape[0], self.model.nq, self.model.nu
+        with _lock(self.model):
+            s = sw.state(self.Q[d, k], self.U[k], self.P[d])
+        thr = _thresholds()
+        p, L = np.ascontiguousarray(self.P[d]), np.array([self.Ls[d]])
+        Q, info, vals = np.empty((n, nq)), np.empty((5, n)), np.empty((len(self.report), n))
+        (Ud, sud), (Udd, sudd) = rows(self.Ud, n, nu), rows(self.Udd, n, nu)
+        a = k + 1
+        got = lib.kincas_sweep(n - a, ptr(self.U, a * nu), ptr(p), ptr(L), ptr(thr), sw.max_evals,
+                               ptr(s), ptr(Q, a * nq), ptr(info, a), n, ptr(Ud, a * sud), sud,
+                               ptr(Udd, a * sudd), sudd, ptr(vals, a), None)
+        stop = a + got
+        self.Q[d, a:stop], self.vals[d, :, a:stop] = Q[a:stop], vals[:, a:stop]
+        return stop
+
+    # --- 3. what is left: gaps resumed by kincas.sweep, values at careful poses ---
+    def resume_gaps(self, names):
+        from .sweeps import sweep
+
+        m, model = self.m, self.model
+        pnames = [k for k, _ in m.parameters]
+        for d in np.flatnonzero((self.code[:, 0] == OK) & (self.code != OK).any(axis=1)):
+            md = m.with_parameters(**dict(zip(pnames, self.P[d])))
+            with _lock(model):
+                pts = model.points(self.Q[d, 0], self.U[0], self.P[d])
+                g = {nm: tuple(pts[:, j]) for j, nm in enumerate(m.moving_points)}
+                keys = [i.key for i in m.inputs]
+                sw = sweep(md, {k: self.U[:, j] for j, k in enumerate(keys)},
+                           rates={k: self.Ud[:, j] for j, k in enumerate(keys)},
+                           accelerations={k: self.Udd[:, j] for j, k in enumerate(keys)},
+                           report=self.report, guess=g)
+            self.Q[d] = sw.q
+            self.code[d] = np.where(sw.ok, OK, NO_ASSEMBLY)
+            self.vals[d] = np.stack([sw[nm] for nm in self.report]) if self.report else self.vals[d]
+            self.fast[d] = True  # values filled
+
+    def fill_values(self):
+        need = (self.code == OK) & ~self.fast
+        d, k = np.nonzero(need)
+        if not len(d) or not self.report:
+            return
+        ev = BatchEvaluator(self.model)
+        with _lock(self.model):
+            self.vals[d, :, k] = ev.quantities(self.report, self.Q[d, k], self.U[k], self.P[d],
+                                               self.Ud[k], self.Udd[k]).T
+
+
+def _thresholds() -> np.ndarray:
+    """The fast pass's acceptance thresholds, as `FastRun` sets them."""
+    from ..core import fast
+    return np.array([fast.RESIDUAL, fast.STEP, fast.JAC_CHANGE, fast.CORRECTION])
+
+
+def _solve(J, b):
+    """Batched J^-1 b (b: vectors or matrices); NaN where J is singular."""
+    vec = b.ndim == J.ndim - 1
+    B = b[..., None] if vec else b
+    try:
+        X = np.linalg.solve(J, B)
+    except np.linalg.LinAlgError:
+        X = np.full(B.shape, np.nan)
+        for i in range(len(B)):
+            try:
+                X[i] = np.linalg.solve(J[i], B[i])
+            except np.linalg.LinAlgError:
+                pass
+    return X[..., 0] if vec else X
