@@ -28,18 +28,25 @@ def json_list(v) -> list:
     return out
 
 
+def param_unit(units: dict, mech, name: str) -> str:
+    """A parameter's unit: the scene's angle unit where it gives a slide's angle, else length."""
+    angular = mech is not None and any(
+        isinstance(sl.angle, Param) and sl.angle.name == name and abs(sl.angle.scale) != 1
+        for sl in mech.slides)
+    return units.get("angle", "deg") if angular else units.get("length", "")
+
+
 def unit_label(units: dict, mech, name: str) -> str:
     """The unit of quantity `name` in a scene's `units` ({"length", "angle", "time"}):
     'mm/s' for a point's velocity, 'deg' for an angle, 'mm per a' for a sensitivity.
     `mech` (the mechanism, or None) tells driven parameters and slides' jerks apart."""
     L, A, T = units.get("length", ""), units.get("angle", "deg"), units.get("time", "s")
     kind, obj, attr = parse_quantity(name)
-    if kind == "sens":
-        return f"{unit_label(units, mech, obj) or '1'} per {attr}"
+    if kind == "sens":  # Q's unit per the parameter's: mm/mm, deg/mm
+        uq, up = unit_label(units, mech, obj), param_unit(units, mech, attr)
+        return f"{uq or '1'}/{up}" if up else (f"{uq} per {attr}" if uq else "")
     if mech is not None and name in mech.param_values:  # a driven parameter: a length, or an angle
-        angular = any(isinstance(sl.angle, Param) and sl.angle.name == name and sl.angle.scale != 1
-                      for sl in mech.slides)
-        return A if angular else L
+        return param_unit(units, mech, name)
     base = A if is_angular(name, mech) else L  # input keys L.angle included
     order = _ORDER.get(attr, 0)
     return base + ("" if order == 0 else f"/{T}" if order == 1 else f"/{T}^{order}")

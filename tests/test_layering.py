@@ -127,6 +127,7 @@ CASADI_OUTSIDE_CORE = {
     "kincas.synthesis.expressions",  # objective/constraint expressions of optimize
     "kincas.synthesis.simultaneous",  # the simultaneous IPOPT problem of optimize
     "kincas.cli.plot",  # pose functions of the drawings
+    "kincas.cli.draw_joints",  # pose functions of gears, racks and cams in the drawings
 }
 
 

@@ -432,7 +432,7 @@ class _Job:
 def _thresholds() -> np.ndarray:
     """The fast pass's acceptance thresholds, as `FastRun` sets them."""
     from ..core import fast
-    return np.array([fast.RESIDUAL, fast.STEP, fast.JAC_CHANGE, fast.CORRECTION])
+    return np.array([fast.RESIDUAL, fast.STEP, fast.JAC_CHANGE, fast.CORRECTION, fast.NEAR])
 
 
 def _solve(J, b):

@@ -80,17 +80,17 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     # (a tall system, with redundant joints, has no compiled pass: its g_q is not square)
     fast = sweeper_for(model, tuple(report), compile) if method == "fast" and model.square else None
     if fast is not None and (compile is False or fast.worth_it(n)):
-        run = fast.sweep(U, p, L, careful, Ud=Ud, Udd=Udd, progress=progress, jacobians=True)
+        run = fast.sweep(U, p, L, careful, Ud=Ud, Udd=Udd, progress=progress)
     elif method in ("fast", "careful"):  # "fast" for a kernel too large to pay for itself
-        run = _careful_only(model, report, U, Ud, Udd, p, careful, progress)
+        run = _careful_only(model, report, U, Ud, Udd, p, L, careful, progress)
     else:
         raise ModelError(f"method: {method!r} is neither \"fast\" nor \"careful\"")
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
     if ok.any():  # gear centre distances at the first solved pose
         check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
-    status = ["ok" if s else NO_ASSEMBLY for s in ok]
+    status = ["ok"] * n if ok.all() else ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
-    events += _singular_events(model, m, U, Q, ok, p, L, flags, J=run.jacobian)
+    events += _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma)
     values = run.values
     if jerks is not None:  # the inputs' jerks enter only the third derivatives
         Uddd = np.broadcast_to(_input_table(m, jerks, "jerks", 0.0), U.shape)
@@ -123,7 +123,7 @@ class _CarefulRun:
         self.values, self.jacobian = np.full((nr, n), np.nan), np.full((n, ng, nq), np.nan)
 
 
-def _careful_only(model, report, U, Ud, Udd, p, careful, progress) -> _CarefulRun:
+def _careful_only(model, report, U, Ud, Udd, p, L, careful, progress) -> _CarefulRun:
     n = U.shape[0]
     run, j = _CarefulRun(n, model.nq, len(report), model.ng), None
     for k in range(n):
@@ -138,7 +138,35 @@ def _careful_only(model, report, U, Ud, Udd, p, careful, progress) -> _CarefulRu
         progress(n, n)
     ok = run.solved
     run.values[:, ok] = model.quantities(report, run.Q[ok], U[ok], p, Ud[ok], Udd[ok])
+    run.signs, run.sigma = _measures(model, run.jacobian, ok, L)
     return run
+
+
+def _measures(model: Model, J, ok, L):
+    """What the fast kernel gives per pose, from g_q at every pose: an orientation that
+    changes sign where the sweep crosses a singular position ((N, 1), 0 where unsolved) and
+    the smallest singular value of the scaled g_q relative to max(1, its largest)."""
+    n, idx = len(ok), np.flatnonzero(ok)
+    dets, sigma = np.zeros(n), np.full(n, np.nan)
+    if model.nq == 0 or not len(idx):
+        return dets[:, None], sigma
+    J = J[idx] * model.column_scale(L)
+    if model.square:
+        dets[idx] = np.linalg.det(J)
+    else:  # tall (redundant joints): no determinant, so chain the relative test of
+        # _same_branch along the sweep: the orientation flips from pose k to the next where
+        # det(Q_k' J_next) and det R_k differ in sign (J_k = Q_k R_k).
+        Qk, Rk = np.linalg.qr(J)
+        dR = np.prod(np.diagonal(Rk, axis1=1, axis2=2), axis=1)
+        o = 1.0
+        for a in range(len(idx)):
+            dets[idx[a]] = o * abs(dR[a])
+            if a + 1 < len(idx):
+                flip = np.sign(dR[a]) * np.sign(np.linalg.det(Qk[a].T @ J[a + 1]))
+                o = o * flip if flip != 0 else o
+    sv = np.linalg.svd(J, compute_uv=False)
+    sigma[idx] = sv[:, -1] / np.maximum(sv[:, 0], 1.0)
+    return np.sign(dets)[:, None], sigma
 
 
 def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,
@@ -151,49 +179,43 @@ def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 # --- singular positions met by a sweep ---
 
 
-def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, J) -> list[dict]:
+def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, signs, sigma) -> list[dict]:
     """Flag solved poses at or next to a singular position and locate it exactly.
 
     A limit lies between a solved pose and a neighbour with no assembly; a sign change of
-    det(g_q) between two solved neighbours means the sweep crossed a singular position
-    (a change point, or a limit met exactly); a pose whose scaled g_q is numerically
-    singular is flagged where it stands.
+    det(g_q) (of any Assur group's block of it) between two solved neighbours means the
+    sweep crossed a singular position (a change point, or a limit met exactly); a pose whose
+    scaled g_q is numerically singular is flagged where it stands.
+
+    `signs` (N, groups) and `sigma` (N) come with the solve (the fast kernel computes them at
+    every pose, kincas/core/blocks.py): sigma is a lower bound of the smallest singular value
+    of a group's scaled block, so only the few poses where it is small get the exact test
+    (the singular values of the whole scaled g_q) here.
     """
     from .singular import FLAG_SIGMA, classify, locate_singular, scaled_jacobians
     n, events = len(ok), []
     if model.nq == 0 or m.inputs == () or n == 0:
         return events
     idx = np.flatnonzero(ok)
-    J = J[idx]  # g_q per solved pose, as the sweep kept it; g_u only where a pose is flagged
-    J = J * model.column_scale(L)
-    dets = np.zeros(n)
-    if model.square:
-        dets[idx] = np.linalg.det(J) if len(idx) else []
-    elif len(idx):  # tall (redundant joints): no determinant, so chain the relative test of
-        # _same_branch along the sweep: the orientation flips from pose k to the next where
-        # det(Q_k' J_next) and det R_k differ in sign (J_k = Q_k R_k).
-        Qk, Rk = np.linalg.qr(J)
-        dR = np.prod(np.diagonal(Rk, axis1=1, axis2=2), axis=1)
-        o = 1.0
-        for a in range(len(idx)):
-            dets[idx[a]] = o * abs(dR[a])
-            if a + 1 < len(idx):
-                flip = np.sign(dR[a]) * np.sign(np.linalg.det(Qk[a].T @ J[a + 1]))
-                o = o * flip if flip != 0 else o
-    sv = np.linalg.svd(J, compute_uv=False) if len(idx) else np.zeros((0, model.nq))
-    for j in np.flatnonzero(sv[:, -1] <= FLAG_SIGMA * np.maximum(sv[:, 0], 1.0)):
-        Gu = scaled_jacobians(model, Q[idx[j]], U[idx[j]], p, L)[1]
-        flags[idx[j]] = classify(J[j], Gu)
+    # a group's bound can sit below the whole matrix's smallest singular value by the
+    # coupling between groups (O(1) once scaled): 1e3 of margin before the exact test
+    maybe = idx[~(sigma[idx] > 1e3 * FLAG_SIGMA)]
+    for k in maybe:
+        J, Gu = scaled_jacobians(model, Q[k], U[k], p, L)
+        sv = np.linalg.svd(J, compute_uv=False)
+        if sv[-1] <= FLAG_SIGMA * max(sv[0], 1.0):
+            flags[k] = classify(J, Gu)
     # Only a solved pose next to an unsolved one, or before a sign change of det g_q, can hold
     # an event: look at those alone (a sweep of 10^5 poses has a handful).
+    flips = np.r_[np.any(signs[:-1] != signs[1:], axis=1), False] if n else np.zeros(0, bool)
     before = np.r_[False, ~ok[:-1]]
     after = np.r_[~ok[1:], False]
-    change = np.r_[ok[:-1] & ok[1:] & (np.sign(dets[:-1]) != np.sign(dets[1:])), False]
+    change = np.r_[ok[:-1] & ok[1:], False] & flips
     for k in idx[before[idx] | after[idx] | change[idx]]:
         for nb in (k - 1, k + 1):
             if not 0 <= nb < n:
                 continue
-            crossing = ok[nb] and nb == k + 1 and np.sign(dets[k]) != np.sign(dets[nb])
+            crossing = ok[nb] and nb == k + 1 and flips[k]
             if ok[nb] and not crossing:
                 continue
             if np.allclose(U[nb], U[k]):

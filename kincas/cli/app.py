@@ -18,7 +18,8 @@ from .. import __version__
 from ..errors import KincasError, OutputError
 from .common import (EXIT_INTERRUPTED, EXIT_OK, EXIT_SCENE, EXIT_UNSOLVED,  # noqa: F401
                      _list, _unit, progress_for)
-from .solve import cli_arguments as _solve_arguments, cli_run as _solve
+from .common import _param_unit  # noqa: F401
+from .solve import cli_arguments as _solve_arguments, cli_run as _solve, rate_line  # noqa: F401
 
 
 # Further commands live in their own modules: each defines `cli_arguments(parser)` and

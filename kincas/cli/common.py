@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from ..units import json_list as _list, unit_label  # noqa: F401  (_list: JSON arrays, NaN -> null)
+from ..units import json_list as _list, param_unit, unit_label  # noqa: F401  (_list: JSON, NaN -> null)
 
 EXIT_OK, EXIT_SCENE, EXIT_UNSOLVED, EXIT_INTERRUPTED = 0, 2, 3, 130
 
@@ -23,3 +23,8 @@ def progress_for(args):
 def _unit(sc, name: str) -> str:
     """The unit of quantity `name` in the scene's units (kincas/units.py)."""
     return unit_label(sc.study.units, sc.mechanism, name)
+
+
+def _param_unit(sc, name: str) -> str:
+    """A parameter's unit in the scene's units (kincas/units.py)."""
+    return param_unit(sc.study.units, sc.mechanism, name)

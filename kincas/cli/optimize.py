@@ -10,7 +10,7 @@ import numpy as np
 
 from ..model.names import is_angular
 from ..synthesis.optimize import OptimizeResult, run_scene
-from ..units import json_list as _list
+from .common import _list, _param_unit
 from .scene import load
 
 
@@ -43,8 +43,12 @@ def report(sc, r: OptimizeResult) -> dict:
     curve = {}
     if "curve" in r.info:  # the fitted input at each target and the distance left there
         c = r.info["curve"]
+        fitted = user(key, r.samples[key])
+        if key.endswith(".angle"):  # within one turn from the sweep's start, not 677 deg
+            turn, lo = (360.0 if deg else 2 * math.pi), float(np.min(sc.study.written[key]))
+            fitted = lo + np.mod(fitted - lo, turn)
         curve = {"curve": {"point": c["point"], "targets": c["targets"].tolist(),
-                           "inputs": {key: _list(user(key, r.samples[key]))},
+                           "inputs": {key: _list(fitted)},
                            "distances": _list(c["distances"])}}
     return {
         "title": sc.study.title, "units": sc.study.units, "ok": r.ok, "converged": r.converged,
@@ -54,6 +58,8 @@ def report(sc, r: OptimizeResult) -> dict:
         "parameters": r.parameters, "varied": r.varied,
         "initial": {p: sc.mechanism.parameter(p) for p in r.varied},
         "bounds": {p: list(bounds[p]) for p in r.varied},
+        "at_bound": {p: side for p in r.varied if (side := _at_bound(r.varied[p], *bounds[p]))},
+        "parameter_units": {p: _param_unit(sc, p) for p in r.varied},
         "samples": {k: _list(user(k, v)) for k, v in r.samples.items()},
         "values": {n: _list(user(n, v)) for n, v in r.values.items()},
         "constraints": [{**{k: c[k] for k in ("expr", "min", "max", "satisfied")},
@@ -64,6 +70,12 @@ def report(sc, r: OptimizeResult) -> dict:
     }
 
 
+def _at_bound(v: float, lo: float, hi: float) -> str | None:
+    """"lower" or "upper" when v sits on that bound (to 1e-9 of the range), else None."""
+    tol = 1e-9 * max(abs(hi - lo), abs(hi), abs(lo), 1e-300)
+    return "lower" if abs(v - lo) <= tol else "upper" if abs(v - hi) <= tol else None
+
+
 def _print(sc, r: OptimizeResult, doc: dict):
     print(f"{sc.study.title or 'kincas'}: optimisation by IPOPT ({r.status}, "
           f"{r.iterations} iterations)")
@@ -71,10 +83,13 @@ def _print(sc, r: OptimizeResult, doc: dict):
     for p in r.problems[1:]:
         print(f"  also: {p}")
     print(f"objective: {r.initial_objective:.8g} (initial design) -> {r.objective:.8g}")
-    print(f"{'parameter':>12}  {'initial':>14}  {'optimised':>14}  {'low':>10}  {'high':>10}")
+    print(f"{'parameter':>12}  {'initial':>14}  {'optimised':>14}  {'low':>10}  {'high':>10}  unit")
     for p, v in r.varied.items():
         lo, hi = doc["bounds"][p]
-        print(f"{p:>12}  {doc['initial'][p]:>14.8g}  {v:>14.8g}  {lo:>10.6g}  {hi:>10.6g}")
+        side = doc["at_bound"].get(p)
+        mark = f"  <- at its {side} bound" if side else ""
+        print(f"{p:>12}  {doc['initial'][p]:>14.8g}  {v:>14.8g}  {lo:>10.6g}  {hi:>10.6g}  "
+              f"{doc['parameter_units'][p] or '-'}{mark}")
     for c in doc["constraints"]:
         v = [x for x in c["value"] if x is not None]
         shown = f"{v[0]:.8g}" if len(v) == 1 else f"from {min(v):.8g} to {max(v):.8g} over the samples"

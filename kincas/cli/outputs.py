@@ -57,6 +57,9 @@ def user_columns(sweep: Sweep, scene=None, names=None):
     """(inputs, values): name -> array in the scene's units (the sweep's own without one)."""
     inputs = scene.user_inputs(sweep) if scene is not None else dict(sweep.inputs)
     values = scene.user_values(sweep) if scene is not None else dict(sweep.values)
+    if scene is not None:  # zero to the solve's accuracy as 0, not as noise
+        from .numbers import clean
+        values = clean(values, scene, sweep)
     if names is not None:
         missing = [n for n in names if n not in values]
         if missing:
@@ -77,6 +80,7 @@ def write_csv(out, sweep: Sweep, scene=None) -> None:
         with open(out, "w", newline="", encoding="utf-8") as f:
             return write_csv(f, sweep, scene)
     inputs, values = user_columns(sweep, scene)
+    values = {k: v for k, v in values.items() if k not in inputs}  # an input reported: once
     w = csv.writer(out, lineterminator="\n")
     w.writerow([heading(k, scene) for k in [*inputs, *values]] + ["status", "flag"])
     cols = [*inputs.values(), *values.values()]

@@ -18,9 +18,10 @@ shows exactly the poses that were solved; poses not "ok" are left out of paths.
 """
 from __future__ import annotations
 
+import threading
 import weakref
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -64,6 +65,7 @@ class Geometry:
     xy: np.ndarray
     slides: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]
     ok: np.ndarray
+    joints: object = field(default=None, repr=False)  # gears, racks, cams: cli/draw_joints.py
 
     def point(self, name: str) -> np.ndarray:
         """(N x 2) positions of one point."""
@@ -71,12 +73,18 @@ class Geometry:
 
 
 _POSE_FUNCTIONS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_POSE_LOCK = threading.Lock()  # threads drawing at once build each function once
 
 
 def _pose_function(model):
     """(q, u, p) -> ground points, moving points, and for each slide its line's point
     `through` and direction angle, all in world coordinates (a body's frame is origin
     (ox, oy) and angle th: a local vector v maps to origin + R(th) v)."""
+    with _POSE_LOCK:
+        return _POSE_FUNCTIONS[model] if model in _POSE_FUNCTIONS else _build_pose_function(model)
+
+
+def _build_pose_function(model):
     if model not in _POSE_FUNCTIONS:
         import casadi as ca
         sym, m = model.sym, model.sym.mech
@@ -118,7 +126,8 @@ def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
         d = np.stack([np.cos(angle), np.sin(angle)], axis=1)
         s = np.einsum("ij,ij->i", xy[:, names.index(sl.point)] - through, d)  # signed distance
         slides[sl.name] = (through, d, s)
-    return Geometry(names, xy, slides, ok)
+    from .draw_joints import joint_geometry
+    return Geometry(names, xy, slides, ok, joint_geometry(model, Q, U, p, ok))
 
 
 # --- shapes ---
@@ -194,6 +203,8 @@ class Drawing:
         self._ground_symbols()
         self._make_bodies()
         self._make_slides()
+        from .draw_joints import JointArtists
+        self.joint_artists = JointArtists(self, geo.joints) if geo.joints is not None else None
         self._make_points(labels)
         self.caption = ax.set_title("", fontsize=9)
         # The limits follow this box, widened to equal scales by matplotlib when drawn (the
@@ -333,6 +344,8 @@ class Drawing:
                                     for t in np.arange(lo, hi + 1e-12, 1.2 * r)])
         for idx, line in (self.joints, self.dots):
             line.set_data(*xy[idx].T)
+        if self.joint_artists is not None:
+            self.joint_artists.update(i)
         for k, t in enumerate(self.labels):
             ok = bool(np.isfinite(xy[k]).all())
             t.set_visible(ok)

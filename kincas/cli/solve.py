@@ -9,6 +9,8 @@ import json
 import math
 import sys
 
+import numpy as np
+
 from .common import EXIT_OK, EXIT_UNSOLVED, _list, _unit, progress_for
 from .scene import load
 
@@ -34,7 +36,8 @@ def cli_run(args) -> int:
         from .outputs import check_outputs
         check_outputs(args, sc.mechanism, len(next(iter(sc.study.inputs.values()))))
     sw = sc.run(progress=progress_for(args))
-    inputs, values = sc.user_inputs(sw), sc.user_values(sw)
+    from .numbers import clean  # zero to the solve's accuracy is printed as 0, not as noise
+    inputs, values = sc.user_inputs(sw), clean(sc.user_values(sw), sc, sw)
     if args.json:
         doc = {"title": sc.study.title, "units": sc.study.units,
                "inputs": {k: _list(v) for k, v in inputs.items()},
@@ -51,6 +54,20 @@ def cli_run(args) -> int:
     return EXIT_OK if all(s == "ok" for s in sw.status) else EXIT_UNSOLVED
 
 
+def rate_line(sc, sw) -> str:
+    """The inputs' rates and accelerations, which every velocity and acceleration follows."""
+    T = sc.study.units.get("time", "s")
+    parts = []
+    for k in sw.inputs:
+        u = _unit(sc, k)
+        r, a = (np.asarray(d.get(k, 0.0), float) for d in (sw.rates, sw.accelerations))
+        if k.endswith(".angle") and sc.study.deg:
+            r, a = np.degrees(r), np.degrees(a)
+        show = lambda v: f"{v.flat[0]:.6g}" if v.size and np.ptp(v) == 0 else "varies"
+        parts.append(f"{k} rate {show(r)} {u}/{T}, acceleration {show(a)} {u}/{T}^2")
+    return "inputs: " + "; ".join(parts) + " (velocities and accelerations follow these)"
+
+
 def _user_event(sc, e: dict) -> dict:
     """A singular position or a resumption, with its input values in the scene's units."""
     deg = sc.study.deg
@@ -60,6 +77,9 @@ def _user_event(sc, e: dict) -> dict:
 
 def _table(sc, sw, inputs, values):
     print(sc.study.title or "kincas")
+    if sw.inputs:
+        print(rate_line(sc, sw))
+    values = {k: v for k, v in values.items() if k not in inputs}  # an input reported: once
     cols = list(inputs) + list(values)
     heads = [c if not _unit(sc, c) else f"{c} [{_unit(sc, c)}]" for c in cols]
     width = [max(12, len(h)) for h in heads]

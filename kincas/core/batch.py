@@ -29,7 +29,8 @@ import casadi as ca
 import numpy as np
 
 from .compiled import Backend, Library
-from .fast import _SWEEP_C, sweeper_for
+from .fast import sweeper_for
+from .kernel import SWEEP_C as _SWEEP_C
 
 _I, _V = ctypes.c_longlong, ctypes.c_void_p
 
@@ -71,7 +72,8 @@ class DesignKernel:
 
     def _library(self) -> Library:
         return Library("kincas_designs", self.sweeper.functions, _SWEEP_C + _DESIGNS_C,
-                       {"NQ": self.nq, "NU": self.nu, "NO": self.no},
+                       {"NQ": self.nq, "NU": self.nu, "NO": self.no,
+                        "NM": len(self.sweeper.blocks) + 1},
                        {"kincas_sweep": _SWEEP_SIG, "kincas_designs": _DESIGNS_SIG})
 
     def lib(self, n: int):

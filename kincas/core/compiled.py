@@ -23,6 +23,7 @@ import re
 import shutil
 import subprocess
 import tempfile
+import threading
 import time
 import warnings
 from pathlib import Path
@@ -39,6 +40,12 @@ COMPILE_MIN_POSES = 50_000  # compile=None compiles for fewer poses only if alre
 _FLAGS = ["-O3", "-fno-semantic-interposition", "-fno-math-errno", "-shared", "-fPIC", "-Wl,-Bsymbolic"]
 _PLAIN = ["-O2", "-shared", "-fPIC"]
 _LIBS: dict[str, ctypes.CDLL] = {}  # loaded libraries by path (the path holds the hash)
+_LIBS_LOCK = threading.Lock()  # threads of this process load (and compile) one at a time
+
+try:
+    import fcntl
+except ImportError:  # not on POSIX: compiles may race, but os.replace keeps each load whole
+    fcntl = None
 
 
 # --- building and caching ---
@@ -90,20 +97,30 @@ class Library:
         self.times = {"generate": time.perf_counter() - t0, "compile": 0.0, "load": 0.0}
 
     def load(self) -> ctypes.CDLL:
-        """The loaded library, compiled first if it is not in the cache."""
-        if str(self.path) not in _LIBS:
-            if not self.path.exists():
-                self._compile()
-                _prune(self.path.parent)
-            else:
-                os.utime(self.path)  # recently used: pruned last
-            t0 = time.perf_counter()
-            lib = ctypes.CDLL(str(self.path))
-            for name, args in self.signatures.items():
-                getattr(lib, name).argtypes, getattr(lib, name).restype = args, ctypes.c_int
-            _LIBS[str(self.path)] = lib
-            self.times["load"] = time.perf_counter() - t0
-        return _LIBS[str(self.path)]
+        """The loaded library, compiled first if it is not in the cache.
+
+        Safe from several threads and processes at once: threads of a process take a lock,
+        processes an exclusive `flock` on a lock file beside the library, and whoever gets it
+        second finds the library built. A library is written under a temporary name and
+        renamed into place, so nobody ever loads a half-written one."""
+        key = str(self.path)
+        with _LIBS_LOCK:
+            if key not in _LIBS:
+                if not self.path.exists():
+                    self.path.parent.mkdir(parents=True, exist_ok=True)
+                    with _file_lock(self.path.with_suffix(".lock")):
+                        if not self.path.exists():  # another process may have built it meanwhile
+                            self._compile()
+                            _prune(self.path.parent)
+                else:
+                    os.utime(self.path)  # recently used: pruned last
+                t0 = time.perf_counter()
+                lib = ctypes.CDLL(key)
+                for name, args in self.signatures.items():
+                    getattr(lib, name).argtypes, getattr(lib, name).restype = args, ctypes.c_int
+                _LIBS[key] = lib
+                self.times["load"] = time.perf_counter() - t0
+            return _LIBS[key]
 
     def _compile(self):
         if self.cc is None:
@@ -122,6 +139,24 @@ class Library:
                 raise RuntimeError(f"{self.cc} failed: {done.stderr.strip()[-400:]}")
             os.replace(out, self.path)  # atomic: other processes see all of it or nothing
         self.times["compile"] = time.perf_counter() - t0
+
+
+class _file_lock:
+    """An exclusive lock on a file, held between processes (a no-op without fcntl)."""
+
+    def __init__(self, path: Path):
+        self.path = path
+
+    def __enter__(self):
+        self.fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        if fcntl is not None:
+            fcntl.flock(self.fd, fcntl.LOCK_EX)
+        return self
+
+    def __exit__(self, *exc):
+        if fcntl is not None:
+            fcntl.flock(self.fd, fcntl.LOCK_UN)
+        os.close(self.fd)
 
 
 # --- sine and cosine of an angle in one call ---
@@ -175,6 +210,7 @@ def _prune(folder: Path) -> None:
         libs = sorted(folder.glob("kincas_*.so"), key=lambda f: f.stat().st_mtime)
         for f in libs[:max(0, len(libs) - MAX_CACHED)]:
             f.unlink(missing_ok=True)
+            f.with_suffix(".lock").unlink(missing_ok=True)
     except OSError:  # another process pruned first: nothing lost
         pass
 
@@ -195,20 +231,24 @@ class Backend:
         self.library: Library | None = None
         self.lib: ctypes.CDLL | None = None
         self.failed = False
+        self._lock = threading.Lock()
 
     def compiled(self, n: int) -> ctypes.CDLL | None:
         """The loaded library to use for n poses, or None for the virtual machine."""
         if self.lib is not None or self.failed or self.compile is False or compiling_disabled():
             return self.lib
-        try:  # a failed build must never fail a user's solve
-            if self.library is None:
-                self.library = self.make_library()
-            if self.compile or self.library.cached or n >= COMPILE_MIN_POSES:
-                self.lib = self.library.load()
-        except Exception as e:
-            self.failed = True
-            warnings.warn(f"kincas: could not compile the {self.what} ({e}); using the slower "
-                          f"uncompiled path", RuntimeWarning, stacklevel=3)
+        with self._lock:  # one thread builds; the others wait and then use it
+            if self.lib is not None or self.failed:
+                return self.lib
+            try:  # a failed build must never fail a user's solve
+                if self.library is None:
+                    self.library = self.make_library()
+                if self.compile or self.library.cached or n >= COMPILE_MIN_POSES:
+                    self.lib = self.library.load()
+            except Exception as e:
+                self.failed = True
+                warnings.warn(f"kincas: could not compile the {self.what} ({e}); using the slower "
+                              f"uncompiled path", RuntimeWarning, stacklevel=3)
         return self.lib
 
 
@@ -289,7 +329,7 @@ class QuantityEvaluator:
         ins = f.sx_in()
         self.f = ca.Function("kQ", ins, [ca.densify(f(*ins))], {"cse": True})
         self.no = self.f.size1_out(0)
-        self._vm = None
+        self._local, self._lock = threading.local(), threading.Lock()  # VM buffers per thread
         self.backend = Backend(compile, self._library, "quantity evaluator")
 
     def _library(self) -> Library:
@@ -318,13 +358,16 @@ class QuantityEvaluator:
         return out
 
     def _vm_evaluate(self, Q, U, p, Ud, Udd, out):
-        if self._vm is None:
-            F = self.f.map("qmap", "serial", CHUNK, [2], [])  # p is the same for every pose
-            buf, call = F.buffer()
+        vm = getattr(self._local, "vm", None)
+        if vm is None:
+            with self._lock:
+                if getattr(self, "_map", None) is None:  # p is the same for every pose
+                    self._map = self.f.map("qmap", "serial", CHUNK, [2], [])
+            buf, call = self._map.buffer()
             scratch = [np.zeros((CHUNK, m)) for m in (self.nq, self.nu, self.nu, self.nu, self.no)]
             buf.set_res(0, memoryview(scratch[-1]))
-            self._vm = (F, buf, call, scratch)  # buf holds raw pointers: keep it referenced
-        _, buf, call, (Qc, Uc, Udc, Uddc, Oc) = self._vm
+            vm = self._local.vm = (buf, call, scratch)  # buf holds raw pointers: keep it
+        buf, call, (Qc, Uc, Udc, Uddc, Oc) = vm
         n = Q.shape[0]
         for k in range(0, n, CHUNK):
             m = min(CHUNK, n - k)

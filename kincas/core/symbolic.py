@@ -196,11 +196,13 @@ class Symbolic:
                            f"or d(Q)/d(p) with declared names)")
         return out
 
-    def quantity_function(self, names: list[str], jerk: bool = False) -> ca.Function:
+    def quantity_function(self, names: list[str], jerk: bool = False, lsolve=None) -> ca.Function:
         """f(q, u, p, u', u'') -> the named quantities (only what they need is built).
 
         With `jerk=True` the function takes the inputs' jerks u''' as a sixth argument;
-        otherwise they are zero (the default of every input's `jerk`).
+        otherwise they are zero (the default of every input's `jerk`). `lsolve(b)`, if given,
+        replaces `self.lsolve` for the solves with g_q (the fast kernel solves them Assur
+        group by Assur group, kincas/core/blocks.py).
 
         Sensitivities d(Q)/d(p) follow the implicit function theorem on the same Jacobian:
         dq/dp = -g_q^-1 g_p, so dQ/dp = Q_q dq/dp + Q_p, with Q written in (q, u, p, u', u'')
@@ -220,23 +222,24 @@ class Symbolic:
         raw = [self._expr(a if k == "sens" else n, t) for n, (k, a, b) in zip(names, parsed)]
         out = ca.vertcat(*raw) if raw else ca.SX(0, 1)
         orders = 3 if ca.depends_on(out, qddd_s) else self._needs(out, qd_s, qdd_s)
+        lsolve = lsolve or self.lsolve
         if orders >= 1:  # only build the linear solves that the report needs
-            qd = ca.densify(-self.lsolve(ca.mtimes(self.Ju, ud)))  # dense even with no input
+            qd = ca.densify(-lsolve(ca.mtimes(self.Ju, ud)))  # dense even with no input
             qdd = ca.SX.zeros(self.nq)
             if orders >= 2:
                 gam = ca.jtimes(ca.jtimes(self.g, z, zd), z, zd)
-                qdd = ca.densify(ca.substitute(-self.lsolve(ca.mtimes(self.Ju, udd) + gam), qd_s, qd))
+                qdd = ca.densify(ca.substitute(-lsolve(ca.mtimes(self.Ju, udd) + gam), qd_s, qd))
             if orders >= 3:  # g''' = g_q q''' + (the rest, at q''' = 0), with q'' and q' known
                 g2 = ca.jtimes(self.g, z, zdd) + gam
                 rest = t.d(g2, 1, third=ca.vertcat(ca.SX.zeros(self.nq), uddd))
                 rest = ca.substitute(ca.substitute(rest, qdd_s, qdd), qd_s, qd)
-                out = ca.substitute(out, qddd_s, ca.densify(-self.lsolve(rest)))
+                out = ca.substitute(out, qddd_s, ca.densify(-lsolve(rest)))
             out = ca.substitute(ca.substitute(out, qdd_s, qdd), qd_s, qd)
         rows = [out[i] for i in range(out.numel())]
         sens = [(i, b) for i, (k, _, b) in enumerate(parsed) if k == "sens"]
         if sens:
             gp = ca.jacobian(self.g, self.p)
-            dq_dp = -self.lsolve(gp)  # one factorisation serves every parameter
+            dq_dp = -lsolve(gp)  # one factorisation serves every parameter
             for i, b in sens:
                 j = self.pnames.index(b)
                 rows[i] = ca.jtimes(rows[i], self.q, dq_dp[:, j]) + ca.jacobian(rows[i], self.p[j])

@@ -246,8 +246,13 @@ def value_problems(m: "Mechanism") -> list[str]:
         elif g.internal and m.value(g.radii[0]) == m.value(g.radii[1]):
             out.append(f"{where}: radii: an internal mesh needs different radii")
     for i, r in enumerate(m.racks):
+        where = f"[[racks]] {r.name or i + 1}"
         if m.value(r.radius) <= 0:
-            out.append(f"[[racks]] {r.name or i + 1}: radius: the pitch radius must be positive")
+            out.append(f"{where}: radius: the pitch radius must be positive")
+        centre = m.link(r.pinion).local(m.slide(r.slide).point)
+        if any(m.value(v) != 0 for v in centre):
+            out.append(f"{where}: slide: the point of slide {r.slide!r} must be the pinion's centre, "
+                       f"the origin of {r.pinion!r}'s frame")
     for i, c in enumerate(m.cams):
         where = f"[[cams]] {c.name or i + 1}"
         rho = m.value(c.roller_radius) if c.roller else 0.0

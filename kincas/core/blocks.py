@@ -1,0 +1,100 @@
+"""g_q's block-triangular form, and the solves and measures the fast kernel takes from it.
+
+Permuted to its block-triangular form (Dulmage-Mendelsohn, `casadi.Sparsity.btf`), g_q has
+irreducible square blocks on its diagonal, one per Assur group (2 x 2 for a dyad, 4 x 4 for a
+triad), and zeros on one side of them. So:
+
+- g_q x = b is solved block by block, each group's unknowns from its own equations once the
+  groups it hangs on are known: x_B = A_BB^-1 (b_B - sum_C A_BC x_C). Its cost, and the size
+  of the generated code, grow with the number of groups instead of with nq^3;
+- det g_q = (permutation sign) * prod det A_BB: its sign, which tells assembly branches
+  apart, is known per group, and g_q is singular exactly where one of its diagonal blocks is.
+  With columns scaled to O(1) (positive factors: the signs do not change), each block gets a
+  lower bound of its smallest singular value: exact for blocks of 1 and 2 unknowns
+  (sigma_min = 2|d| / (sqrt(F + 2|d|) + sqrt(F - 2|d|)), F = ||A||_F^2), |d| / F^((n-1)/2)
+  beyond (the largest singular value is at most sqrt(F)).
+
+The blocks are `Model.blocks` (kincas/core/structure.py), each with `.rows` and `.cols`.
+
+>>> import numpy as np, casadi as ca
+>>> from kincas.core.structure import Block
+>>> A = ca.DM([[2.0, 1.0], [0.0, 3.0]])
+>>> signs, rel = block_measures(A, np.ones(2), [Block(np.arange(2), np.arange(2), ())])
+>>> round(float(rel * np.sqrt(14)), 12), round(float(np.linalg.svd(A.full(), compute_uv=False)[-1]), 12)
+(1.84240297561, 1.84240297561)
+"""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+
+# --- symbolic solves and measures over the blocks ---
+
+
+def _small_solve(A, b):
+    n = A.size1()
+    if n == 1:
+        return b / A[0, 0]
+    if n == 2:  # Cramer's rule: forward stable in two dimensions, and few operations
+        d = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
+        return ca.vertcat(A[1, 1] * b[0, :] - A[0, 1] * b[1, :], A[0, 0] * b[1, :] - A[1, 0] * b[0, :]) / d
+    return ca.solve(A, b)
+
+
+def block_solve(J, b, blocks: list[Block]):
+    """J^-1 b (J square with this block structure, b one or more columns), group by group."""
+    n, k = J.size1(), b.size2()
+    x = [None] * n
+    for blk in blocks:
+        rhs = b[blk.rows.tolist(), :]
+        known = [j for j in range(n) if x[j] is not None]
+        if known:
+            coupling = J[blk.rows.tolist(), known]
+            if coupling.nnz():
+                rhs = rhs - ca.mtimes(coupling, ca.vertcat(*[x[j] for j in known]))
+        xb = _small_solve(J[blk.rows.tolist(), blk.cols.tolist()], rhs)
+        for i, j in enumerate(blk.cols):
+            x[j] = xb[i, :]
+    return ca.vertcat(*x) if n else ca.SX(0, k)
+
+
+def block_measures(J, cs, blocks: list[Block]):
+    """(sign of det of each diagonal block, smallest lower bound of a block's smallest
+    singular value relative to max(1, its largest)), J's columns scaled by cs > 0."""
+    signs, sig = [], []
+    for blk in blocks:
+        c = cs[blk.cols.tolist()] if isinstance(cs, (ca.SX, ca.DM)) else ca.DM(np.asarray(cs)[blk.cols])
+        A = J[blk.rows.tolist(), blk.cols.tolist()] * ca.repmat(ca.reshape(c, 1, -1), len(blk.rows), 1)
+        n, F = A.size1(), ca.sumsqr(A)
+        d = ca.det(A) if n > 1 else A[0, 0]
+        ad = ca.fabs(d)
+        if n <= 2:
+            lb = ad if n == 1 else 2 * ad / (ca.sqrt(F + 2 * ad) + ca.sqrt(ca.fmax(F - 2 * ad, 0)))
+        else:
+            lb = ad / F ** ((n - 1) / 2)
+        signs.append(ca.sign(d))
+        sig.append(lb / ca.fmax(1, ca.sqrt(F)))
+    if not blocks:
+        return ca.SX(0, 1), ca.SX(1)
+    return ca.vertcat(*signs), ca.mmin(ca.vertcat(*sig))
+
+
+def block_change(J0, J, D, blocks: list[Block]):
+    """max over blocks of sum |D^-1 (A0^-1 A - I) D| for the diagonal blocks A0 of J0 and A
+    of J. Below 1 for every block, each A0 + t (A - A0), t in [0, 1], is invertible, hence
+    so is J0 + t (J - J0) (block triangular): det g_q keeps its sign between the two."""
+    out = [ca.SX(0)]
+    for blk in blocks:
+        r, c = blk.rows.tolist(), blk.cols.tolist()
+        Db = D[c]
+        M = (_small_solve(J0[r, c], J[r, c]) - ca.DM.eye(len(c))) * ca.repmat(Db.T, len(c), 1) / ca.repmat(Db, 1, len(c))
+        out.append(ca.sum1(ca.sum2(ca.fabs(M))))
+    return ca.mmax(ca.vertcat(*out))
+
+
+def numeric_signs(J: np.ndarray, blocks: list[Block]) -> np.ndarray:
+    """(N, len(blocks)) signs of the blocks' determinants of N matrices J (N, n, n)."""
+    if not blocks:
+        return np.ones((J.shape[0], 0))
+    return np.stack([np.sign(np.linalg.det(J[:, b.rows][:, :, b.cols])) for b in blocks], axis=1)

@@ -1,0 +1,152 @@
+"""The fast sweep's kernel: casadi functions for one pose, and the C loop that drives them.
+
+Three functions, every linear solve done Assur group by Assur group (kincas/core/blocks.py),
+so their size grows with the number of groups, not with nq^3:
+
+- kP: the prediction from the last solved pose (tangent, second-order term);
+- kN: at q, the Newton step g_q^-1 g and the measures that stop Newton (max |g| / L and the
+  step's size in radians or lengths / L): nothing else is evaluated at a Newton iterate;
+- kF: once per pose, at the final q: g_q, the tangent dq/du, the residual, the branch test
+  against the last pose (Jacobian change per group, size of the correction), the singular
+  measures (the sign of each group's det and a lower bound of its smallest singular value,
+  columns scaled to O(1)) and the reported quantities, sharing one set of sines and cosines.
+
+One stopping rule: a pose is converged when the Newton step that would follow is below STEP
+(radians, or lengths / L) and the residual below RESIDUAL; that last step is applied, so a
+pose ends where quadratic convergence puts it (rounding). kN iterates until its step is
+below NEAR (quadratic convergence then makes the next one ~NEAR^2), and kF, which needs g
+and g_q at the final q anyway, gives that next step: a pose usually costs one or two kN and
+one kF. Where convergence is not quadratic (near a singular position) the next step stays
+above STEP and the pose goes to the careful path.
+"""
+from __future__ import annotations
+
+import casadi as ca
+
+from .blocks import block_change, block_measures, block_solve
+
+RESIDUAL = 1e-10  # as the careful path's ACCEPT: max |g| / L
+STEP = 1e-13  # the next Newton step (radians, or lengths / L), applied before stopping
+JAC_CHANGE = 0.9  # per group, sum |entries of D^-1 (A_prev^-1 A - I) D| (below 1 keeps det's sign)
+CORRECTION = 0.25  # ||D^-1 (q - q_pred)||_1: Newton may not wander far from the prediction
+MAX_EVALS = 5  # kN evaluations per pose at most
+NEAR = 1e-8  # kN's step below which the next is negligible where convergence is quadratic
+
+
+# --- the casadi functions ---
+
+
+def kernel_functions(sym, blocks, report=()) -> list[ca.Function]:
+    """[kP, kN, kF] (see the module text), outputs dense so that C can index them.
+
+    The prediction is of second order: with the tangents T0 at the last pose (input u0) and
+    T1 at the one before (u1), dT = T0 - T1 ~ H[u0 - u1, .] for the second derivative H of
+    q(u), so along a step u - u0 = l (u0 - u1), H[u - u0, u - u0] ~ l dT (u - u0); its error
+    is O(h^3) on a straight sweep and still O(h^2) where the sweep turns."""
+    nq, nu = sym.nq, sym.nu
+    solve = lambda A, b: block_solve(A, b, blocks)
+    q, qp, J0 = ca.SX.sym("q", nq), ca.SX.sym("qp", nq), ca.SX.sym("J0", nq, nq)
+    T0, u0, u = ca.SX.sym("T0", nq, nu), ca.SX.sym("u0", nu), ca.SX.sym("u", nu)
+    T1, u1 = ca.SX.sym("T1", nq, nu), ca.SX.sym("u1", nu)
+    du, dup = u - u0, u0 - u1
+    lam = ca.if_else(ca.dot(dup, dup) > 0, ca.dot(du, dup) / ca.dot(dup, dup), 0)
+    pred = q + ca.mtimes(T0, du) + 0.5 * lam * ca.mtimes(T0 - T1, du)
+    p, L, ud, udd = ca.SX.sym("p", sym.np), ca.SX.sym("L"), ca.SX.sym("ud", nu), ca.SX.sym("udd", nu)
+    is_length = ca.DM(sym.is_length.astype(float))
+    D = ca.if_else(is_length, L, 1)  # the scale of each unknown
+    cs = ca.if_else(is_length, 1, 1 / L)  # g_q's columns to O(1): 1 (lengths), 1/L (angles)
+    g, Jq, Ju = ca.Function("G", [sym.q, sym.u, sym.p], [sym.g, sym.Jq, sym.Ju])(q, u, p)
+    step = solve(Jq, g)
+    rs = ca.vertcat(ca.mmax(ca.fabs(g)) / L, ca.norm_1(step / D))  # a sum keeps NaNs
+    T = -solve(Jq, Ju)
+    # J0 arrives dense but has g_q's sparsity: projecting it keeps the group solves sparse
+    change = block_change(ca.project(J0, Jq.sparsity()), Jq, D, blocks)
+    signs, sigma = block_measures(Jq, cs, blocks)
+    if report:
+        qf = sym.quantity_function(list(report), lsolve=lambda b: block_solve(sym.Jq, b, blocks))
+        y = ca.densify(qf(q, u, p, ud, udd))
+    else:
+        y = ca.SX(0, 1)
+    d, o = ca.densify, {"cse": True}  # cse: one sin and cos per angle, shared by everything
+    return [ca.Function("kP", [q, T0, u0, u, T1, u1], [d(pred)], o),
+            ca.Function("kN", [q, u, p, L], [d(step), rs], o),
+            ca.Function("kF", [q, u, p, L, ud, udd, J0, qp],
+                        [d(Jq), d(T), rs, ca.vertcat(change, ca.norm_1((q - qp) / D)),
+                         ca.vertcat(signs, sigma), y, d(step)], o)]
+
+
+def state_function(sym, blocks) -> ca.Function:
+    """kT(q, u, p) -> (g_q, dq/du) dense: the kernel's state at a pose solved elsewhere."""
+    q, u, p = ca.SX.sym("q", sym.nq), ca.SX.sym("u", sym.nu), ca.SX.sym("p", sym.np)
+    Jq, Ju = ca.Function("G", [sym.q, sym.u, sym.p], [sym.Jq, sym.Ju])(q, u, p)
+    return ca.Function("kT", [q, u, p], [ca.densify(Jq), ca.densify(-block_solve(Jq, Ju, blocks))],
+                       {"cse": True})
+
+
+def vm_step(kP, kN, kF, nq, nu, max_evals) -> ca.Function:
+    """One pose for the virtual machine, the compiled loop's arithmetic with a fixed number
+    of kN evaluations: once a step is below NEAR, q stays put, so it ends where the loop stops.
+    info = (residual, next step, Jacobian change, correction, kN steps, converged)."""
+    q0, J0, T0, u0 = ca.SX.sym("q0", nq), ca.SX.sym("J0", nq, nq), ca.SX.sym("T0", nq, nu), ca.SX.sym("u0", nu)
+    u, p, L, thr = ca.SX.sym("u", nu), ca.SX.sym("p", kN.size1_in(2)), ca.SX.sym("L"), ca.SX.sym("t", 5)
+    ud, udd, T1, u1 = ca.SX.sym("ud", nu), ca.SX.sym("udd", nu), ca.SX.sym("T1", nq, nu), ca.SX.sym("u1", nu)
+    q = qp = kP(q0, T0, u0, u, T1, u1)
+    done, evals = ca.SX(0), ca.SX(0)
+    for _ in range(max_evals):
+        dq, rs = kN(q, u, p, L)
+        evals += 1 - done
+        q = ca.if_else(done, q, q - dq)
+        done = ca.logic_or(done, rs[1] <= thr[4])
+    J, T, rs, mc, meas, y, dq = kF(q, u, p, L, ud, udd, J0, qp)
+    conv = ca.logic_and(rs[0] <= thr[0], rs[1] <= thr[1])
+    q = ca.if_else(conv, q - dq, q)
+    info = ca.vertcat(rs, mc, evals, conv)
+    return ca.Function("kS", [q0, J0, T0, u0, T1, u1, u, p, L, thr, ud, udd],
+                       [q, J, T, u, T0, u0, info, y, meas])
+
+
+# --- the C loop around them (NQ, NU, NO, NM: sizes; state s = q, J, T = dq/du, u at the
+# last pose, then T and u at the one before; matrices column-major) ---
+
+SWEEP_C = """
+int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const casadi_real* L,
+                 const casadi_real* thr, casadi_int max_evals, casadi_real* s, casadi_real* Q,
+                 casadi_real* info, casadi_int ld, const casadi_real* Ud, casadi_int sud,
+                 const casadi_real* Udd, casadi_int sudd, casadi_real* vals, casadi_real* meas) {
+  const casadi_real* arg[SZ_ARG]; casadi_real* res[SZ_RES]; casadi_int iw[SZ_IW]; casadi_real w[SZ_W];
+  casadi_real qp[NQ], q[NQ], dq[NQ], J[NQ*NQ], T[NQ*NU], rs[2], rf[2], mc[2], ms[NM], y[NO > 0 ? NO : 1];
+  casadi_int k, i, it;
+  for (k = 0; k < n; ++k) {
+    const casadi_real* u = U + k*NU;
+    int conv = 0;
+    arg[0] = s; arg[1] = s + NQ + NQ*NQ; arg[2] = s + NQ + NQ*NQ + NQ*NU; arg[3] = u;
+    arg[4] = s + NQ + NQ*NQ + NQ*NU + NU; arg[5] = s + NQ + NQ*NQ + 2*NQ*NU + NU; res[0] = qp;
+    if (kP(arg, res, iw, w, 0)) break;
+    for (i = 0; i < NQ; ++i) q[i] = qp[i];
+    for (it = 1; ; ++it) {  /* Newton until the step just applied makes the next negligible */
+      arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = L; res[0] = dq; res[1] = rs;
+      if (kN(arg, res, iw, w, 0)) break;
+      for (i = 0; i < NQ; ++i) q[i] -= dq[i];
+      if (rs[1] <= thr[4] || it >= max_evals) break;
+    }
+    arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = L; arg[4] = Ud + k*sud; arg[5] = Udd + k*sudd;
+    arg[6] = s + NQ; arg[7] = qp;
+    res[0] = J; res[1] = T; res[2] = rf; res[3] = mc; res[4] = ms; res[5] = y; res[6] = dq;
+    if (kF(arg, res, iw, w, 0)) break;
+    conv = rf[0] <= thr[0] && rf[1] <= thr[1];  /* the next step is negligible: apply it */
+    if (conv) for (i = 0; i < NQ; ++i) q[i] -= dq[i];
+    for (i = 0; i < NQ; ++i) Q[k*NQ + i] = q[i];
+    for (i = 0; i < NO; ++i) vals[i*ld + k] = y[i];  /* one contiguous row per quantity */
+    if (meas) for (i = 0; i < NM; ++i) meas[i*ld + k] = ms[i];
+    info[k] = rf[0]; info[ld + k] = rf[1]; info[2*ld + k] = mc[0]; info[3*ld + k] = mc[1];
+    info[4*ld + k] = (casadi_real) it;
+    if (!(conv && mc[0] <= thr[2] && mc[1] <= thr[3])) break;
+    for (i = 0; i < NQ*NU + NU; ++i) s[NQ + NQ*NQ + NQ*NU + NU + i] = s[NQ + NQ*NQ + i];
+    for (i = 0; i < NQ; ++i) s[i] = q[i];
+    for (i = 0; i < NQ*NQ; ++i) s[NQ + i] = J[i];
+    for (i = 0; i < NQ*NU; ++i) s[NQ + NQ*NQ + i] = T[i];
+    for (i = 0; i < NU; ++i) s[NQ + NQ*NQ + NQ*NU + i] = u[i];
+  }
+  return (int) k;
+}
+"""
