@@ -161,7 +161,7 @@ def mobility(scene: dict) -> int:
 # and the example files, without kincas
 
 # Checked by other files: chains no dyad method solves (tests/test_class3.py) and
-# optimisation studies (tests/test_optimize.py).
+# optimisation studies (tests/test_optimize.py); forces and geometry (tests/test_forces_examples.py).
 NO_CLOSED_FORM = {"assur_triad", "stephenson3", "eightbar"}
 # Gears, racks, cams, relative inputs, fixed pins in moving slots: tests/test_joint_examples.py
 JOINT_EXAMPLES = {"geared_fivebar", "planetary", "rack_fourbar", "eccentric_cam", "roller_cam",
@@ -169,7 +169,8 @@ JOINT_EXAMPLES = {"geared_fivebar", "planetary", "rack_fourbar", "eccentric_cam"
 
 
 def _checked_elsewhere(stem: str) -> bool:
-    return stem in NO_CLOSED_FORM or stem in JOINT_EXAMPLES or stem.startswith(("synthesis_", "optimize_"))
+    return stem in NO_CLOSED_FORM or stem in JOINT_EXAMPLES or stem.startswith(
+        ("synthesis_", "optimize_", "forces_"))
 
 
 def test_every_example_has_a_closed_form():

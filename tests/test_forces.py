@@ -267,3 +267,46 @@ def test_bad_force_names_and_scene_fields(capsys, tmp_path):
     assert "[links] crank: mass: unknown parameter 'heavy'" in err
     assert "[[loads]] 1: force: missing" in err
     assert "[[loads]] 2: unknown field 'force'" in err
+
+
+def test_relative_elbow_drive_efforts_and_reactions():
+    # two-link arm, elbow motor on the upper arm: static efforts from the moment of the load
+    # about each joint (the shoulder carries the whole arm, the elbow the forearm)
+    l1, l2, a, b, F = 0.3, 0.25, 0.4, 0.9, (2.0, -30.0)
+    m = Mechanism(ground={"S": (0, 0)},
+                  links=[Link.bar("upper", "S", "E", l1), Link.bar("forearm", "E", "H", l2, mass=1.5)],
+                  inputs=[Input.angle("upper"), Input.angle("forearm/upper")], gravity=G,
+                  loads=[Load.force("H", F)])
+    names = ["effort(upper.angle)", "effort(forearm/upper.angle)", "reaction(E, forearm).x",
+             "reaction(E, forearm).y", "reaction(S, upper).y"]
+    pose = kincas.solve(m, {"upper.angle": a, "forearm/upper.angle": b},
+                        rates={"upper.angle": 0.0, "forearm/upper.angle": 0.0}, report=names)
+    e = np.array([l1 * math.cos(a), l1 * math.sin(a)])
+    h = e + l2 * np.array([math.cos(a + b), math.sin(a + b)])
+    g2 = (e + h) / 2
+    cross = lambda r, f: r[0] * f[1] - r[1] * f[0]
+    weight = (0.0, 1.5 * G[1])
+    # the motor balances the moment of the loads beyond it: T + r x F = 0
+    shoulder = -(cross(h, F) + cross(g2, weight))
+    elbow = -(cross(h - e, F) + cross(g2 - e, weight))
+    assert abs(pose["effort(upper.angle)"] - shoulder) < 1e-10
+    assert abs(pose["effort(forearm/upper.angle)"] - elbow) < 1e-10
+    # the forearm hangs on the elbow: the pin carries its weight and the load
+    assert abs(pose["reaction(E, forearm).x"] + F[0]) < 1e-10
+    assert abs(pose["reaction(E, forearm).y"] + F[1] + weight[1]) < 1e-10
+    assert abs(pose["reaction(S, upper).y"] + F[1] + weight[1]) < 1e-10
+
+
+def test_gear_pair_effort_by_its_ratio_and_reactions_refused(capsys, tmp_path):
+    from conftest import EXAMPLES
+    import tomllib
+    scene = tomllib.loads((EXAMPLES / "geared_fivebar.toml").read_text())
+    scene["loads"] = [{"link": "crank2", "torque": 8.0}]
+    scene["output"] = {"report": ["effort(crank1.angle)", "crank2.omega"]}
+    code, out, err = run_cli(capsys, "solve", write_scene(tmp_path, scene), "--json")
+    assert code == 0, err
+    # external mesh, r1/r2 = 1/2: crank2 turns back at half the rate; T w1 + 8 w2 = 0
+    assert np.allclose(out["values"]["effort(crank1.angle)"], 8.0 * 0.5, rtol=0, atol=1e-10)
+    scene["output"] = {"report": ["reaction(B, left).x"]}
+    code, _, err = run_cli(capsys, "solve", write_scene(tmp_path, scene), "--json")
+    assert code == 2 and "gears, racks or cams" in err

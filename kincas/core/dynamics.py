@@ -178,8 +178,11 @@ def _newton_euler(sym, t):
     if sym.ng > sym.nq:
         return ["joint reactions are not determined where joints are redundant"], None
     kinds = {i.kind for i in mech.inputs} - {"angle", "slide", "parameter"}
-    if kinds or any("/" in i.target for i in mech.inputs):
+    if kinds:
         return ["joint reactions are not available for this kind of input"], None
+    if any(getattr(mech, k, ()) for k in ("gears", "racks", "cams")):
+        return ["joint reactions are not available yet with gears, racks or cams "
+                "(efforts and shaking forces are)"], None
     unknowns = {}  # (kind, names...) -> symbol(s)
     forces = []  # (body, (x, y), (fx, fy)) and torques (body, None, tau)
     for p in list(mech.ground_points) + list(mech.moving_points):
@@ -204,9 +207,10 @@ def _newton_euler(sym, t):
         fx, fy = lam * n[0] + F * d[0], lam * n[1] + F * d[1]
         forces += [(bodies_at(mech, sl.point)[0], xy, (fx, fy)), (sl.along, xy, (-fx, -fy))]
     for i in mech.inputs:
-        if i.kind == "angle":
+        if i.kind == "angle":  # a motor on the ground, or on body B for a relative angle A/B
             T = unknowns[("input", i.target)] = ca.SX.sym(f"T_{i.target}")
-            forces.append((i.target, None, T))
+            a, _, b = i.target.partition("/")
+            forces += [(a, None, T)] + ([(b, None, -T)] if b and b != GROUND else [])
     x = ca.vertcat(*unknowns.values()) if unknowns else ca.SX(0, 1)
     n_links = len(mech.links)
     if x.numel() != 3 * n_links:

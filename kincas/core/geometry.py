@@ -19,7 +19,8 @@ Each is null (NaN) where it is undefined: a point at rest has no path direction;
 stretch (no normal acceleration) has no finite centre of curvature; a translating link, or two
 links turning at the same rate, have no finite instant centre. "At rest" and "the same rate"
 are judged against the input rates: |v| <= 1e-9 times the speed scale
-V = sum_i |u'_i| (times the mechanism's size for an angle input), |w| <= 1e-9 V / size.
+V = sum_i |u'_i| (times a size, the largest coordinate of a declared point, for an angle
+input), |w| <= 1e-9 V / size.
 """
 from __future__ import annotations
 
@@ -60,10 +61,19 @@ class Time:
     def speed_scale(self):
         """sum |u'| (times the size for angle inputs): what "at rest" is measured against."""
         sym = self.sym
-        size = sym.mech.size()
+        size = self.size
         ud = self.zd[sym.nq:]
         terms = [ca.fabs(ud[k]) * (size if i.kind == "angle" else 1.0) for k, i in enumerate(sym.mech.inputs)]
         return sum(terms, ca.SX(0))
+
+    @property
+    def size(self):
+        """A length scale of the mechanism, symbolic in its parameters (the structure's model
+        is shared by every parameter value): the largest coordinate of a declared point."""
+        sym = self.sym
+        xy = [sym.val(v) for _, pt in sym.mech.ground for v in pt]
+        xy += [sym.val(v) for lk in sym.mech.links for _, pt in lk.points for v in pt]
+        return ca.fmax(ca.mmax(ca.fabs(ca.vertcat(*xy))), 1e-300)
 
 
 # --- names ---
@@ -136,5 +146,5 @@ def _instant_centre(sym, a, b, attr, t):
     cx = (vax + wa * oay) - (vbx + wb * oby)
     cy = (vay - wa * oax) - (vby - wb * obx)
     dw = wa - wb
-    turning = ca.fabs(dw) > NULL_REL * t.speed_scale / sym.mech.size()
+    turning = ca.fabs(dw) > NULL_REL * t.speed_scale / t.size
     return _null_unless(turning, -cy / dw if attr == "icx" else cx / dw)

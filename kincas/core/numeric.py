@@ -42,8 +42,9 @@ from .tolerances import ACCEPT, MAX_ITER, MAX_STEP, TOL  # noqa: F401  (their ol
 
 
 def _structure_key(m: Mechanism):
+    # loads and gravity enter the force quantities' expressions, so they are structure too
     return (tuple(k for k, _ in m.parameters), m.ground, m.links, m.slides, m.inputs,
-            m.gears, m.racks, m.cams)
+            m.gears, m.racks, m.cams, m.gravity, m.loads)
 
 
 _CACHE: dict = {}

@@ -11,6 +11,7 @@ Names:
   * a parameter: its value (the same at every sample, unless an input drives it);
   * a data array given beside the expression: one value per sample;
   * `pi`.
+  * a force quantity written as a call: `effort(crank.angle)`, `reaction(B, rod).x`;
 Functions, element by element: sin cos tan asin acos atan atan2 sqrt exp log abs hypot (the
 trigonometric ones take and give angles in the caller's unit). Over the samples:
   * `sum(E)`, `mean(E)`: over the sample inputs;
@@ -36,6 +37,7 @@ from ..errors import ModelError
 UNARY = {"sin", "cos", "tan", "asin", "acos", "atan", "sqrt", "exp", "log", "abs"}
 BINARY = {"atan2", "hypot"}
 AGGREGATE = {"sum", "mean", "max", "min"}
+FORCES = {"effort", "reaction"}  # quantity names written as calls (kincas/core/dynamics.py)
 CONST, SAMPLE, TOTAL = "constant", "per sample", "total"
 
 
@@ -88,8 +90,14 @@ def _walk(node, out: Expr, data: set, inside: bool):
         _walk(node.left, out, data, inside), _walk(node.right, out, data, inside)
     elif isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
         _walk(node.operand, out, data, inside)
+    elif isinstance(node, ast.Call) and quantity_name(node) is not None:  # effort(KEY)
+        name = quantity_name(node)
+        out.quantities.append(name) if name not in out.quantities else None
     elif isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and not node.keywords:
         f, n = node.func.id, len(node.args)
+        if f in FORCES:
+            raise ModelError(f"{where}: {ast.unparse(node)!r}: write effort(KEY) with an input's "
+                             f"key, or reaction(P, LINK).x / reaction(SLIDE).y")
         if f in AGGREGATE:
             if n != 1:
                 raise ModelError(f"{where}: {f}() takes one expression")
@@ -117,9 +125,20 @@ def _walk(node, out: Expr, data: set, inside: bool):
 
 
 def quantity_name(node) -> str | None:
-    """'P.x' for the tree of `P.x`; None for anything else."""
+    """'P.x' for the tree of `P.x`, 'effort(crank.angle)' for `effort(crank.angle)`,
+    'reaction(B, rod).x' for `reaction(B, rod).x`; None for anything else."""
     if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
         return f"{node.value.id}.{node.attr}"
+    call = node.value if isinstance(node, ast.Attribute) else node
+    if not (isinstance(call, ast.Call) and isinstance(call.func, ast.Name) and not call.keywords):
+        return None
+    f, args = call.func.id, call.args
+    if f == "effort" and isinstance(node, ast.Call) and len(args) == 1:
+        inner = args[0].id if isinstance(args[0], ast.Name) else quantity_name(args[0])
+        return None if inner is None else f"effort({inner})"
+    if f == "reaction" and isinstance(node, ast.Attribute) and 1 <= len(args) <= 2 \
+            and all(isinstance(a, ast.Name) for a in args):
+        return f"reaction({', '.join(a.id for a in args)}).{node.attr}"
     return None
 
 
@@ -171,6 +190,8 @@ class Evaluator:
             if isinstance(node.op, ast.Div):
                 return k, a / b
             return k, a ** b
+        if quantity_name(node) is not None:
+            return self.leaf("quantity", quantity_name(node))
         f = node.func.id
         if f in AGGREGATE:
             k, v = self.eval(node.args[0], e)
