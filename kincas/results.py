@@ -141,6 +141,19 @@ class Sweep:
         out.append(f"  reported: {_names(self.values, 8) or 'nothing'}")
         return out
 
+    # --- in the data tools (extra kincas[data]) ---
+    def to_pandas(self, length: str = ""):
+        """A DataFrame: one row per pose, the inputs as index, a column per quantity, then
+        `status` and `flag`; units (radians, and `length` if named) in `df.attrs["units"]`."""
+        from .frames import sweep_to_pandas
+        return sweep_to_pandas(self, length)
+
+    def to_xarray(self, length: str = ""):
+        """A Dataset along the dimension `pose`: inputs as coordinates, each quantity a variable
+        with `attrs["units"]`, and `status`, `flag`, `ok`, `residual`."""
+        from .frames import sweep_to_xarray
+        return sweep_to_xarray(self, length)
+
     @property
     def ok(self) -> np.ndarray:
         """Boolean mask of the solved poses (the same as `status == "ok"`)."""

@@ -9,7 +9,7 @@ import pytest
 import closed_forms as cf
 from conftest import EXAMPLES, run_cli, write_scene
 
-FAIRBAIRN = (EXAMPLES / "fairbairn.toml").read_text(encoding="utf-8")
+FAIRBAIRN = (EXAMPLES / "fairbairn.toml").read_text(encoding="utf-8").split("\n[tolerance]")[0]
 
 
 def one_line_exit_2(code, err, *words):
@@ -157,3 +157,9 @@ def test_a_negated_parameter_is_minus_its_value(capsys, tmp_path):
     assert code == 0, err
     for k, v in plain["values"].items():
         assert negated["values"][k] == pytest.approx(v, rel=1e-12, abs=1e-12)
+
+
+def test_the_fairbairn_example_has_a_tolerance_section(capsys):
+    code, doc, err = run_cli(capsys, "tolerance", EXAMPLES / "fairbairn.toml", "--samples", "200", "--json")
+    assert code == 0, err
+    assert set(doc["std"]) == {"a1", "a3", "a62"} and doc["agrees"]

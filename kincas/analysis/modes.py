@@ -112,7 +112,8 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
     found = [sol.q for sol in (model.newton(q, u, p, L) for q in Q) if sol.ok]  # polish
     first = model.assemble(u, p, guess, L)  # the assembly a sweep from the guess starts on
     picked = first.q if first.ok else None
-    return _distinct(m, model, found + ([picked] if picked is not None else []), u, p, L, picked)
+    from ..frames import Modes  # a list, with to_pandas() and to_xarray()
+    return Modes(_distinct(m, model, found + ([picked] if picked is not None else []), u, p, L, picked))
 
 
 def _input_vector(m: Mechanism, inputs) -> np.ndarray:

@@ -83,6 +83,16 @@ class ToleranceResult:
         """Relative sampling error of a Monte-Carlo standard deviation, 1 / sqrt(2 (n - 1))."""
         return 1.0 / math.sqrt(2.0 * max(self.samples - 1, 1))
 
+    def to_pandas(self, length: str = ""):
+        """A DataFrame per pose: each output's nominal value, `std Q` and `mc Q`, status, failed."""
+        from ..frames import tolerance_to_pandas
+        return tolerance_to_pandas(self, length)
+
+    def to_xarray(self, length: str = ""):
+        """A Dataset (pose x quantity): nominal, first_order, monte_carlo; status, failed."""
+        from ..frames import tolerance_to_xarray
+        return tolerance_to_xarray(self, length)
+
     def agrees(self, k: float = 4.0) -> bool:
         """Whether, at every solved pose, |Monte Carlo - first order| is within k sampling
         errors of the output's largest first-order std over the sweep. (Relative to each

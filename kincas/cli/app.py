@@ -30,6 +30,7 @@ COMMANDS = {
     "optimize": ("kincas.cli.optimize", "optimise parameters as the scene's [optimize] section says"),
     "tolerance": ("kincas.cli.tolerance", "first-order and Monte-Carlo spread of outputs from parameter tolerances"),
     "study": ("kincas.cli.study", "many designs at once: the scene's [study] section, one row per design"),
+    "cam": ("kincas.cli.cam", "design a disc cam from the scene's [cam_design] section (profile, pressure angle, curvature)"),
 }
 
 

@@ -230,7 +230,8 @@ def _fail(message: str):
 
 # flag -> (attribute of the parsed arguments, what writes it: "matplotlib", "animation" or None)
 FILE_FLAGS = {"--csv": ("csv", None), "--plot": ("plot", "matplotlib"),
-              "--animate": ("animate", "animation"), "--plot-quantities": ("plot_quantities", "matplotlib")}
+              "--animate": ("animate", "animation"), "--plot-quantities": ("plot_quantities", "matplotlib"),
+              "--html": ("html", "html"), "--svg": ("svg", "svg"), "--dxf": ("dxf", "dxf")}
 
 
 def check_outputs(args, mechanism=None, poses: int | None = None) -> None:
@@ -242,11 +243,16 @@ def check_outputs(args, mechanism=None, poses: int | None = None) -> None:
         path = getattr(args, attr, None)
         if not path:
             continue
-        if writer:
+        if writer in ("matplotlib", "animation"):
             try:
                 require_matplotlib(flag)
             except ModuleNotFoundError as e:
                 _fail(str(e))
+        if writer == "dxf":
+            try:
+                import ezdxf  # noqa: F401
+            except ModuleNotFoundError:
+                _fail('--dxf needs ezdxf: pip install "kincas[cad]"')
         check_path(flag, path, _formats(writer))
     pose = getattr(args, "pose", None)
     if poses is not None and pose is not None and not -poses <= pose < poses:
@@ -282,6 +288,8 @@ def _formats(writer) -> set[str] | None:
     if writer == "matplotlib":
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         return set(FigureCanvasAgg.get_supported_filetypes())
+    if writer in ("html", "svg", "dxf"):
+        return {"html": {"html", "htm"}, "svg": {"svg"}, "dxf": {"dxf"}}[writer]
     if writer == "animation":
         from matplotlib.animation import writers
         out = {"gif", "webp", "apng"}  # Pillow, which the plot extra installs
@@ -308,7 +316,10 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
     jobs = [("csv", lambda p: write_csv(p, sweep, scene)),
             ("plot", lambda p: _save_drawing(p, m, sweep, pose, paths, captions, length)),
             ("animate", lambda p: _animate(p, m, sweep, paths, captions, length)),
-            ("plot_quantities", lambda p: plot_quantities(sweep, scene=scene).savefig(p, dpi=100))]
+            ("plot_quantities", lambda p: plot_quantities(sweep, scene=scene).savefig(p, dpi=100)),
+            ("html", lambda p: _html(p, m, sweep, scene, paths)),
+            ("svg", lambda p: _svg(p, m, sweep, scene, pose, paths)),
+            ("dxf", lambda p: _dxf(p, m, sweep, scene, pose, paths))]
     for attr, job in jobs:
         path = getattr(args, attr, None)
         if path:
@@ -318,6 +329,29 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
                 _fail(f"cannot write {path}: {e.strerror or e}")
             except ValueError as e:  # a file type matplotlib or Pillow cannot write
                 _fail(f"cannot write {path}: {str(e).splitlines()[0] if str(e) else type(e).__name__}")
+
+
+DENSE = 4  # solved poses between two of the sweep's, for the paths of vector pictures
+
+
+def _dense(sweep) -> int:
+    return DENSE if len(sweep) <= 2000 else 0
+
+
+def _html(path, m, sweep, scene, paths):
+    from .html import write_html
+    write_html(path, m, sweep, scene, paths, dense=_dense(sweep))
+
+
+def _svg(path, m, sweep, scene, pose, paths):
+    from .svg import write_svg
+    write_svg(path, m, sweep, pose, paths=paths, scene=scene, dense=_dense(sweep))
+
+
+def _dxf(path, m, sweep, scene, pose, paths):
+    from .dxf import write_dxf
+    write_dxf(path, m, sweep, pose, paths=paths, dense=_dense(sweep),
+              units=scene.study.units.get("length", "") if scene is not None else "")
 
 
 def _caption(scene, sweep, inputs, i) -> str:

@@ -23,6 +23,9 @@ def cli_arguments(parser) -> None:
     parser.add_argument("--plot", metavar="OUT.png", help="draw the mechanism with the paths of its points")
     parser.add_argument("--animate", metavar="OUT.gif", help="animate the sweep")
     parser.add_argument("--plot-quantities", metavar="OUT.png", help="plot the reported quantities against the input")
+    parser.add_argument("--html", metavar="OUT.html", help="one self-contained page: the mechanism animated, a slider, the quantities plotted")
+    parser.add_argument("--svg", metavar="OUT.svg", help="the drawing and the paths as vector graphics")
+    parser.add_argument("--dxf", metavar="OUT.dxf", help="links, pivots, slides and paths as DXF entities, a layer per body (kincas[cad])")
     parser.add_argument("--paths", metavar="P,Q", help="points whose paths --plot and --animate draw (default: every moving point)")
     parser.add_argument("--pose", type=int, metavar="I", help="the pose --plot draws, by index (default: the first solved; -1: the last)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar, even on a terminal")
@@ -31,7 +34,8 @@ def cli_arguments(parser) -> None:
 def cli_run(args) -> int:
     """Solve the scene and print (or write) the results."""
     sc = load(args.scene)
-    wants_files = args.csv or args.plot or args.animate or args.plot_quantities
+    wants_files = (args.csv or args.plot or args.animate or args.plot_quantities or args.html
+                   or args.svg or args.dxf)
     if wants_files or args.pose is not None:  # wrong options fail before a long solve
         from .outputs import check_outputs
         check_outputs(args, sc.mechanism, len(next(iter(sc.study.inputs.values()))))

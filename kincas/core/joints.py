@@ -35,7 +35,7 @@ import numpy as np
 from ..errors import ModelError
 from ..model import spline
 from ..model.joints import Circle, split_relative
-from ..model.mechanism import GROUND
+from ..model.mechanism import GROUND, as_param
 from ..model.names import ANGULAR_ATTRS  # noqa: F401  (cam quantities: angles, kept here too)
 
 _PRESSURE_FLOOR = 1e-9  # a follower slower than this times the inputs' speed scale stands
@@ -116,8 +116,18 @@ def polar_radius(sym, prof, phi):
     coefficients are linear maps of the (possibly symbolic) radii; the interval is picked by
     piecewise constants, whose derivative is zero, so the derivatives are exact."""
     a = np.asarray(prof.angles, float)
-    radii = ca.vertcat(*[sym.val(v) for v in prof.radii])
-    A, B, C, D = (ca.mtimes(ca.DM(Mx), radii) for Mx in spline.coefficient_maps(a))
+    # numbers stay numbers: only the radii given as parameters enter symbolically, through
+    # the columns of the coefficient maps that multiply them (sizes O(n) per parameter)
+    plain = np.array([0.0 if as_param(v) else float(v) for v in prof.radii])
+    named = [k for k, v in enumerate(prof.radii) if as_param(v)]
+    coef = [ca.DM(c) for c in spline.coefficients(a, plain)]
+    if named:
+        unit = np.zeros((len(a), len(named)))
+        unit[named, range(len(named))] = 1.0
+        maps = spline.coefficients(a, unit)
+        radii = ca.vertcat(*[sym.val(prof.radii[k]) for k in named])
+        coef = [c + ca.mtimes(ca.DM(Mx), radii) for c, Mx in zip(coef, maps)]
+    A, B, C, D = coef
     t = phi - a[0]
     t = t - spline.TURN * ca.floor(t / spline.TURN)  # in [0, 2 pi) from the first angle
     knots = a - a[0]

@@ -29,34 +29,67 @@ def intervals(angles) -> np.ndarray:
     return np.diff(np.append(a, a[0] + TURN))
 
 
+def _cyclic_solve(h: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """Solve the cyclic tridiagonal system of the periodic spline's second derivatives,
+    h_{i-1} x_{i-1} + 2 (h_{i-1} + h_i) x_i + h_i x_{i+1} = rhs_i (indices modulo n), for
+    every column of rhs, in O(n) per column (Thomas's algorithm with the Sherman-Morrison
+    correction for the two corner entries)."""
+    n = len(h)
+    lower, diag, upper = np.roll(h, 1), 2 * (np.roll(h, 1) + h), h.copy()  # row i: h_{i-1}, ..., h_i
+    if n == 3:  # too small for the correction's splitting: solve it directly
+        K = np.diag(diag)
+        for i in range(n):
+            K[i, (i - 1) % n] += lower[i]
+            K[i, (i + 1) % n] += upper[i]
+        return np.linalg.solve(K, rhs)
+    gamma = -diag[0]
+    d = diag.copy()
+    d[0] -= gamma
+    d[-1] -= upper[-1] * lower[0] / gamma
+    u = np.zeros(n)
+    u[0], u[-1] = gamma, upper[-1]  # K = T + u v', v = (1, 0, ..., 0, lower_0 / gamma)
+
+    def thomas(b):
+        b = np.array(b, float)
+        c, dd = np.zeros(n), d.copy()
+        c[0] = upper[0] / dd[0]
+        b[0] = b[0] / dd[0]
+        for i in range(1, n):
+            m = dd[i] - lower[i] * c[i - 1]
+            c[i] = upper[i] / m if i < n - 1 else 0.0
+            b[i] = (b[i] - lower[i] * b[i - 1]) / m
+        for i in range(n - 2, -1, -1):
+            b[i] -= c[i] * b[i + 1]
+        return b
+    y, z = thomas(rhs), thomas(u)
+    fact = (y[0] + lower[0] * y[-1] / gamma) / (1 + z[0] + lower[0] * z[-1] / gamma)
+    return y - np.multiply.outer(z, fact) if y.ndim > 1 else y - fact * z
+
+
+def coefficients(angles, radii) -> tuple[np.ndarray, ...]:
+    """(a, b, c, d) on each interval for the data `radii` (a vector, or a matrix whose
+    columns are several data sets): see `coefficient_maps`."""
+    h = intervals(angles)
+    r = np.asarray(radii, float)
+    hh = h if r.ndim == 1 else h[:, None]
+    S = (np.roll(r, -1, axis=0) - r) / hh  # chord slopes
+    M = _cyclic_solve(h, 6 * (S - np.roll(S, 1, axis=0)))
+    Mn = np.roll(M, -1, axis=0)
+    return r, S - hh * (2 * M + Mn) / 6, M / 2, (Mn - M) / (6 * hh)
+
+
 def coefficient_maps(angles) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(A, B, C, D): the spline's polynomial coefficients on each interval as linear maps of
     the data. The second derivatives M solve the cyclic tridiagonal system
     h_{i-1} M_{i-1} + 2 (h_{i-1} + h_i) M_i + h_i M_{i+1} = 6 (s_i - s_{i-1}),
     with s_i = (r_{i+1} - r_i) / h_i the slopes of the chords (indices modulo n)."""
-    h = intervals(angles)
-    n = len(h)
-    eye = np.eye(n)
-    nxt = np.roll(eye, -1, axis=0)  # row i picks r_{i+1}
-    S = (nxt - eye) / h[:, None]  # chord slopes as maps of r
-    K = np.zeros((n, n))
-    for i in range(n):
-        K[i, (i - 1) % n] += h[i - 1]
-        K[i, i] += 2 * (h[i - 1] + h[i])
-        K[i, (i + 1) % n] += h[i]
-    M = np.linalg.solve(K, 6 * (S - np.roll(S, 1, axis=0)))
-    Mn = np.roll(M, -1, axis=0)
-    A = eye
-    B = S - h[:, None] * (2 * M + Mn) / 6
-    C = M / 2
-    D = (Mn - M) / (6 * h[:, None])
-    return A, B, C, D
+    return coefficients(angles, np.eye(len(angles)))
 
 
 def evaluate(angles, radii, phi, order: int = 2) -> np.ndarray:
     """r and its first `order` derivatives in phi at the angles `phi` (rows: r, r', r'')."""
     a = np.asarray(angles, float)
-    A, B, C, D = (Mx @ np.asarray(radii, float) for Mx in coefficient_maps(a))
+    A, B, C, D = coefficients(a, radii)
     t = np.mod(np.asarray(phi, float) - a[0], TURN)
     i = np.clip(np.searchsorted(a - a[0], t, side="right") - 1, 0, len(a) - 1)
     t = t - (a[i] - a[0])

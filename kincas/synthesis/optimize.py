@@ -91,6 +91,17 @@ class OptimizeResult:
     sweep: Sweep | None = None
     info: dict = field(default_factory=dict)
 
+    def to_pandas(self, length: str = ""):
+        """A DataFrame per sample (inputs as index, the expressions' quantities as columns),
+        the parameters, objective and status in `df.attrs`."""
+        from ..frames import optimize_to_pandas
+        return optimize_to_pandas(self, length)
+
+    def to_xarray(self, length: str = ""):
+        """A Dataset along `sample`; parameters, objective and status as attributes."""
+        from ..frames import optimize_to_xarray
+        return optimize_to_xarray(self, length)
+
     # --- scipy.optimize.OptimizeResult's familiar names ---
     @property
     def x(self) -> np.ndarray:

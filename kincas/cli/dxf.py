@@ -1,0 +1,92 @@
+"""`--dxf out.dxf`: the mechanism at one pose and the paths over the sweep as DXF entities
+(through ezdxf, the optional extra `kincas[cad]`), in the mechanism's own coordinates.
+
+One layer per body (named as the link), `ground` for the pivots and ground guides, `slides`
+for the blocks, `paths` for the paths. A bar is a LINE, a body of three or more points a
+closed LWPOLYLINE, each point a CIRCLE, each path an LWPOLYLINE per run of solved poses,
+each guide a LINE, each block a closed LWPOLYLINE.
+
+>>> import os, tempfile, numpy as np, kincas, ezdxf
+>>> m = kincas.Mechanism(ground={"O": (0, 0)},
+...     links=[kincas.Link.bar("crank", "O", "A", 1), kincas.Link.bar("rod", "A", "B", 3)],
+...     slides=[kincas.Slide("B", "ground", name="slider")],
+...     inputs=[kincas.Input.angle("crank")], guess={"B": (3.5, 0)})
+>>> sw = kincas.sweep(m, {"crank.angle": np.linspace(0, 2 * np.pi, 9)})
+>>> with tempfile.TemporaryDirectory() as d:
+...     write_dxf(os.path.join(d, "m.dxf"), m, sw, pose=0)
+...     doc = ezdxf.readfile(os.path.join(d, "m.dxf"))
+>>> [tuple(round(c, 9) for c in e.dxf.end)[:2] for e in doc.modelspace().query('LINE[layer=="crank"]')]
+[(1.0, 0.0)]
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.mechanism import Mechanism
+from ..results import Sweep
+from .picture import picture
+from .svg import _runs
+
+_UNITS = {"mm": 4, "cm": 5, "m": 6, "in": 1, "ft": 2, "um": 13, "km": 7}  # DXF $INSUNITS codes
+
+
+def _require():
+    try:
+        import ezdxf
+    except ModuleNotFoundError:
+        raise ModuleNotFoundError('--dxf needs ezdxf: pip install "kincas[cad]"', name="ezdxf") from None
+    return ezdxf
+
+
+def dxf_document(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None,
+                 dense: int = 0, units: str = ""):
+    """An ezdxf document of the drawing at `pose` (default: the first solved) with the paths."""
+    ezdxf = _require()
+    from ezdxf import colors
+    pic = picture(m, sweep, paths, dense)
+    i = pic.first if pose is None else int(pose) % max(len(sweep), 1)
+    xy = pic.xy[i]
+    doc = ezdxf.new("R2010")
+    if units in _UNITS:
+        doc.units = _UNITS[units]
+    msp = doc.modelspace()
+    rgb = lambda hexc: colors.rgb2int(tuple(int(hexc[k:k + 2], 16) for k in (1, 3, 5)))
+    for name in ("ground", "slides", "paths"):
+        doc.layers.add(name)
+    for b in pic.bodies:
+        if b.name not in doc.layers:
+            doc.layers.add(b.name).rgb = tuple(int(b.colour[k:k + 2], 16) for k in (1, 3, 5))
+        pts = xy[b.ring]
+        if not np.isfinite(pts).all():
+            continue
+        at = {"layer": b.name, "true_color": rgb(b.colour)}
+        if len(b.ring) >= 3:
+            msp.add_lwpolyline([tuple(p) for p in pts], close=True, dxfattribs=at)
+        else:
+            msp.add_line(tuple(pts[0]), tuple(pts[1]), dxfattribs=at)
+        for k in b.ring:
+            if np.isfinite(xy[k]).all():
+                msp.add_circle(tuple(xy[k]), 0.7 * pic.r, dxfattribs={"layer": b.name})
+    for k in pic.ground:
+        msp.add_circle(tuple(xy[k]), 0.7 * pic.r, dxfattribs={"layer": "ground"})
+    for g in pic.guides:
+        t, d = g.through[i], g.direction[i]
+        if not (np.isfinite(t).all() and np.isfinite(d).all()):
+            continue
+        msp.add_line(tuple(t + g.lo * d), tuple(t + g.hi * d),
+                     dxfattribs={"layer": "ground" if g.ground else "slides"})
+        p = xy[g.point]
+        if np.isfinite(p).all():
+            n, r = np.array([-d[1], d[0]]), pic.r
+            c = [p - 2 * r * d - 1.4 * r * n, p + 2 * r * d - 1.4 * r * n, p + 2 * r * d + 1.4 * r * n,
+                 p - 2 * r * d + 1.4 * r * n]
+            msp.add_lwpolyline([tuple(q) for q in c], close=True, dxfattribs={"layer": "slides"})
+    for name, a in pic.paths.items():
+        for run in _runs(a):
+            msp.add_lwpolyline([tuple(q) for q in run], dxfattribs={"layer": "paths"})
+    return doc
+
+
+def write_dxf(path, m: Mechanism, sweep: Sweep, pose: int | None = None, **kw) -> None:
+    """Write `dxf_document(m, sweep, pose, **kw)` to `path`."""
+    dxf_document(m, sweep, pose, **kw).saveas(str(path))

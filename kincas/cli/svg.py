@@ -1,0 +1,131 @@
+"""`--svg out.svg`: the drawing at one pose and the paths over the sweep as vector graphics.
+
+Coordinates in the file are the mechanism's own (a group flips the y axis), so a CAD or
+vector program measures true lengths: each bar is a `<line data-link=NAME>`, each body of
+three or more points a `<polygon data-link=NAME>`, each point a `<circle data-point=NAME>`,
+each path one or more `<polyline data-path=NAME>` (broken where poses were not solved), each
+slide's guide a `<line data-slide=NAME>` and its block a `<polygon data-block=NAME>`.
+
+>>> import io, numpy as np, kincas, xml.etree.ElementTree as ET
+>>> m = kincas.Mechanism(ground={"O": (0, 0)},
+...     links=[kincas.Link.bar("crank", "O", "A", 1), kincas.Link.bar("rod", "A", "B", 3)],
+...     slides=[kincas.Slide("B", "ground", name="slider")],
+...     inputs=[kincas.Input.angle("crank")], guess={"B": (3.5, 0)})
+>>> sw = kincas.sweep(m, {"crank.angle": np.linspace(0, 2 * np.pi, 9)})
+>>> root = ET.fromstring(svg_text(m, sw, pose=2))          # crank at 90 deg: A = (0, 1)
+>>> a = [c for c in root.iter("{http://www.w3.org/2000/svg}circle") if c.get("data-point") == "A"][0]
+>>> round(float(a.get("cx")), 9), round(float(a.get("cy")), 9)
+(0.0, 1.0)
+"""
+from __future__ import annotations
+
+from xml.sax.saxutils import escape, quoteattr
+
+import numpy as np
+
+from ..model.mechanism import Mechanism
+from ..results import Sweep
+from .picture import INK, picture
+
+
+def _f(v: float) -> str:
+    return f"{float(v):.10g}"
+
+
+def _pts(a: np.ndarray) -> str:
+    return " ".join(f"{_f(x)},{_f(y)}" for x, y in a)
+
+
+def _runs(a: np.ndarray):
+    """The runs of finite rows of an (M x 2) array, each with at least two rows."""
+    good = np.isfinite(a).all(axis=1)
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], good.astype(int), [0]])))
+    for lo, hi in zip(edges[::2], edges[1::2]):
+        if hi - lo >= 2:
+            yield a[lo:hi]
+
+
+def svg_text(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None, scene=None,
+             dense: int = 0, width: float = 800) -> str:
+    """The SVG document: the drawing at `pose` (default: the first solved) and the paths."""
+    pic = picture(m, sweep, paths, dense)
+    i = pic.first if pose is None else int(pose) % max(len(sweep), 1)
+    xy = pic.xy[i]
+    (x0, y0), (x1, y1) = pic.box()
+    w, h = x1 - x0, y1 - y0
+    height = width * h / w if w > 0 else width
+    r, sw_ = pic.r, pic.r * 0.35  # point radius, bar width's unit
+    units = scene.study.units.get("length", "") if scene is not None else ""
+    title = getattr(getattr(scene, "study", None), "title", "") or "kincas"
+    out = ['<?xml version="1.0" encoding="UTF-8"?>',
+           f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(width)}" height="{_f(height)}" '
+           f'viewBox="{_f(x0)} {_f(-y1)} {_f(w)} {_f(h)}" data-units={quoteattr(units)}>',
+           f"<title>{escape(title)}</title>",
+           '<rect x="%s" y="%s" width="%s" height="%s" fill="white"/>' % (_f(x0), _f(-y1), _f(w), _f(h)),
+           '<g transform="scale(1,-1)" stroke-linecap="round" stroke-linejoin="round">']
+    owner = {}
+    for b in pic.bodies:
+        for k in b.ring:
+            owner.setdefault(pic.names[k], b.colour)
+    out.append('<g id="paths" fill="none">')
+    for p, a in pic.paths.items():
+        for run in _runs(a):
+            out.append(f'<polyline data-path={quoteattr(p)} points="{_pts(run)}" stroke="{owner.get(p, INK)}" '
+                       f'stroke-width="{_f(0.4 * sw_)}" stroke-dasharray="{_f(2 * r)} {_f(1.5 * r)}"/>')
+    out.append("</g>")
+    out.append('<g id="ground">')
+    for k in pic.ground:
+        x, y = xy[k]
+        g = 2.5 * r
+        out.append(f'<polygon data-ground={quoteattr(pic.names[k])} points="{_pts([(x, y), (x - 0.7 * g, y - g), (x + 0.7 * g, y - g)])}" '
+                   f'fill="#dddddd" stroke="{INK}" stroke-width="{_f(0.3 * sw_)}"/>')
+    out.append("</g>")
+    out.append('<g id="slides">')
+    for gd in pic.guides:
+        t, d = gd.through[i], gd.direction[i]
+        if not (np.isfinite(t).all() and np.isfinite(d).all()):
+            continue
+        a, b = t + gd.lo * d, t + gd.hi * d
+        out.append(f'<line data-slide={quoteattr(gd.name)} x1="{_f(a[0])}" y1="{_f(a[1])}" x2="{_f(b[0])}" '
+                   f'y2="{_f(b[1])}" stroke="{gd.colour}" stroke-width="{_f(0.4 * sw_)}"/>')
+        p = xy[gd.point]
+        if np.isfinite(p).all():
+            n = np.array([-d[1], d[0]])
+            c = [p - 2 * r * d - 1.4 * r * n, p + 2 * r * d - 1.4 * r * n, p + 2 * r * d + 1.4 * r * n,
+                 p - 2 * r * d + 1.4 * r * n]
+            out.append(f'<polygon data-block={quoteattr(gd.name)} points="{_pts(c)}" fill="#f2f2f2" '
+                       f'stroke="{INK}" stroke-width="{_f(0.3 * sw_)}"/>')
+    out.append("</g>")
+    out.append('<g id="bodies">')
+    for b in sorted(pic.bodies, key=lambda b: b.driven):
+        pts = xy[b.ring]
+        if not np.isfinite(pts).all():
+            continue
+        if len(b.ring) >= 3:
+            out.append(f'<polygon data-link={quoteattr(b.name)} points="{_pts(pts)}" fill="{b.colour}" '
+                       f'fill-opacity="0.45" stroke="{b.colour}" stroke-width="{_f(0.6 * sw_)}"/>')
+        else:
+            (ax, ay), (bx, by) = pts
+            out.append(f'<line data-link={quoteattr(b.name)} x1="{_f(ax)}" y1="{_f(ay)}" x2="{_f(bx)}" '
+                       f'y2="{_f(by)}" stroke="{b.colour}" stroke-width="{_f(1.6 * sw_)}"/>')
+    out.append("</g>")
+    out.append('<g id="points">')
+    for k, name in enumerate(pic.names):
+        x, y = xy[k]
+        if np.isfinite([x, y]).all():
+            out.append(f'<circle data-point={quoteattr(name)} cx="{_f(x)}" cy="{_f(y)}" r="{_f(0.7 * r)}" '
+                       f'fill="white" stroke="{INK}" stroke-width="{_f(0.3 * sw_)}"/>')
+    out.append("</g></g>")
+    out.append(f'<g id="labels" font-family="sans-serif" font-size="{_f(2.2 * r)}" fill="{INK}">')
+    for k, name in enumerate(pic.names):  # outside the flip, so the text reads upright
+        x, y = xy[k]
+        if np.isfinite([x, y]).all():
+            out.append(f'<text x="{_f(x + 1.2 * r)}" y="{_f(-y - 1.2 * r)}">{escape(name)}</text>')
+    out.append("</g></svg>")
+    return "\n".join(out) + "\n"
+
+
+def write_svg(path, m: Mechanism, sweep: Sweep, pose: int | None = None, **kw) -> None:
+    """Write `svg_text(m, sweep, pose, **kw)` to `path`."""
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(svg_text(m, sweep, pose, **kw))

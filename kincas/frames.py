@@ -1,0 +1,203 @@
+"""Results as pandas DataFrames and xarray Datasets (the optional extra `kincas[data]`).
+
+`Sweep.to_pandas()`: one row per pose, the inputs as the index (a MultiIndex when several
+inputs advance together), a column per reported quantity, then `status` and `flag`.
+`Sweep.to_xarray()`: a Dataset along the dimension `pose`, the inputs as coordinates, each
+quantity a variable with its unit in `attrs["units"]`. Tolerance analyses, assembly modes and
+optimisations convert the same way. Values are as the result holds them: angles in radians,
+lengths in the mechanism's own unit (name it with `length="mm"`).
+
+>>> import numpy as np, kincas
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+...            kincas.Link.bar("rocker", "D", "C", 3)],
+...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+>>> sw = kincas.sweep(m, {"crank.angle": np.linspace(0, np.pi, 3)}, report=["C.x", "rocker.omega"])
+>>> df = sw.to_pandas()
+>>> df.index.name, list(df.columns), df["status"].tolist()
+('crank.angle', ['C.x', 'rocker.omega', 'status', 'flag'], ['ok', 'ok', 'ok'])
+>>> sw.to_xarray(length="mm")["C.x"].attrs["units"]
+'mm'
+"""
+from __future__ import annotations
+
+import importlib
+
+import numpy as np
+
+_ORDER = {"x": 0, "y": 0, "s": 0, "angle": 0, "vx": 1, "vy": 1, "v": 1, "omega": 1,
+          "ax": 2, "ay": 2, "a": 2, "alpha": 2, "jx": 3, "jy": 3, "jerk": 3}
+
+
+def require(package: str):
+    """Import pandas or xarray, or say in one line how to get them."""
+    try:
+        return importlib.import_module(package)
+    except ModuleNotFoundError:
+        raise ModuleNotFoundError(f"this needs {package}, which is not installed: "
+                                  f'pip install "kincas[data]"', name=package) from None
+
+
+def unit_of(name: str, length: str = "", angle: str = "rad", time: str = "s") -> str:
+    """The unit of a quantity or input key as a result holds it ('' when it has none or is
+    not known here).
+
+    >>> unit_of("rocker.alpha"), unit_of("C.vx", "mm"), unit_of("d(C.x)/d(a)", "mm")
+    ('rad/s^2', 'mm/s', 'mm/mm')
+    """
+    if name.startswith("d(") and ")/d(" in name:
+        q = name[2:name.index(")/d(")]
+        uq = unit_of(q, length, angle, time)
+        return f"{uq or '1'}/{length}" if length else uq
+    attr = name.rsplit(".", 1)[-1] if "." in name else None
+    order = _ORDER.get(attr) if attr else None
+    if order is None:
+        return length if "." not in name else ""  # a parameter driven by an input: a length
+    base = angle if attr in ("angle", "omega", "alpha", "jerk") else length
+    if not base:
+        return ""
+    return base + ("" if order == 0 else f"/{time}" if order == 1 else f"/{time}^{order}")
+
+
+def _index(pd, inputs: dict, n: int):
+    keys = list(inputs)
+    if not keys:
+        return pd.RangeIndex(n, name="pose")
+    if len(keys) == 1:
+        return pd.Index(np.asarray(inputs[keys[0]], float), name=keys[0])
+    return pd.MultiIndex.from_arrays([np.asarray(inputs[k], float) for k in keys], names=keys)
+
+
+# --- sweeps ---
+
+
+def sweep_to_pandas(sw, length: str = ""):
+    pd = require("pandas")
+    cols = {k: np.asarray(v, float) for k, v in sw.values.items()}
+    cols["status"] = sw.status.astype(str)
+    cols["flag"] = pd.array([f if f else None for f in sw.flags], dtype="object")
+    df = pd.DataFrame(cols, index=_index(pd, sw.inputs, len(sw)))
+    df.attrs["units"] = {k: unit_of(k, length) for k in [*sw.inputs, *sw.values]}
+    return df
+
+
+def sweep_to_xarray(sw, length: str = ""):
+    xr = require("xarray")
+    coords = {k: ("pose", np.asarray(v, float), {"units": unit_of(k, length)})
+              for k, v in sw.inputs.items()}
+    data = {k: ("pose", np.asarray(v, float), {"units": unit_of(k, length)})
+            for k, v in sw.values.items() if k not in sw.inputs}
+    data["status"] = ("pose", sw.status.astype(str))
+    data["flag"] = ("pose", np.array([f or "" for f in sw.flags], dtype=str))
+    data["ok"] = ("pose", sw.ok)
+    data["residual"] = ("pose", np.asarray(sw.residual, float),
+                        {"description": "loop-closure residual relative to the size"})
+    return xr.Dataset(data, coords=coords, attrs={"size": float(sw.size)})
+
+
+# --- tolerance analyses ---
+
+
+def tolerance_to_pandas(r, length: str = ""):
+    pd = require("pandas")
+    cols = {}
+    for n in r.names:
+        cols[n] = np.asarray(r.nominal[n], float)
+        cols[f"std {n}"] = np.asarray(r.first_order[n], float)
+        cols[f"mc {n}"] = np.asarray(r.monte_carlo[n], float)
+    cols["status"] = np.asarray(r.status).astype(str)
+    cols["failed"] = np.asarray(r.failed, int)
+    df = pd.DataFrame(cols, index=_index(pd, r.inputs, len(r.status)))
+    df.attrs.update(samples=r.samples, seed=r.seed, std=dict(r.std),
+                    units={n: unit_of(n, length) for n in [*r.inputs, *r.names]})
+    return df
+
+
+def tolerance_to_xarray(r, length: str = ""):
+    xr = require("xarray")
+    stack = lambda d: np.stack([np.asarray(d[n], float) for n in r.names], axis=1)
+    coords = {k: ("pose", np.asarray(v, float), {"units": unit_of(k, length)}) for k, v in r.inputs.items()}
+    coords["quantity"] = ("quantity", list(r.names))
+    coords["units"] = ("quantity", [unit_of(n, length) for n in r.names])
+    data = {"nominal": (("pose", "quantity"), stack(r.nominal)),
+            "first_order": (("pose", "quantity"), stack(r.first_order),
+                            {"description": "first-order std from the exact sensitivities"}),
+            "monte_carlo": (("pose", "quantity"), stack(r.monte_carlo),
+                            {"description": "Monte-Carlo std"}),
+            "status": ("pose", np.asarray(r.status).astype(str)),
+            "failed": ("pose", np.asarray(r.failed, int))}
+    attrs = {"samples": int(r.samples), **{f"std {p}": float(s) for p, s in r.std.items()}}
+    if r.seed is not None:
+        attrs["seed"] = int(r.seed)
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+# --- assembly modes ---
+
+
+def _mode_columns(modes) -> dict:
+    cols: dict[str, list] = {}
+    for md in modes:
+        for p, (x, y) in md.points.items():
+            cols.setdefault(f"{p}.x", []).append(float(x))
+            cols.setdefault(f"{p}.y", []).append(float(y))
+        for lk, a in md.angles.items():
+            cols.setdefault(f"{lk}.angle", []).append(float(a))
+    cols["residual"] = [float(md.residual) for md in modes]
+    cols["orientation"] = [int(md.orientation) for md in modes]
+    cols["from_guess"] = [bool(md.from_guess) for md in modes]
+    return cols
+
+
+def modes_to_pandas(modes, length: str = ""):
+    pd = require("pandas")
+    df = pd.DataFrame(_mode_columns(modes), index=pd.RangeIndex(1, len(modes) + 1, name="mode"))
+    df.attrs["units"] = {c: unit_of(c, length) for c in df.columns if "." in c}
+    return df
+
+
+def modes_to_xarray(modes, length: str = ""):
+    xr = require("xarray")
+    data = {c: ("mode", np.asarray(v), {"units": unit_of(c, length)} if "." in c else {})
+            for c, v in _mode_columns(modes).items()}
+    return xr.Dataset(data, coords={"mode": np.arange(1, len(modes) + 1)})
+
+
+# --- optimisations ---
+
+
+def optimize_to_pandas(r, length: str = ""):
+    pd = require("pandas")
+    n = len(next(iter(r.samples.values()))) if r.samples else 0
+    df = pd.DataFrame({k: np.asarray(v, float) for k, v in r.values.items()},
+                      index=_index(pd, r.samples, n))
+    df.attrs.update(parameters=dict(r.parameters), varied=dict(r.varied), objective=r.objective,
+                    ok=r.ok, status=r.status, message=r.message,
+                    units={k: unit_of(k, length) for k in [*r.samples, *r.values]})
+    return df
+
+
+def optimize_to_xarray(r, length: str = ""):
+    xr = require("xarray")
+    coords = {k: ("sample", np.asarray(v, float), {"units": unit_of(k, length)}) for k, v in r.samples.items()}
+    data = {k: ("sample", np.asarray(v, float), {"units": unit_of(k, length)})
+            for k, v in r.values.items() if k not in r.samples}
+    attrs = {"objective": float(r.objective), "ok": int(r.ok), "status": r.status,
+             "message": r.message, "iterations": int(r.iterations),
+             **{f"parameter {p}": float(v) for p, v in r.parameters.items()},
+             "varied": ", ".join(r.varied)}
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+# --- a list of modes that converts like the other results ---
+
+
+class Modes(list):
+    """The assembly modes `find_modes` returns: a list of `Mode`, with `to_pandas()` (a row
+    per mode: points, angles, residual, orientation, from_guess) and `to_xarray()`."""
+
+    def to_pandas(self, length: str = ""):
+        return modes_to_pandas(self, length)
+
+    def to_xarray(self, length: str = ""):
+        return modes_to_xarray(self, length)
