@@ -52,12 +52,8 @@ def run(dims, method):
     return np.array([s["C.x"], s["C.y"], s["rocker.omega"]])
 
 
-# The compiled kernel's buffers are still shared between threads (core/fast.py, the `speed`
-# part of issue [8]): there threads can even corrupt memory, so those runs wait for its fix.
-FAST_SHARED = pytest.mark.skip(reason="core/fast.py shares its buffers between threads (speed's part of [8])")
-
-
-@pytest.mark.parametrize("method", ["careful", pytest.param("fast", marks=FAST_SHARED)])
+# (the fast path's own threads and processes, compiled: tests/test_fast_threads.py)
+@pytest.mark.parametrize("method", ["careful", "fast"])
 def test_four_threads_four_fourbars(method):
     alone = [run(d, method) for d in DIMS]
     for d, r in zip(DIMS, alone):
@@ -121,7 +117,6 @@ def _in_threads(fn, args):
     return out
 
 
-@FAST_SHARED  # find_modes and analyse start from a default (fast) sweep
 def test_modes_and_tolerance_from_threads():
     from kincas.analysis.modes import find_modes
     from kincas.analysis.tolerance import analyse
