@@ -384,3 +384,30 @@ def test_pictures_of_gears_racks_and_cams():
     # flat face: along the tappet's x axis (horizontal) through the contact point
     ax, sw = drawn("flat_tappet", 4, ["cam.contact.y"])
     np.testing.assert_allclose(_line(ax, "cam face")[:, 1], sw["cam.contact.y"][4], atol=1e-9)
+
+
+def test_vector_pictures_draw_the_joints():
+    """SVG: the planet's pitch circle (15) about C among the `data-joint` polylines; DXF: the
+    roller's circle on layer "joints"."""
+    import xml.etree.ElementTree as ET
+    from kincas.cli.scene import load
+    from kincas.cli.svg import svg_text
+    sc = load(EXAMPLES / "planetary.toml")
+    sw = kincas.sweep(sc.mechanism, sc.study.inputs, report=["C.x", "C.y"])
+    root = ET.fromstring(svg_text(sc.mechanism, sw, pose=4))
+    lines = [e for e in root.iter("{http://www.w3.org/2000/svg}polyline") if e.get("data-joint")]
+    c = np.array([sw["C.x"][4], sw["C.y"][4]])
+    found = False
+    for e in lines:
+        pts = np.array([[float(v) for v in p.split(",")] for p in e.get("points").split()])
+        found |= e.get("data-joint") == "planet_ring pitch circle" and np.allclose(np.hypot(*(pts - c).T), 15, atol=1e-8)
+    assert found
+    pytest.importorskip("ezdxf")
+    from kincas.cli.dxf import dxf_document
+    sc = load(EXAMPLES / "roller_cam.toml")
+    sw = kincas.sweep(sc.mechanism, sc.study.inputs, report=["F.x", "F.y"])
+    doc = dxf_document(sc.mechanism, sw, pose=2)
+    polys = doc.modelspace().query('LWPOLYLINE[layer=="joints"]')
+    f = np.array([sw["F.x"][2], sw["F.y"][2]])
+    assert any(np.allclose(np.hypot(*(np.array([p[:2] for p in e.get_points()]) - f).T), 10, atol=1e-8)
+               for e in polys)

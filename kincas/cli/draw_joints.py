@@ -126,86 +126,99 @@ def _world(frame, pts):
     return np.stack([x + c * pts[:, 0] - s * pts[:, 1], y + s * pts[:, 0] + c * pts[:, 1]], axis=1)
 
 
+def curves(m, geo, i: int, unit: float) -> list[tuple[str, str, np.ndarray]]:
+    """What the joints draw at pose i, format-free: (label, body whose colour it takes,
+    (K x 2) polyline) for each pitch circle and its turning radius, rack pitch line and its
+    ticks (NaN rows break a polyline), cam profile, contact point (one row), roller circle and
+    flat face. `geo` is `plot.geometry`'s, `unit` the drawing's unit of size."""
+    jg, out = geo.joints, []
+    if jg is None:
+        return out
+    t = np.linspace(0, 2 * np.pi, 121)
+    circ = np.stack([np.cos(t), np.sin(t)], axis=1)
+
+    def pitch(label, body, r):
+        x, y, th = jg.frames[body][i]
+        out.append((label, body, np.array([x, y]) + r * circ))
+        out.append((label + " mark", body, np.array([[x, y], [x + r * np.cos(th), y + r * np.sin(th)]])))
+    for k, g in enumerate(m.gears):
+        for b, r in zip(g.links, jg.numbers[("gear", k)]):
+            pitch(f"{g.name or 'gear'} pitch circle", b, float(r))
+    for k, rk in enumerate(m.racks):
+        r = float(jg.numbers[("rack", k)])
+        pitch(f"{rk.name or 'rack'} pinion pitch circle", rk.pinion, r)
+        through, dvec, s = (a[i] for a in geo.slides[rk.slide])
+        sv = geo.slides[rk.slide][2]
+        sv = sv[np.isfinite(sv)] if np.isfinite(sv).any() else np.zeros(1)
+        lo, hi = sv.min() - 4 * unit, sv.max() + 4 * unit
+        nrm = np.array([-dvec[1], dvec[0]]) * (-1.0 if rk.teeth == "right" else 1.0)
+        base = through + r * nrm
+        along = m.slide(rk.slide).along
+        out.append((f"{rk.name or 'rack'} pitch line", along, np.array([base + lo * dvec, base + hi * dvec])))
+        step = 1.5 * unit  # ticks fixed to the rack: at multiples of `step` from `through`
+        ks = np.arange(np.ceil(lo / step), np.floor(hi / step) + 1) * step
+        ticks = [row for k_ in ks for row in (base + k_ * dvec, base + k_ * dvec + 0.8 * unit * nrm, [np.nan] * 2)]
+        out.append((f"{rk.name or 'rack'} teeth", along, np.array(ticks).reshape(-1, 2)))
+    for c in m.cams:
+        data = jg.numbers[("cam", c.name)]
+        local = profile_points(c, data[1:])
+        out.append((f"{c.name} profile", c.body, _world(jg.frames[c.body][i], local)))
+        cp = jg.contact[c.name][i]
+        out.append((f"{c.name} contact", "", cp.reshape(1, 2)))
+        if c.roller:
+            out.append((f"{c.name} roller", "", geo.point(c.roller)[i] + float(data[0]) * circ))
+        elif c.flat:
+            fth = jg.frames[c.flat][i][2]
+            half = 0.6 * np.ptp(local, axis=0).max()
+            dvec = np.array([np.cos(fth), np.sin(fth)])
+            out.append((f"{c.name} face", c.flat, np.array([cp - half * dvec, cp + half * dvec])))
+    return out
+
+
+_STYLE = {"pitch circle": ("-.", 1.0, 3.2), "mark": ("-", 1.2, 3.2), "pitch line": ("-", 1.4, 3.3),
+          "teeth": ("-", 0.8, 3.3), "profile": ("-", 1.6, 3.4), "contact": ("o", 0, 6.5),
+          "roller": ("-", 1.2, 5.5), "face": ("-", 3.0, 5.5)}
+
+
+def style(label: str) -> tuple[str, float, float]:
+    """(matplotlib line style, width, z order) of a curve, by the end of its label."""
+    return next(v for k, v in _STYLE.items() if label.endswith(k))
+
+
 class JointArtists:
     """The artists of every gear, rack and cam of a `plot.Drawing`; `update(i)` moves them."""
 
     def __init__(self, drawing, jg: JointGeometry):
-        self.d, self.jg, m, ax = drawing, jg, drawing.m, drawing.ax
-        colour = lambda b: drawing.colour.get(b, "#555555")  # noqa: E731
-        self.gears = []
-        for i, g in enumerate(m.gears):
-            for b, r in zip(g.links, jg.numbers[("gear", i)]):
-                circle, = ax.plot([], [], "-.", lw=1.0, color=colour(b), zorder=3.2,
-                                  label=f"{g.name or 'gear'} pitch circle")
-                mark, = ax.plot([], [], "-", lw=1.2, color=colour(b), zorder=3.2)
-                self.gears.append((b, float(r), circle, mark))
-                self._grow(jg.frames[b][:, :2], float(r))
-        self.racks = []
-        for i, rk in enumerate(m.racks):  # the pinion's pitch circle, then the rack's line
-            r = float(jg.numbers[("rack", i)])
-            circle, = ax.plot([], [], "-.", lw=1.0, color=colour(rk.pinion), zorder=3.2,
-                              label=f"{rk.name or 'rack'} pinion pitch circle")
-            mark, = ax.plot([], [], "-", lw=1.2, color=colour(rk.pinion), zorder=3.2)
-            self.gears.append((rk.pinion, r, circle, mark))
-            line, = ax.plot([], [], "-", lw=1.4, color=colour(m.slide(rk.slide).along), zorder=3.3,
-                            label=f"{rk.name or 'rack'} pitch line")
-            ticks, = ax.plot([], [], "-", lw=0.8, color=colour(m.slide(rk.slide).along), zorder=3.3)
-            self.racks.append((rk, float(jg.numbers[("rack", i)]), line, ticks))
-        self.cams = []
-        for c in m.cams:
-            data = jg.numbers[("cam", c.name)]
-            local = profile_points(c, data[1:])
-            prof, = ax.plot([], [], "-", lw=1.6, color=colour(c.body), zorder=3.4, label=f"{c.name} profile")
-            dot, = ax.plot([], [], "o", ms=4, color="#c0392b", zorder=6.5, label=f"{c.name} contact")
-            extra = None
-            if c.roller:
-                extra, = ax.plot([], [], "-", lw=1.2, color=INK_ROLLER, zorder=5.5, label=f"{c.name} roller")
-            elif c.flat:
-                extra, = ax.plot([], [], "-", lw=3, color=colour(c.flat), zorder=5.5, label=f"{c.name} face")
-            self.cams.append((c, float(data[0]), local, prof, dot, extra))
-            fr = jg.frames[c.body]
-            for i in np.flatnonzero(np.isfinite(fr).all(axis=1))[:: max(1, len(fr) // 24)]:
-                self._grow(_world(fr[i], local), 0.0)
+        self.d = drawing
+        colour = lambda b: drawing.colour.get(b, "#c0392b" if not b else "#555555")  # noqa: E731
+        self.lines = []
+        for k, (label, body, xy) in enumerate(curves(drawing.m, drawing.geo, drawing.i0, drawing.r)):
+            ls, lw, z = style(label)
+            c = "#333333" if label.endswith("roller") else colour(body)
+            kw = dict(ms=4) if ls == "o" else dict(lw=lw)
+            line, = drawing.ax.plot([], [], ls, color=c, zorder=z, label=label.removesuffix(" mark")
+                                    if not label.endswith("mark") else "_" + label, **kw)
+            self.lines.append(line)
+        for label, body, xy in self._all_poses():
+            self._grow(xy)
 
-    def _grow(self, pts, r):
-        """Widen the drawing's box to hold these points (and circles of radius r about them)."""
+    def _all_poses(self):
+        geo = self.d.geo
+        for i in np.flatnonzero(geo.ok)[:: max(1, len(geo.ok) // 24)]:
+            yield from curves(self.d.m, geo, int(i), self.d.r)
+
+    def _grow(self, pts):
+        """Widen the drawing's box to hold these points."""
         pts = pts[np.isfinite(pts).all(axis=1)]
         if pts.size:
             box = self.d.box
-            box[0] = np.minimum(box[0], pts.min(axis=0) - r - 2 * self.d.r)
-            box[1] = np.maximum(box[1], pts.max(axis=0) + r + 2 * self.d.r)
+            box[0] = np.minimum(box[0], pts.min(axis=0) - 2 * self.d.r)
+            box[1] = np.maximum(box[1], pts.max(axis=0) + 2 * self.d.r)
 
     def update(self, i: int):
-        jg, nan2 = self.jg, np.full((2, 2), np.nan)
-        t = np.linspace(0, 2 * np.pi, 121)
-        for b, r, circle, mark in self.gears:
-            x, y, th = jg.frames[b][i] if 0 <= i < len(jg.frames[b]) else (np.nan,) * 3
-            circle.set_data(x + r * np.cos(t), y + r * np.sin(t))
-            mark.set_data([x, x + r * np.cos(th)], [y, y + r * np.sin(th)])  # turns with the body
-        for rk, r, line, ticks in self.racks:
-            through, dvec, _ = (a[i] for a in self.d.geo.slides[rk.slide])
-            lo, hi = self.d.sref[rk.slide]
-            nrm = np.array([-dvec[1], dvec[0]]) * (-1.0 if rk.teeth == "right" else 1.0)
-            base = through + r * nrm
-            ends = np.array([base + lo * dvec, base + hi * dvec])
-            line.set_data(*ends.T)
-            pitch = 0.5 * self.d.r * 3
-            ks = np.arange(np.ceil(lo / pitch), np.floor(hi / pitch) + 1) * pitch  # fixed to the rack
-            segs = [[base + k * dvec, base + k * dvec + 0.8 * self.d.r * nrm, [np.nan, np.nan]] for k in ks]
-            ticks.set_data(*np.array(segs).reshape(-1, 2).T if segs else nan2)
-        for c, rho, local, prof, dot, extra in self.cams:
-            fr = jg.frames[c.body][i]
-            prof.set_data(*_world(fr, local).T)
-            cp = jg.contact[c.name][i]
-            dot.set_data([cp[0]], [cp[1]])
-            if c.roller:
-                ctr = self.d.geo.point(c.roller)[i]
-                extra.set_data(ctr[0] + rho * np.cos(t), ctr[1] + rho * np.sin(t))
-            elif c.flat:
-                fx, fy, fth = jg.frames[c.flat][i]
-                half = 0.6 * np.ptp(local, axis=0).max()
-                dvec = np.array([np.cos(fth), np.sin(fth)])
-                extra.set_data(*np.array([cp - half * dvec, cp + half * dvec]).T)
-
-
-INK_ROLLER = "#333333"
+        if not 0 <= i < len(self.d.geo.ok):
+            for line in self.lines:
+                line.set_data([], [])
+            return
+        for line, (_, _, xy) in zip(self.lines, curves(self.d.m, self.d.geo, i, self.d.r)):
+            line.set_data(*xy.T)

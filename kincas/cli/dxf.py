@@ -84,6 +84,14 @@ def dxf_document(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=N
     for name, a in pic.paths.items():
         for run in _runs(a):
             msp.add_lwpolyline([tuple(q) for q in run], dxfattribs={"layer": "paths"})
+    curves = pic.joint_curves(i)  # gears, racks, cams (cli/draw_joints.py): layer "joints"
+    if curves:
+        doc.layers.add("joints")
+    for label, body, a in curves:
+        if len(a) == 1 and np.isfinite(a).all():
+            msp.add_circle(tuple(a[0]), 0.5 * pic.r, dxfattribs={"layer": "joints"})
+        for run in _runs(a):
+            msp.add_lwpolyline([tuple(q) for q in run], dxfattribs={"layer": "joints"})
     return doc
 
 

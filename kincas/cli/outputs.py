@@ -118,6 +118,21 @@ def _break_wraps(name: str, x, v, half):
     return np.insert(x.astype(float), jumps, np.nan), np.insert(np.asarray(v, float), jumps, np.nan)
 
 
+def _flat(v: np.ndarray):
+    """(v, None), or (its mean everywhere it is finite, the mean) when v is constant to
+    rounding (a spread within 1e-9 of its size): plotted as a line, not as 1e-14 noise.
+
+    >>> _flat(np.array([0.25, 0.25 + 1e-15, np.nan]))[1]
+    0.25
+    """
+    v = np.asarray(v, float)
+    fin = v[np.isfinite(v)]
+    if fin.size < 2 or np.ptp(fin) > 1e-9 * max(float(np.abs(fin).max()), 1e-300):
+        return v, None
+    c = float(f"{np.mean(fin):.12g}")  # its digits beyond rounding are noise
+    return np.where(np.isfinite(v), c, np.nan), c
+
+
 def plot_quantities(sweep: Sweep, names=None, *, scene=None, fig=None):
     """Plot reported quantities (default: all) against the input, one panel each; returns the
     Figure. Poses flagged "limit", "change point" or "singular" are marked by vertical lines,
@@ -148,7 +163,12 @@ def plot_quantities(sweep: Sweep, names=None, *, scene=None, fig=None):
     style = "-" if len(x) > 1 else "o"
     shown = set()
     for ax, (name, v) in zip(axes, values.items()):
+        v, flat = _flat(v)
         ax.plot(*_break_wraps(name, x, v, half), style, color="C0", lw=1.4, ms=4)
+        ax.ticklabel_format(axis="y", useOffset=False)  # no "1e-12+5e1" offset labels
+        if flat is not None:  # constant to rounding: a flat line in a readable band
+            pad = 0.05 * abs(flat) if flat != 0 else 1.0
+            ax.set_ylim(flat - pad, flat + pad)
         ax.set_ylabel(heading(name, scene), fontsize=8)
         ax.tick_params(labelsize=7)
         ax.grid(True, color="#e6e6e6", lw=0.6)
@@ -187,9 +207,10 @@ def plot_quantities(sweep: Sweep, names=None, *, scene=None, fig=None):
 
 
 def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, fps: int = 20,
-            captions=None, units: str = "", dpi: int = 80, size=(6.4, 4.8)) -> int:
+            captions=None, units: str = "", dpi: int = 80, size=(6.4, 4.8), progress=None) -> int:
     """Write an animated GIF of the sweep's solved poses (at most `frames` of them, evenly
-    spread); returns the number of frames written. `captions[i]` titles pose i.
+    spread); returns the number of frames written. `captions[i]` titles pose i;
+    `progress(done, total)` is called after each frame (a progress bar, say).
 
     >>> import os, tempfile, numpy as np, kincas
     >>> m = kincas.Mechanism(ground={"O": (0, 0)},
@@ -201,22 +222,28 @@ def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, 
     ...     animate(m, sw, os.path.join(d, "slider.gif"), frames=4, size=(2, 1.5), dpi=40)
     4
     """
-    from .plot import Drawing, caption, check_paths, geometry, new_figure, require_matplotlib
+    from .plot import (Drawing, caption, check_paths, geometry, new_figure, require_matplotlib,
+                       smooth_paths)
     require_matplotlib("kincas.outputs.animate")
     from matplotlib.animation import PillowWriter
     ok = np.flatnonzero(sweep.ok) if sweep.ok.any() else np.array([0])
     pick = ok[np.unique(np.round(np.linspace(0, ok.size - 1, min(frames, ok.size))).astype(int))]
     fig = new_figure(size)
-    d = Drawing(fig.subplots(), m, geometry(m, sweep), check_paths(m, paths), True, units)
+    chosen = check_paths(m, paths)
+    d = Drawing(fig.subplots(), m, geometry(m, sweep), chosen, True, units, smooth_paths(m, sweep, chosen))
     cap = captions if captions is not None else [caption(sweep, i) for i in range(len(sweep))]
     d.update(int(pick[0]), cap[pick[0]])
     fig.canvas.draw()  # lay the figure out once; every frame keeps that layout
     fig.set_layout_engine("none")
     writer = PillowWriter(fps=fps)
     with writer.saving(fig, str(path), dpi):
-        for i in pick:  # one drawing per frame
+        if progress is not None:
+            progress(0, len(pick))
+        for k, i in enumerate(pick):  # one drawing per frame
             d.update(int(i), cap[i])
             writer.grab_frame()
+            if progress is not None:
+                progress(k + 1, len(pick))
     return len(pick)
 
 
@@ -315,7 +342,7 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
     captions = [_caption(scene, sweep, inputs, i) for i in range(len(sweep))]
     jobs = [("csv", lambda p: write_csv(p, sweep, scene)),
             ("plot", lambda p: _save_drawing(p, m, sweep, pose, paths, captions, length)),
-            ("animate", lambda p: _animate(p, m, sweep, paths, captions, length)),
+            ("animate", lambda p: _animate(p, m, sweep, paths, captions, length, _rendering(args))),
             ("plot_quantities", lambda p: plot_quantities(sweep, scene=scene).savefig(p, dpi=100)),
             ("html", lambda p: _html(p, m, sweep, scene, paths)),
             ("svg", lambda p: _svg(p, m, sweep, scene, pose, paths)),
@@ -372,5 +399,14 @@ def _save_drawing(path, m, sweep, pose, paths, captions, length):
     fig.savefig(path, dpi=100)
 
 
-def _animate(path, m, sweep, paths, captions, length):
-    animate(m, sweep, path, paths=paths, captions=captions, units=length)
+def _rendering(args):
+    """A progress bar labelled "rendering" where `kincas solve` would show one."""
+    from .app import progress_for
+    bar = progress_for(args)
+    if bar is not None:
+        bar.label = "rendering"
+    return bar
+
+
+def _animate(path, m, sweep, paths, captions, length, progress=None):
+    animate(m, sweep, path, paths=paths, captions=captions, units=length, progress=progress)

@@ -63,11 +63,15 @@ class Picture:
     paths: dict[str, np.ndarray] = field(default_factory=dict)  # point -> M x 2 (NaN breaks)
     r: float = 1.0  # the picture's unit of size (2 % of its extent)
     first: int = 0  # the first solved pose
+    # pose -> [(label, body, polyline)] of the gears, racks and cams (cli/draw_joints.py)
+    joint_curves: object = field(default=lambda i: [], repr=False)
 
     def box(self) -> np.ndarray:
         """[[xmin, ymin], [xmax, ymax]] of everything drawn over the sweep, with a margin."""
         parts = [self.xy[np.isfinite(self.xy).all(axis=2)]]
         parts += [p[np.isfinite(p).all(axis=1)] for p in self.paths.values()]
+        if self.ok.any():
+            parts += [c[np.isfinite(c).all(axis=1)] for _, _, c in self.joint_curves(self.first)]
         for g in self.guides:
             for s in (g.lo, g.hi):
                 e = g.through + s * g.direction
@@ -117,7 +121,12 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int = 0) -> Picture:
     chosen = check_paths(m, paths)
     path_xy = dense_paths(m, sweep, chosen, dense) if dense > 0 else {p: geo.point(p) for p in chosen}
     return Picture(names, xy, geo.ok, [names.index(g) for g in m.ground_points], bodies, guides,
-                   path_xy, r, i0)
+                   path_xy, r, i0, _joint_curves(m, geo, r))
+
+
+def _joint_curves(m: Mechanism, geo, r: float):
+    from .draw_joints import curves
+    return lambda i: curves(m, geo, i, r) if geo.joints is not None and 0 <= i < len(geo.ok) else []
 
 
 def dense_paths(m: Mechanism, sweep: Sweep, points: list[str], per_step: int) -> dict[str, np.ndarray]:

@@ -169,7 +169,8 @@ INK, PAPER = "#222222", "white"
 class Drawing:
     """Every artist of a mechanism drawing; `update(i)` moves them to pose i."""
 
-    def __init__(self, ax, m: Mechanism, geo: Geometry, paths, labels: bool, units: str = ""):
+    def __init__(self, ax, m: Mechanism, geo: Geometry, paths, labels: bool, units: str = "",
+                 path_xy: dict | None = None):
         self.ax, self.m, self.geo = ax, m, geo
         self.i0 = default_pose(geo.ok)
         pts = geo.xy[np.isfinite(geo.xy).all(axis=2)]
@@ -194,7 +195,7 @@ class Drawing:
         self.colour = {lk.name: f"C{k % 10}" for k, lk in enumerate(m.links)}
         owner = {p: lk.name for lk in reversed(m.links) for p in lk.point_names}  # the first link
         for p in paths:  # a path in its link's colour; NaN at unsolved poses breaks the line
-            xy = geo.point(p)
+            xy = path_xy[p] if path_xy and p in path_xy else geo.point(p)
             if np.isfinite(xy).all(axis=1).sum() >= 2:
                 ax.plot(*xy.T, "--", lw=1.0, color=self.colour.get(owner.get(p), INK), alpha=0.7, zorder=2)
         names = geo.names  # what surrounds each point: the other points of its bodies
@@ -260,26 +261,51 @@ class Drawing:
 
     def _make_slides(self):
         """A slot along a link: two rails in the link's colour. A guide on the ground: one
-        hatched surface on the side away from the links that pull the block, so they do not
-        cross it. The block rides between the rails, or against the surface."""
+        hatched surface on the side the links never reach over the sweep (beyond the block),
+        so none crosses it; where they reach both sides (a centric slider-crank's rod), two
+        plain rails. The block rides between the rails, or against the surface."""
         from matplotlib.collections import LineCollection
         from matplotlib.patches import Polygon
         self.guides = []  # (slide, [(side, rail)], block, hatch or None)
         for sl in self.m.slides:
             sides = (-1.0, 1.0)
             if sl.along == GROUND:
-                k, (_, d, _) = self.geo.names.index(sl.point), self.geo.slides[sl.name]
-                n = np.stack([-d[:, 1], d[:, 0]], axis=1)
-                pull = sum(np.nanmean(np.einsum("ij,ij->i", self.geo.xy[:, j] - self.geo.xy[:, k], n))
-                           for j in self.near[k]) if self.geo.ok.any() else 0.0
-                sides = (-1.0 if not pull < 0 else 1.0,)  # the side the links are not on
+                sides = self._free_sides(sl)
             c = INK if sl.along == GROUND else self.colour[sl.along]
             rails = [(side, self.ax.plot([], [], "-", lw=1.2, color=c, zorder=3.5)[0]) for side in sides]
             block = self.ax.add_patch(Polygon(np.zeros((4, 2)), closed=True, fc="#f2f2f2", ec=INK,
                                               lw=1.2, zorder=5))
             hatch = (self.ax.add_collection(LineCollection([], colors=INK, linewidths=0.7, zorder=3.5))
-                     if sl.along == GROUND else None)
+                     if sl.along == GROUND and len(sides) == 1 else None)
             self.guides.append((sl, rails, block, hatch))
+
+    def _free_sides(self, sl) -> tuple[float, ...]:
+        """(+1,) or (-1,): the one side of a ground guide that no link reaches at any pose,
+        within the guide's length and beyond the block's half-width; (-1, +1) when the links
+        reach both sides (then no side can be hatched without a link crossing it)."""
+        through, d, _ = self.geo.slides[sl.name]
+        n = np.stack([-d[:, 1], d[:, 0]], axis=1)
+        names, xy = self.geo.names, self.geo.xy
+        t = np.linspace(0.0, 1.0, 17)[None, :, None]
+        samples = [xy[:, [names.index(p)]] for p in self.m.ground_points + self.m.moving_points
+                   if p != sl.point]
+        for lk in self.m.links:  # points along every pair of a body's points: its bars and edges
+            idx = [names.index(p) for p in lk.point_names]
+            for a in range(len(idx)):
+                for b in range(a + 1, len(idx)):
+                    pa, pb = xy[:, [idx[a]]], xy[:, [idx[b]]]
+                    samples.append(pa + t * (pb - pa))
+        rel = np.concatenate(samples, axis=1) - through[:, None, :]
+        across = np.einsum("ijk,ik->ij", rel, n)
+        along = np.einsum("ijk,ik->ij", rel, d)
+        lo, hi = self.sref[sl.name]
+        inside = (along >= lo) & (along <= hi) & np.isfinite(across)
+        w = 1.4 * self.r
+        up = bool((across[inside] > w).any())
+        down = bool((across[inside] < -w).any())
+        if up and down:
+            return (-1.0, 1.0)
+        return (1.0,) if not up else (-1.0,)
 
     def _make_points(self, labels: bool):
         """Joints (on two bodies or more, the ground counting as one) as rings, other points
@@ -306,7 +332,7 @@ class Drawing:
         for sl, rails, *_ in self.guides:
             if sl.point == name:  # a ground guide's surface is on one side
                 along = self.geo.slides[sl.name][1][i]
-                v = v + (rails[0][0] * np.array([-along[1], along[0]]) if sl.along == GROUND else 0.0)
+                v = v + (rails[0][0] * np.array([-along[1], along[0]]) if len(rails) == 1 else 0.0)
         v = -v
         if along is not None and np.isfinite(along).all():  # the guide runs both ways: go across
             n = np.array([-along[1], along[0]])
@@ -383,9 +409,23 @@ def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=
         ax = plt.subplots(figsize=(6.4, 4.8))[1]
     paths = check_paths(m, paths)
     i = default_pose(sweep) if pose is None else int(pose) % max(len(sweep), 1)  # -1: the last
-    d = Drawing(ax, m, geometry(m, sweep), paths, labels, units)
+    d = Drawing(ax, m, geometry(m, sweep), paths, labels, units, smooth_paths(m, sweep, paths))
     d.update(i, caption(sweep, i) if title is None else title)
     return ax
+
+
+def smooth_paths(m: Mechanism, sweep: Sweep, paths: list[str]) -> dict | None:
+    """Paths through about 360 poses, the extra ones SOLVED between the sweep's (see
+    `kincas.cli.picture.dense_paths`), so that a 12-pose sweep does not draw a 12-gon; None
+    for sweeps of more than 60 poses (their poses are dense enough)."""
+    n = len(sweep)
+    if n < 2 or n > 60 or not paths:
+        return None
+    per_step = int(min(16, max(0, -(-360 // (n - 1)) - 1)))
+    if per_step == 0:
+        return None
+    from .picture import dense_paths
+    return dense_paths(m, sweep, paths, per_step)
 
 
 def check_paths(m: Mechanism, paths) -> list[str]:

@@ -109,6 +109,19 @@ def svg_text(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None,
             out.append(f'<line data-link={quoteattr(b.name)} x1="{_f(ax)}" y1="{_f(ay)}" x2="{_f(bx)}" '
                        f'y2="{_f(by)}" stroke="{b.colour}" stroke-width="{_f(1.6 * sw_)}"/>')
     out.append("</g>")
+    out.append('<g id="joints" fill="none">')  # gears, racks, cams: cli/draw_joints.py
+    colours = {b.name: b.colour for b in pic.bodies}
+    for label, body, a in pic.joint_curves(i):
+        c = colours.get(body, INK)
+        if len(a) == 1:  # a cam's contact point
+            if np.isfinite(a).all():
+                out.append(f'<circle data-joint={quoteattr(label)} cx="{_f(a[0, 0])}" cy="{_f(a[0, 1])}" '
+                           f'r="{_f(0.5 * r)}" fill="#c0392b"/>')
+            continue
+        for run in _runs(a):
+            out.append(f'<polyline data-joint={quoteattr(label)} points="{_pts(run)}" stroke="{c}" '
+                       f'stroke-width="{_f(0.4 * sw_)}"/>')
+    out.append("</g>")
     out.append('<g id="points">')
     for k, name in enumerate(pic.names):
         x, y = xy[k]
