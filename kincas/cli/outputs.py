@@ -401,7 +401,7 @@ def _save_drawing(path, m, sweep, pose, paths, captions, length):
 
 def _rendering(args):
     """A progress bar labelled "rendering" where `kincas solve` would show one."""
-    from .app import progress_for
+    from .common import progress_for
     bar = progress_for(args)
     if bar is not None:
         bar.label = "rendering"
