@@ -411,3 +411,31 @@ def test_vector_pictures_draw_the_joints():
     f = np.array([sw["F.x"][2], sw["F.y"][2]])
     assert any(np.allclose(np.hypot(*(np.array([p[:2] for p in e.get_points()]) - f).T), 10, atol=1e-8)
                for e in polys)
+
+
+def test_html_page_draws_the_cam(tmp_path):
+    """The --html page of the roller cam runs without a JavaScript error and shows the
+    contact point (red) where kincas puts it."""
+    import re
+    from test_html import BROWSER, browser
+    if BROWSER is None:
+        pytest.skip("no headless Chromium on this machine")
+    page = tmp_path / "cam.html"
+    import kincas.cli
+    assert kincas.cli.main(["solve", str(EXAMPLES / "roller_cam.toml"), "--html", str(page)]) == 0
+    pose = 6
+    dom = browser(tmp_path, page.as_uri() + f"#pose={pose}", "--dump-dom")
+    errors = re.search(r'<pre id="errors">(.*?)</pre>', dom, re.S)
+    assert errors is not None and errors.group(1).strip() == "", dom[-2000:]
+    sx, ox, oy = map(float, re.search(r'data-transform="([^"]+)"', dom).group(1).split())
+    from kincas.cli.scene import load
+    sc = load(EXAMPLES / "roller_cam.toml")
+    sw = kincas.sweep(sc.mechanism, sc.study.inputs, report=["cam.contact.x", "cam.contact.y"])
+    x, y = sw["cam.contact.x"][pose], sw["cam.contact.y"][pose]
+    shot = tmp_path / "cam.png"
+    browser(tmp_path, page.as_uri() + f"#pose={pose}", f"--screenshot={shot}")
+    from PIL import Image
+    img = Image.open(shot).convert("RGB")
+    px, py = round(ox + sx * x), round(oy - sx * y)
+    assert any(max(abs(a - b) for a, b in zip(img.getpixel((px + dx, py + dy)), (0xC0, 0x39, 0x2B))) <= 40
+               for dx in (-1, 0, 1) for dy in (-1, 0, 1))

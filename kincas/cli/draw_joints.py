@@ -126,15 +126,16 @@ def _world(frame, pts):
     return np.stack([x + c * pts[:, 0] - s * pts[:, 1], y + s * pts[:, 0] + c * pts[:, 1]], axis=1)
 
 
-def curves(m, geo, i: int, unit: float) -> list[tuple[str, str, np.ndarray]]:
+def curves(m, geo, i: int, unit: float, fine: int = 121) -> list[tuple[str, str, np.ndarray]]:
     """What the joints draw at pose i, format-free: (label, body whose colour it takes,
     (K x 2) polyline) for each pitch circle and its turning radius, rack pitch line and its
     ticks (NaN rows break a polyline), cam profile, contact point (one row), roller circle and
-    flat face. `geo` is `plot.geometry`'s, `unit` the drawing's unit of size."""
+    flat face. `geo` is `plot.geometry`'s, `unit` the drawing's unit of size, `fine` the
+    number of points of a circle (three times that for a cam's profile)."""
     jg, out = geo.joints, []
     if jg is None:
         return out
-    t = np.linspace(0, 2 * np.pi, 121)
+    t = np.linspace(0, 2 * np.pi, fine)
     circ = np.stack([np.cos(t), np.sin(t)], axis=1)
 
     def pitch(label, body, r):
@@ -161,7 +162,7 @@ def curves(m, geo, i: int, unit: float) -> list[tuple[str, str, np.ndarray]]:
         out.append((f"{rk.name or 'rack'} teeth", along, np.array(ticks).reshape(-1, 2)))
     for c in m.cams:
         data = jg.numbers[("cam", c.name)]
-        local = profile_points(c, data[1:])
+        local = profile_points(c, data[1:], 3 * fine)
         out.append((f"{c.name} profile", c.body, _world(jg.frames[c.body][i], local)))
         cp = jg.contact[c.name][i]
         out.append((f"{c.name} contact", "", cp.reshape(1, 2)))

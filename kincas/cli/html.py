@@ -70,10 +70,19 @@ def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0
                     "lo": g.lo, "hi": g.hi, "through": _arr(g.through[keep]),
                     "direction": _arr(g.direction[keep])} for g in pic.guides],
         "paths": {p: _arr(v) for p, v in pic.paths.items()},
+        "joints": _joints(pic, keep),
         "x": {"name": heading(xkey, scene) if xkey else "pose", "values": _arr(x[keep])},
         "quantities": [{"name": heading(k, scene), "values": _arr(np.asarray(v)[keep])}
                        for k, v in values.items()],
     }
+
+
+def _joints(pic, keep) -> list:
+    """Per kept pose, the gears', racks' and cams' polylines (cli/draw_joints.py), coarser
+    than in the other pictures so that the page stays small: [{colour, pts}]."""
+    colours = {b.name: b.colour for b in pic.bodies}
+    return [[{"colour": "#c0392b" if len(a) == 1 else colours.get(body, INK), "pts": _arr(a, 7)}
+             for _, body, a in pic.joint_curves(int(i), 41)] for i in keep]
 
 
 def html_page(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0) -> str:
@@ -167,6 +176,12 @@ function drawMechanism(i) {
       ctx.fillRect(-2 * R, -1.4 * R, 4 * R, 2.8 * R); ctx.strokeRect(-2 * R, -1.4 * R, 4 * R, 2.8 * R);
       ctx.restore();
     }
+  }
+  for (const c of D.joints[i] || []) {  // gears, racks, cams
+    if (c.pts.length === 1) {
+      const p = c.pts[0]; if (!fin(p)) continue;
+      ctx.beginPath(); ctx.arc(X(p), Y(p), 3, 0, 2 * Math.PI); ctx.fillStyle = c.colour; ctx.fill();
+    } else line(c.pts, c.colour, 1.2);
   }
   const order = D.bodies.filter(b => !b.driven).concat(D.bodies.filter(b => b.driven));
   for (const b of order) {

@@ -64,7 +64,7 @@ class Picture:
     r: float = 1.0  # the picture's unit of size (2 % of its extent)
     first: int = 0  # the first solved pose
     # pose -> [(label, body, polyline)] of the gears, racks and cams (cli/draw_joints.py)
-    joint_curves: object = field(default=lambda i: [], repr=False)
+    joint_curves: object = field(default=lambda i, fine=121: [], repr=False)
 
     def box(self) -> np.ndarray:
         """[[xmin, ymin], [xmax, ymax]] of everything drawn over the sweep, with a margin."""
@@ -126,7 +126,8 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int = 0) -> Picture:
 
 def _joint_curves(m: Mechanism, geo, r: float):
     from .draw_joints import curves
-    return lambda i: curves(m, geo, i, r) if geo.joints is not None and 0 <= i < len(geo.ok) else []
+    return lambda i, fine=121: (curves(m, geo, i, r, fine) if geo.joints is not None and 0 <= i < len(geo.ok)
+                                else [])
 
 
 def dense_paths(m: Mechanism, sweep: Sweep, points: list[str], per_step: int) -> dict[str, np.ndarray]:

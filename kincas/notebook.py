@@ -1,0 +1,102 @@
+"""How results look in Jupyter: a `Mechanism` as an SVG drawing of its first pose, a `Sweep`
+as a short summary (poses, solved, flags, events) with small plots of its quantities.
+`repr` stays one line; these are only the notebook's rich displays.
+
+A mechanism holds no input values, so its "first pose" is the one its declaration implies:
+an angle input at the angle its link has between the points the ground and the guess place
+(0 when they do not place two of them), a slide input where the guess puts its point, a
+parameter input at the parameter's value; solved from the guess, so on its branch.
+
+>>> import numpy as np, kincas, xml.etree.ElementTree as ET
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+...            kincas.Link.bar("rocker", "D", "C", 3)],
+...     inputs=[kincas.Input.angle("crank")], guess={"B": (0, 1), "C": (3.6, 2.9)})
+>>> first_inputs(m)                       # the guess puts B above A: the crank at 90 deg
+{'crank.angle': 1.5707963267948966}
+>>> ET.fromstring(m._repr_svg_()).tag
+'{http://www.w3.org/2000/svg}svg'
+"""
+from __future__ import annotations
+
+import math
+from html import escape
+
+import numpy as np
+
+
+def first_inputs(m) -> dict[str, float]:
+    """The input values the mechanism's ground points and guess imply (see the module)."""
+    known = {**{g: (m.value(x), m.value(y)) for g, (x, y) in m.ground},
+             **{p: (m.value(x), m.value(y)) for p, (x, y) in m.guess}}
+    out = {}
+    for inp in m.inputs:
+        v = 0.0
+        try:
+            if inp.kind == "parameter":
+                v = m.parameter(inp.target)
+            elif inp.kind == "angle" and "/" not in inp.target:
+                lk = m.link(inp.target)
+                loc = {p: (m.value(x), m.value(y)) for p, (x, y) in lk.points}
+                pair = [p for p in lk.point_names if p in known][:2]
+                if len(pair) == 2:
+                    (p, q), (lp, lq) = pair, (loc[pair[0]], loc[pair[1]])
+                    world = math.atan2(known[q][1] - known[p][1], known[q][0] - known[p][0])
+                    v = world - math.atan2(lq[1] - lp[1], lq[0] - lp[0])
+                    v = math.atan2(math.sin(v), math.cos(v))
+            elif inp.kind == "slide":
+                sl = m.slide(inp.target)
+                if sl.along == "ground" and sl.point in known:
+                    tx, ty = (m.value(c) for c in sl.through)
+                    a = m.value(sl.angle)
+                    px, py = known[sl.point]
+                    v = (px - tx) * math.cos(a) + (py - ty) * math.sin(a)
+        except (KeyError, ValueError, TypeError, AttributeError):
+            v = 0.0
+        out[inp.key] = float(v)
+    return out
+
+
+def mechanism_svg(m, width: float = 420) -> str:
+    """The mechanism drawn at its first pose (see the module), as SVG text."""
+    from .analysis.sweeps import sweep
+    from .cli.svg import svg_text
+    sw = sweep(m, {k: np.array([v]) for k, v in first_inputs(m).items()}, report=[])
+    return svg_text(m, sw, 0, width=width)
+
+
+def _spark(x, v, w=150, h=40) -> str:
+    """A small line plot of v against x, as an inline SVG."""
+    ok = np.isfinite(x) & np.isfinite(v)
+    if ok.sum() < 2:
+        return ""
+    x, v = np.asarray(x)[ok], np.asarray(v)[ok]
+    x0, x1, y0, y1 = x.min(), x.max(), v.min(), v.max()
+    if x1 == x0:
+        return ""
+    if y1 - y0 <= 1e-9 * max(abs(y0), abs(y1), 1e-300):
+        y0, y1 = y0 - 1, y1 + 1
+    px = 2 + (w - 4) * (x - x0) / (x1 - x0)
+    py = h - 2 - (h - 4) * (v - y0) / (y1 - y0)
+    pts = " ".join(f"{a:.1f},{b:.1f}" for a, b in zip(px, py))
+    return (f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}">'
+            f'<polyline points="{pts}" fill="none" stroke="#1f77b4" stroke-width="1.2"/></svg>')
+
+
+def sweep_html(sw, most: int = 6) -> str:
+    """The sweep's summary and a small plot of each of its first `most` quantities."""
+    lines = sw.summary_lines()
+    key = next((k for k, v in sw.inputs.items() if np.ptp(np.asarray(v, float)) > 0), None)
+    x = np.asarray(sw.inputs[key], float) if key else np.arange(len(sw), dtype=float)
+    cells = []
+    for name in list(sw.values)[:most]:
+        v = np.asarray(sw.values[name], float)
+        fin = v[np.isfinite(v)]
+        rng = f"{fin.min():.4g} to {fin.max():.4g}" if fin.size else "not solved"
+        cells.append(f"<td style='padding:2px 8px'><code>{escape(name)}</code><br>{_spark(x, v)}"
+                     f"<br><small>{rng}</small></td>")
+    more = len(sw.values) - most
+    tail = f"<p><small>and {more} more quantities</small></p>" if more > 0 else ""
+    against = f"<small>against {escape(key)}</small>" if key else "<small>against the pose</small>"
+    return (f"<div><pre style='margin:0'>{escape(chr(10).join(lines))}</pre>"
+            f"<table><tr>{''.join(cells)}</tr></table>{against}{tail}</div>")
