@@ -10,10 +10,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
+from ..core.assembly import NEAR, assemble, blocks, group_links, modes, polish_singular
+# the first pose of a sweep (its home is the core: `kincas modes` and `range` start there too)
+from ..core.assembly import ambiguous as _ambiguous, first_pose as _first, no_assembly as _no_assembly  # noqa: F401
 from ..core.numeric import Model, Solution
 from ..model.mechanism import Mechanism
 
+
+WATCH = 0.5  # a group conditioned below this at either end of a step is checked for a crossing
 
 # --- a pose of a sweep on the careful path ---
 
@@ -22,8 +26,10 @@ def careful_pose(model: Model, m: Mechanism, U, p, L, guess, k: int, j: int | No
                  events: list) -> Solution:
     """Pose k of a sweep over the input table U, from the last solved pose j (None: none yet).
 
-    `run` holds the poses solved so far (`Q`, `solved`); a resume after a gap appends a
-    "resume" event to `events`.
+    `run` holds the poses solved so far (`Q`, `solved`). A pose after a gap (poses with no
+    assembly) resumes in the mode of every Assur group it left where that mode assembles, and
+    appends a "resume" event saying so: "branch" "same", or "other" with the `groups` (their
+    links) whose mode changed.
     """
     u = U[k]
     if j is None:
@@ -33,50 +39,47 @@ def careful_pose(model: Model, m: Mechanism, U, p, L, guess, k: int, j: int | No
     sol = _continue(model, run.Q[j], U[j], u, p, L, depth=8 if fresh else 0, prev=prev)
     if sol is None:
         sol = _recover(model, m, (run.Q[j], U[j]), u, p, L)
-    if sol.ok and not fresh:  # back in range: on the same branch if it exists; say which
-        before = Solution(run.Q[j], 0.0, 0, True, model.jac(run.Q[j], U[j], p))
-        sign, before = _det_sign(model, sol, L), _det_sign(model, before, L)
-        if 0 not in (sign, before) and sign != before:
-            alt = _same_branch_assembly(model, m, u, p, L, before, run.Q[j], U[j])
+    if sol.ok and not fresh:  # back in range: in the modes it left where they assemble
+        before = modes(model, model.jac(run.Q[j], U[j], p), L)[0]
+        after = modes(model, sol.J, L)[0]
+        changed = np.flatnonzero((before != after) & (before != 0) & (after != 0))
+        if changed.size:  # first the modes it left, group by group
+            alt = assemble(model, u, p, L, want=before, near=run.Q[j])
             if alt is not None:
-                sol, sign = alt, before
-        events.append({"kind": "resume", "pose": int(k),
-                       "branch": "same" if sign == before or 0 in (sign, before) else "other"})
+                got = modes(model, alt.J, L)[0]
+                moved = np.flatnonzero((before != got) & (before != 0) & (got != 0))
+                if moved.size < changed.size:
+                    sol, changed = alt, moved
+        names = group_links(model)
+        events.append({"kind": "resume", "pose": int(k), "branch": "other" if changed.size else "same"}
+                      | ({"groups": [names[i] for i in changed]} if changed.size else {}))
     return sol
 
 
 # --- one pose: from the guess, from the previous pose, after a failure ---
 
 
-def _first(model: Model, u, p, L, guess) -> Solution:
-    return model.assemble(u, p, guess, L)  # Newton from the guess, else IPOPT; gears settled
-
-
 def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:
-    """Continuation failed: Newton straight from the last pose, then IPOPT (nearest assembly)."""
+    """Continuation failed: Newton straight from the last pose, kept only where every group
+    stays in its mode; otherwise (and where Newton fails) the assembly in the last pose's
+    modes, group by group; IPOPT only where that is not conclusive (`_ambiguous`)."""
+    want = modes(model, model.jac(last[0], last[1], p), L)[0]
     sol = model.newton(last[0], u, p, L)
-    if not sol.ok:
+    if sol.ok:
+        got = modes(model, sol.J, L)[0]
+        if not np.any((got != want) & (got != 0) & (want != 0)):
+            return sol
+    alt = assemble(model, u, p, L, want=want, near=last[0])
+    if alt is not None:
+        got = modes(model, alt.J, L)[0]
+        if not np.any((got != want) & (got != 0) & (want != 0)) or not sol.ok:
+            return alt  # in the modes left, or (none there) another: the sweep's events say it
+    if sol.ok:
+        return sol  # only another mode assembles here: a crossing, which the events flag
+    if _ambiguous(model):
         pts = model.points(last[0], last[1], p)
-        sol = model.nearest_assembly(last[0], u, p, {nm: pts[:, j] for j, nm in enumerate(m.moving_points)}, L)
-    return sol
-
-
-def _same_branch_assembly(model: Model, m: Mechanism, u, p, L, sign, q_last, u_last):
-    """Back in range after a gap (a limit, where the branches meet): the assembly whose
-    det(g_q) has the given sign, nearest the last solved pose; None if there is none.
-    The assemblies come from scattered starts, as `kincas modes` finds them."""
-    from .modes import find_modes
-    try:
-        modes = find_modes(m, {i.key: float(v) for i, v in zip(m.inputs, u)}, starts=128)
-    except ModelError:
-        return None
-    last = model.points(q_last, u_last, p)
-    near = [(float(np.linalg.norm(model.points(md.q, u, p) - last)), md.q)
-            for md in modes if md.orientation == sign]
-    if not near:
-        return None
-    sol = model.newton(min(near, key=lambda t: t[0])[1], u, p, L)
-    return sol if sol.ok and _det_sign(model, sol, L) == sign else None
+        return model.nearest_assembly(last[0], u, p, {nm: pts[:, j] for j, nm in enumerate(m.moving_points)}, L)
+    return _no_assembly(model, last[0])
 
 
 def _scaled_norm(model: Model, dq, L) -> float:
@@ -97,18 +100,52 @@ def _continue(model: Model, q0, u0, u1, p, L, depth: int, prev=None) -> Solution
     if pred is None:
         pred = q0 + model.tangent(q0, u0, p) @ (u1 - u0)
     sol = model.newton(pred, u1, p, L)
-    if sol.ok and depth == 0:
-        return sol
+    if sol.ok and depth == 0:  # the shortest step: a group may change mode only by crossing
+        # a singular position of its own that lies in this step (else it jumped branch)
+        return sol if _same_branch(model, J0, sol, L) or _crossed(model, q0, u0, u1, J0, sol, p, L) else None
     if sol.ok:
         moved = _scaled_norm(model, pred - q0, L)
         far = _scaled_norm(model, sol.q - pred, L) > max(0.02, 0.5 * moved)
-        if sol.iterations <= 8 and not far and _same_branch(model, J0, sol, L):
+        if sol.iterations <= 8 and not far and _same_branch(model, J0, sol, L) \
+                and not _passes_singular(model, q0, u0, u1, J0, sol, p, L):
             return sol
     if depth == 0:
         return None
     um = 0.5 * (u0 + u1)
     mid = _continue(model, q0, u0, um, p, L, depth - 1, prev)
     return None if mid is None else _continue(model, mid.q, um, u1, p, L, depth - 1, (q0, u0))
+
+
+def _passes_singular(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
+    """Whether a group that is not well conditioned at either end of the step has a singular
+    position inside it: then Newton may have landed on the other branch through a change
+    point with its mode unchanged (branches cross there), and the step must be cut."""
+    from .singular import locate_singular
+    c = np.minimum(modes(model, J0, L)[1], modes(model, sol.J, L)[1])
+    for i in np.flatnonzero(c < WATCH):
+        s = locate_singular(model, q0, u0, p, L, u1 - u0, max_iter=2, group=int(i), probe=True)
+        if s is None or not -0.5 < s < 1.5:  # two extended Newton steps: not in this step
+            continue
+        found = locate_singular(model, q0, u0, p, L, u1 - u0, group=int(i))
+        if found is not None and 0 < found[2] < 1:
+            return True
+    return False
+
+
+def _crossed(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
+    """Whether every group whose mode differs between J0 (at u0) and sol (at u1) has a
+    singular position of its own between u0 and u1 (located from the nearer end)."""
+    from .singular import locate_singular
+    s0, c0 = modes(model, J0, L)
+    s1, c1 = modes(model, sol.J, L)
+    for i in np.flatnonzero((s0 != s1) & (s0 != 0) & (s1 != 0)):
+        start, d = ((q0, u0), u1 - u0) if c0[i] <= c1[i] else ((sol.q, u1), u0 - u1)
+        if min(c0[i], c1[i]) < NEAR and polish_singular(model, *start, p, L, [int(i)]) is not None:
+            continue  # that end is the singular position (within rounding)
+        found = locate_singular(model, start[0], start[1], p, L, d, group=int(i))
+        if found is None or not -1e-9 <= found[2] <= 1 + 1e-9:
+            return False
+    return True
 
 
 def _ill(model: Model, J, L) -> bool:
@@ -136,33 +173,27 @@ def _secant(q0, u0, u1, prev):
     return q0 + (q0 - qp) * t
 
 
-def _scaled_det(model: Model, J, L) -> float:
-    # Columns scaled to O(1) so the determinant's size means the same at every scale.
-    return float(np.linalg.det(J * model.column_scale(L))) if J.size else 1.0
-
-
 def _det_sign(model: Model, sol: Solution, L) -> int:
-    """The sign of det(g_q), which tells the assembly branches apart; 0 near a singular
-    position, and for a tall g_q (redundant joints), which has no determinant."""
+    """The sign of det(g_q) (the product of the groups' modes); 0 near a singular position,
+    and for a tall g_q (redundant joints), which has no determinant."""
     if not model.square:
         return 0
-    d = _scaled_det(model, sol.J, L)
-    return 0 if abs(d) < 1e-8 else int(np.sign(d))
+    return int(np.prod(modes(model, sol.J, L)[0]))
 
 
 def _same_branch(model: Model, J0, sol: Solution, L) -> bool:
-    """Whether det(g_q) kept its sign from J0 to sol.J (or either is nearly singular).
+    """Whether every Assur group kept its mode from J0 to sol.J (or is nearly singular at
+    either: there the mode is not defined, and the sweep's events locate the crossing).
 
     A tall g_q (redundant joints) has no determinant, but a relative invariant serves:
     with J0 = Q0 R0 (Q0 an orthonormal basis of J0's column space), det(Q0' J) is
     continuous in J and equals det R0 at J0, so it changes sign only where Q0' J is
     singular: det(Q0' J1) and det(R0) of opposite signs mean a singular position was
-    crossed, exactly as det g_q's sign change does for a square system (for which
-    this is the same test: Q0 is square and orthogonal)."""
-    c = model.column_scale(L)
+    crossed, exactly as det g_q's sign change does for a square system."""
     if model.square:
-        d0, d1 = _scaled_det(model, J0, L), _scaled_det(model, sol.J, L)
-    else:
-        Q0, R0 = np.linalg.qr(J0 * c)
-        d0, d1 = float(np.prod(np.diag(R0))), float(np.linalg.det(Q0.T @ (sol.J * c)))
+        s0, s1 = modes(model, J0, L)[0], modes(model, sol.J, L)[0]
+        return not np.any((s0 != s1) & (s0 != 0) & (s1 != 0))
+    c = model.column_scale(L)
+    Q0, R0 = np.linalg.qr(J0 * c)
+    d0, d1 = float(np.prod(np.diag(R0))), float(np.linalg.det(Q0.T @ (sol.J * c)))
     return np.sign(d0) == np.sign(d1) or min(abs(d0), abs(d1)) < 1e-8

@@ -39,6 +39,7 @@ import numpy as np
 from ..errors import ModelError, SceneError
 from ..model.mechanism import Mechanism
 from ..results import wrap_angle
+from ..core.assembly import first_pose
 from ..core.scatter import newton_starts
 from ..core.numeric import model_of
 from ..core.tolerances import ACCEPT, BRANCH
@@ -110,7 +111,7 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
     Q = Q[_unique(_point_rows(model, Q, u, p), 10 * SAME * L)]  # many starts, few modes
 
     found = [sol.q for sol in (model.newton(q, u, p, L) for q in Q) if sol.ok]  # polish
-    first = model.assemble(u, p, guess, L)  # the assembly a sweep from the guess starts on
+    first = first_pose(model, u, p, L, guess)  # the assembly a sweep from the guess starts on
     picked = first.q if first.ok else None
     from ..frames import Modes  # a list, with to_pandas() and to_xarray()
     return Modes(_distinct(m, model, found + ([picked] if picked is not None else []), u, p, L, picked))

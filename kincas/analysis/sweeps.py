@@ -26,6 +26,7 @@ from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
 from ..core.symbolic import default_report, needs_jerk
 from .continuation import careful_pose
+from .events import null_derivatives
 from ..core.joints import check_first_pose
 from .inputs import input_table as _input_table
 
@@ -90,7 +91,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
     status = ["ok"] * n if ok.all() else ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
-    events += _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma)
+    found, at = _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma)
+    events += found
     values = run.values
     if jerks is not None:  # the inputs' jerks enter only the third derivatives
         Uddd = np.broadcast_to(_input_table(m, jerks, "jerks", 0.0), U.shape)
@@ -101,6 +103,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
             got = np.asarray(f(Q[ok].T, U[ok].T, rep, Ud[ok].T, Udd[ok].T, Uddd[ok].T))
             values = np.array(values, dtype=float)
             values[np.ix_(third, np.flatnonzero(ok))] = got
+    null_derivatives(model, report, values, Q, U, p, at)  # no wrong number at a singular pose
     keys = [i.key for i in m.inputs]
     events.sort(key=lambda e: e["pose"])
     for e in events:
@@ -143,27 +146,32 @@ def _careful_only(model, report, U, Ud, Udd, p, L, careful, progress) -> _Carefu
 
 
 def _measures(model: Model, J, ok, L):
-    """What the fast kernel gives per pose, from g_q at every pose: an orientation that
-    changes sign where the sweep crosses a singular position ((N, 1), 0 where unsolved) and
-    the smallest singular value of the scaled g_q relative to max(1, its largest)."""
+    """What the fast kernel gives per pose, from g_q at every pose: each group's mode (N,
+    groups), or for a tall g_q an orientation that changes sign where the sweep crosses a
+    singular position ((N, 1)), 0 where unsolved; and the smallest singular value of the
+    scaled g_q relative to max(1, its largest) (a group's conditioning, for a square one)."""
     n, idx = len(ok), np.flatnonzero(ok)
     dets, sigma = np.zeros(n), np.full(n, np.nan)
     if model.nq == 0 or not len(idx):
         return dets[:, None], sigma
+    if model.square:  # each Assur group's mode, as the kernel gives it (see core/assembly.py)
+        from ..core.assembly import modes
+        signs = np.zeros((n, len(model.blocks)))
+        signs[idx], cond = modes(model, J[idx], L)
+        sigma[idx] = cond.min(axis=1, initial=1.0)
+        return signs, sigma
+    # tall (redundant joints): no determinant, so chain the relative test of _same_branch
+    # along the sweep: the orientation flips from pose k to the next where det(Q_k' J_next)
+    # and det R_k differ in sign (J_k = Q_k R_k).
     J = J[idx] * model.column_scale(L)
-    if model.square:
-        dets[idx] = np.linalg.det(J)
-    else:  # tall (redundant joints): no determinant, so chain the relative test of
-        # _same_branch along the sweep: the orientation flips from pose k to the next where
-        # det(Q_k' J_next) and det R_k differ in sign (J_k = Q_k R_k).
-        Qk, Rk = np.linalg.qr(J)
-        dR = np.prod(np.diagonal(Rk, axis1=1, axis2=2), axis=1)
-        o = 1.0
-        for a in range(len(idx)):
-            dets[idx[a]] = o * abs(dR[a])
-            if a + 1 < len(idx):
-                flip = np.sign(dR[a]) * np.sign(np.linalg.det(Qk[a].T @ J[a + 1]))
-                o = o * flip if flip != 0 else o
+    Qk, Rk = np.linalg.qr(J)
+    dR = np.prod(np.diagonal(Rk, axis1=1, axis2=2), axis=1)
+    o = 1.0
+    for a in range(len(idx)):
+        dets[idx[a]] = o * abs(dR[a])
+        if a + 1 < len(idx):
+            flip = np.sign(dR[a]) * np.sign(np.linalg.det(Qk[a].T @ J[a + 1]))
+            o = o * flip if flip != 0 else o
     sv = np.linalg.svd(J, compute_uv=False)
     sigma[idx] = sv[:, -1] / np.maximum(sv[:, 0], 1.0)
     return np.sign(dets)[:, None], sigma
@@ -179,56 +187,15 @@ def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 # --- singular positions met by a sweep ---
 
 
-def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, signs, sigma) -> list[dict]:
-    """Flag solved poses at or next to a singular position and locate it exactly.
-
-    A limit lies between a solved pose and a neighbour with no assembly; a sign change of
-    det(g_q) (of any Assur group's block of it) between two solved neighbours means the
-    sweep crossed a singular position (a change point, or a limit met exactly); a pose whose
-    scaled g_q is numerically singular is flagged where it stands.
+def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, signs, sigma):
+    """Flag solved poses at or next to a singular position and locate it exactly, one event
+    per Assur group (kincas/analysis/events.py). Returns (events, at: the poses exactly at a
+    singular position, which it moved onto it).
 
     `signs` (N, groups) and `sigma` (N) come with the solve (the fast kernel computes them at
     every pose, kincas/core/blocks.py): sigma is a lower bound of the smallest singular value
-    of a group's scaled block, so only the few poses where it is small get the exact test
-    (the singular values of the whole scaled g_q) here.
+    of a group's scaled block, so only the few poses where it is small, and the ends of a
+    change of a group's sign, get exact per-group measures.
     """
-    from .singular import FLAG_SIGMA, classify, locate_singular, scaled_jacobians
-    n, events = len(ok), []
-    if model.nq == 0 or m.inputs == () or n == 0:
-        return events
-    idx = np.flatnonzero(ok)
-    # a group's bound can sit below the whole matrix's smallest singular value by the
-    # coupling between groups (O(1) once scaled): 1e3 of margin before the exact test
-    maybe = idx[~(sigma[idx] > 1e3 * FLAG_SIGMA)]
-    for k in maybe:
-        J, Gu = scaled_jacobians(model, Q[k], U[k], p, L)
-        sv = np.linalg.svd(J, compute_uv=False)
-        if sv[-1] <= FLAG_SIGMA * max(sv[0], 1.0):
-            flags[k] = classify(J, Gu)
-    # Only a solved pose next to an unsolved one, or before a sign change of det g_q, can hold
-    # an event: look at those alone (a sweep of 10^5 poses has a handful).
-    flips = np.r_[np.any(signs[:-1] != signs[1:], axis=1), False] if n else np.zeros(0, bool)
-    before = np.r_[False, ~ok[:-1]]
-    after = np.r_[~ok[1:], False]
-    change = np.r_[ok[:-1] & ok[1:], False] & flips
-    for k in idx[before[idx] | after[idx] | change[idx]]:
-        for nb in (k - 1, k + 1):
-            if not 0 <= nb < n:
-                continue
-            crossing = ok[nb] and nb == k + 1 and flips[k]
-            if ok[nb] and not crossing:
-                continue
-            if np.allclose(U[nb], U[k]):
-                continue
-            found = locate_singular(model, Q[k], U[k], p, L, direction=U[nb] - U[k])
-            if found is None:
-                continue
-            s = found[2]
-            if not (-1e-9 <= s <= 1 + 1e-9):
-                continue  # the singular position found is not between these two poses
-            kind = classify(*scaled_jacobians(model, found[0], found[1], p, L), tol=1e-6) or "singular"
-            at = k if (not ok[nb] or s <= 0.5) else nb
-            flags[at] = flags[at] or kind
-            events.append({"kind": kind, "pose": int(at),
-                           "inputs": {i.key: float(v) for i, v in zip(m.inputs, found[1])}})
-    return events
+    from .events import sweep_events
+    return sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma)

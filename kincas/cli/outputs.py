@@ -289,6 +289,16 @@ def check_outputs(args, mechanism=None, poses: int | None = None) -> None:
         bad = [p for p in _names(args.paths) if p not in known]
         if bad:
             _fail(f"--paths: unknown point(s) {', '.join(bad)} (points: {', '.join(sorted(known))})")
+    geo = {k: _names(getattr(args, k, None) or "") for k in ("evolute", "centrodes")}
+    if any(geo.values()):
+        if not getattr(args, "plot", None):
+            _fail("--evolute, --centrodes: they draw on the picture of --plot OUT.png; give --plot")
+        if mechanism is not None:
+            from .draw_geometry import check_geometry
+            try:
+                check_geometry(mechanism, geo["evolute"], geo["centrodes"])
+            except ValueError as e:
+                _fail(str(e))
 
 
 def check_path(flag: str, path, formats=None) -> None:
@@ -341,7 +351,9 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
     inputs = scene.user_inputs(sweep)
     captions = [_caption(scene, sweep, inputs, i) for i in range(len(sweep))]
     jobs = [("csv", lambda p: write_csv(p, sweep, scene)),
-            ("plot", lambda p: _save_drawing(p, m, sweep, pose, paths, captions, length)),
+            ("plot", lambda p: _save_drawing(p, m, sweep, pose, paths, captions, length,
+                                             _names(getattr(args, "evolute", None) or ""),
+                                             _names(getattr(args, "centrodes", None) or ""))),
             ("animate", lambda p: _animate(p, m, sweep, paths, captions, length, _rendering(args))),
             ("plot_quantities", lambda p: plot_quantities(sweep, scene=scene).savefig(p, dpi=100)),
             ("html", lambda p: _html(p, m, sweep, scene, paths)),
@@ -391,11 +403,14 @@ def _caption(scene, sweep, inputs, i) -> str:
     return head + ", ".join(parts) + ("" if sweep.status[i] == "ok" else f" ({sweep.status[i]})")
 
 
-def _save_drawing(path, m, sweep, pose, paths, captions, length):
+def _save_drawing(path, m, sweep, pose, paths, captions, length, evolute=(), centrodes=()):
     from .plot import default_pose, draw, new_figure
     fig = new_figure()
     i = default_pose(sweep) if pose is None else pose % len(sweep)
-    draw(m, sweep, i, ax=fig.subplots(), paths=paths, title=captions[i], units=length)
+    ax = draw(m, sweep, i, ax=fig.subplots(), paths=paths, title=captions[i], units=length)
+    if evolute or centrodes:  # kinematic geometry over the drawing (kincas/cli/draw_geometry.py)
+        from .draw_geometry import draw_geometry
+        draw_geometry(ax, m, sweep, i, evolute, centrodes)
     fig.savefig(path, dpi=100)
 
 

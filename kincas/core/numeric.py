@@ -324,17 +324,6 @@ class Model:
                 known.setdefault(pt, origin + R @ loc[(lname, pt)])
         return _joints.place(self, q, u, p)  # cams' contact parameters; angles in (-pi, pi]
 
-    def assemble(self, u, p, guess: dict[str, tuple[float, float]], L: float) -> Solution:
-        """The assembly the guessed points lead to: Newton from the placement they give
-        (`initial_q`), and where that fails IPOPT's assembly nearest the guessed points;
-        gears' angles then settled in (-pi, pi] (kincas/core/joints.py). This is where
-        every sweep starts."""
-        q0 = self.initial_q(u, p, guess, L)
-        sol = self.newton(q0, u, p, L)
-        if not sol.ok:
-            sol = self.nearest_assembly(q0, u, p, {k: np.array(v) for k, v in guess.items()}, L)
-        return _joints.settle_first(self, sol, u, p, L)
-
     # --- IPOPT: the assembly nearest to target positions ---
     def nearest_assembly(self, q0, u, p, targets: dict[str, np.ndarray], L) -> Solution:
         """min sum |P - target|^2 subject to g = 0, by IPOPT (scaled by the size L)."""

@@ -1,0 +1,158 @@
+"""Singular positions met by a sweep, group by group, from per-pose measures.
+
+The sweep hands over, for every solved pose, each Assur group's mode (the sign of its block
+of g_q's determinant) and conditioning (its block's sigma_min / sigma_max, columns scaled to
+O(1): a pure number, the same at 1e-6 m and at 1e6 m); see kincas/core/assembly.py. Then:
+
+- a pose where a group's conditioning is below NEAR may sit *at* a singular position (Newton
+  stops about sqrt(TOL) from one): `polish_singular` decides, and where it converges the
+  pose is moved exactly onto it, flagged, and its velocities and accelerations are null
+  (g_q has no inverse there: `null_derivatives`), so no wrong number is ever reported;
+- a group whose mode differs between two consecutive solved poses crossed a singular
+  position of its own: located and flagged, one event per group (two loops folding at once
+  are two events, although det g_q keeps its sign); a change that cannot be located is
+  still an event (kind "singular");
+- a solved pose next to one with no assembly: the limit of each group that lies between
+  them is located;
+- a pose whose whole g_q is numerically singular is flagged where it stands.
+
+Events carry "kind", "pose", "inputs" and "group" (the links of the group concerned).
+
+>>> import numpy as np, kincas
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 4),
+...            kincas.Link.bar("rocker", "D", "C", 1)],
+...     inputs=[kincas.Input.angle("crank")], guess={"C": (4.5, 0.87)})
+>>> sw = kincas.sweep(m, {"crank.angle": np.radians([150.0, 180.0])}, report=["C.y", "C.vy"])
+>>> sw.flags[1], abs(float(sw["C.y"][1])) < 1e-12, bool(np.isnan(sw["C.vy"][1]))
+('change point', True, True)
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.assembly import NEAR, group_links, modes, polish_singular
+from ..core.symbolic import parse_quantity
+from .singular import FLAG_SIGMA, classify, locate_singular, scaled_jacobians
+
+MAX_GROUPS_AT_GAP = 8  # groups tried for a limit next to a gap (the worst conditioned first)
+
+
+# --- the events of a sweep ---
+
+
+def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma):
+    """Events and flags of a sweep from the per-pose measures the solve gives.
+
+    Parameters
+    ----------
+    model : kincas.core.numeric.Model
+    m : kincas.Mechanism
+    U, Q : numpy.ndarray
+        Inputs (n, nu) and unknowns (n, nq) per pose; Q is updated where a pose is moved
+        exactly onto a singular position.
+    ok : numpy.ndarray of bool
+        Which poses are solved.
+    flags : list
+        One entry per pose, filled in place.
+    signs : numpy.ndarray
+        (n, groups): each group's mode, the sign of its block's determinant (for a tall g_q,
+        one relative orientation per pose, see `tall_orientation`).
+    sigma : numpy.ndarray
+        (n,): a lower bound of the groups' conditioning; only poses where it is small, and
+        the ends of a change, get the exact per-group measures (`modes`) here.
+
+    Returns
+    -------
+    events : list of dict
+    at : numpy.ndarray of bool
+        The poses at a singular position (their velocities and accelerations are null).
+    """
+    n = len(ok)
+    at = np.zeros(n, dtype=bool)
+    events: list[dict] = []
+    if model.nq == 0 or not m.inputs or n == 0:
+        return events, at
+    signs = np.nan_to_num(np.asarray(signs, float)).astype(int)
+    sigma = np.asarray(sigma, float)
+    names = group_links(model)
+    keys = [i.key for i in m.inputs]
+    exact: dict = {}
+
+    def measure(k):  # (modes, conditioning) of every group at pose k, from g_q there
+        if k not in exact:
+            exact[k] = modes(model, model.jac(Q[k], U[k], p), L)
+        return exact[k]
+
+    def event(kind, pose, u, group):
+        flags[pose] = flags[pose] or kind
+        events.append({"kind": kind, "pose": int(pose),
+                       "inputs": {k: float(v) for k, v in zip(keys, u)}, "group": names[group]})
+
+    def kind_at(q, u, tol=1e-6):
+        return classify(*scaled_jacobians(model, q, u, p, L), tol=tol) or "singular"
+
+    # poses at a singular position: exactly onto it, flagged, one event per group
+    for k in np.flatnonzero(ok & ~(sigma > NEAR)):
+        groups = [int(i) for i in np.flatnonzero(measure(k)[1] < NEAR)]
+        q = polish_singular(model, Q[k], U[k], p, L, groups) if groups else None
+        if q is None:
+            continue
+        Q[k], at[k] = q, True
+        exact.pop(k)
+        signs[k, groups if signs.shape[1] == len(names) else 0] = 0
+        kind = kind_at(q, U[k])
+        flags[k] = kind
+        for i in groups:
+            event(kind, k, U[k], i)
+    # poses whose g_q is numerically singular as a whole, flagged where they stand
+    for k in np.flatnonzero(ok & ~at & ~(sigma > 1e3 * FLAG_SIGMA)):
+        J, Gu = scaled_jacobians(model, Q[k], U[k], p, L)
+        sv = np.linalg.svd(J, compute_uv=False)
+        if sv[-1] <= FLAG_SIGMA * max(sv[0], 1.0):
+            flags[k] = flags[k] or classify(J, Gu)
+    # a group changing mode between two solved poses crossed a singular position of its own
+    for k in np.flatnonzero(ok[:-1] & ok[1:]):
+        a, b = signs[k], signs[k + 1]
+        for i in np.flatnonzero((a != b) & (a != 0) & (b != 0)):
+            c0, c1 = measure(k)[1][i], measure(k + 1)[1][i]
+            start, other = (k, k + 1) if c0 <= c1 else (k + 1, k)
+            found = locate_singular(model, Q[start], U[start], p, L, U[other] - U[start], group=int(i))
+            if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
+                pose = start if found[2] <= 0.5 else other
+                event(kind_at(found[0], found[1]), pose, found[1], int(i))
+            else:  # crossed, but not located: said all the same
+                event("singular", k + 1, U[k + 1], int(i))
+    # a solved pose next to one with no assembly: the limits between them
+    for k in np.flatnonzero(ok):
+        for nb in (k - 1, k + 1):
+            if not 0 <= nb < n or ok[nb] or np.allclose(U[nb], U[k]):
+                continue
+            for i in np.argsort(measure(k)[1])[:MAX_GROUPS_AT_GAP]:
+                found = locate_singular(model, Q[k], U[k], p, L, U[nb] - U[k], group=int(i))
+                if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
+                    event(kind_at(found[0], found[1]), k, found[1], int(i))
+    return events, at
+
+
+# --- values at a singular pose ---
+
+
+def null_derivatives(model, report, values, Q, U, p, at) -> None:
+    """At poses exactly at a singular position (`at`): positions recomputed from the exact
+    pose, every quantity that needs g_q's inverse (velocities, accelerations, sensitivities)
+    set to NaN. The flag says why."""
+    idx = np.flatnonzero(at)
+    if idx.size == 0 or not report:
+        return
+    plain = []
+    for r, name in enumerate(report):
+        kind, obj, attr = parse_quantity(name)
+        _, order = model.sym.position_expr(obj, attr) if kind == "plain" else (None, None)
+        plain.append(order == 0)
+    plain = np.array(plain)
+    if plain.any():
+        names = [nm for nm, keep in zip(report, plain) if keep]
+        zeros = np.zeros((idx.size, model.nu))
+        values[np.ix_(np.flatnonzero(plain), idx)] = model.quantities(names, Q[idx], U[idx], p, zeros, zeros)
+    values[np.ix_(np.flatnonzero(~plain), idx)] = np.nan

@@ -1,0 +1,316 @@
+"""Assembly group by group: each Assur group's mode, its conditioning, and a pose built without
+a guess.
+
+g_q in block-triangular form has one irreducible diagonal block per Assur group (a dyad's block
+is 2 x 2); the equations of block i involve only the unknowns of blocks 0..i. So:
+
+- a group's **assembly mode** is the sign of its block's determinant, det(g_q[rows, cols]):
+  for a dyad it is exactly which of its two circle intersections it takes. A pose's mode is
+  the vector of these signs, one per group; det g_q (their product) cannot tell (+, +) from
+  (-, -), the vector can.
+- a group's **conditioning** is its block's smallest singular value relative to its largest,
+  columns scaled to O(1) (angles times a length, lengths as ratios): a pure number, the same
+  for a mechanism of 1e-6 m and of 1e6 m. It is 0 where the group is at a singular position.
+- a pose is **assembled** group by group in solve order: each block by a small Newton on its
+  own equations (the blocks before it fixed) from a few starts, keeping the solution in the
+  wanted mode (default +1: the mode whose block determinant is positive) nearest a reference
+  pose. A group with no solution from any start has no assembly there: that is decided in a
+  few block Newton steps, without an optimiser.
+- at a pose at (or within rounding of) a singular position, `polish_singular` puts the
+  unknowns exactly on it: Gauss-Newton on g = 0, g_q[rows, cols] v = 0, v0.v = 1 at fixed
+  inputs, which converges quadratically where plain Newton crawls (g_q singular).
+
+>>> import numpy as np, kincas
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
+>>> model = kincas.compile(m)
+>>> sol = assemble(model, np.array([0.0]), np.zeros(0), m.size())
+>>> sol.ok, modes(model, sol.J, m.size())[0].tolist()  # no guess needed: the default mode
+(True, [1])
+"""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+from .newton import newton
+from .joints import settle_first
+from .numeric import Solution
+from .tolerances import ACCEPT, TOL
+
+SIGN_TOL = 1e-8  # a block whose conditioning is below this has no trustworthy sign (mode 0)
+# Newton converges only linearly onto a singular position, and stops about sqrt(TOL) from
+# it: a group conditioned below NEAR may be *at* one; `polish_singular` decides.
+NEAR = 1e-5
+
+
+# --- the groups: blocks of g_q ---
+
+
+def blocks(model) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(rows, cols) of each Assur group's block of g_q, in solve order (a block's equations
+    involve only its own unknowns and those of the blocks before it).
+
+    The blocks are `model.blocks` where the model has them, else the block-triangular form of
+    g_q's sparsity (`casadi.Sparsity.btf`); either way they are put in an order that g_q's
+    sparsity proves a solve order. A tall g_q (redundant joints) or a structurally singular
+    one is a single block."""
+    memo = model.__dict__.setdefault("_assembly_blocks", [])
+    if memo:
+        return memo[0]
+    nq, ng = model.nq, model.ng
+    own = getattr(model, "blocks", None)
+    if own is not None:  # already in solve order (kincas/core/structure.py)
+        memo.append([(np.asarray(b.rows, int), np.asarray(b.cols, int)) for b in own])
+        return memo[0]
+    else:
+        out = []
+        if nq and ng == nq:
+            nb, rp, cp, rb, cb, _, ccb = model.sym.Jq.sparsity().btf()
+            if ccb[3] == nq:
+                out = [(np.array(sorted(rp[rb[k]:rb[k + 1]]), dtype=int),
+                        np.array(sorted(cp[cb[k]:cb[k + 1]]), dtype=int)) for k in range(nb)]
+    if nq and not out:
+        out = [(np.arange(ng), np.arange(nq))]
+    memo.append(_solve_order(model, out))
+    return memo[0]
+
+
+def _solve_order(model, bl):
+    """The blocks sorted so that each one's equations use unknowns of blocks before it only
+    (a topological order of the dependencies that g_q's sparsity shows)."""
+    sp = model.sym.Jq.sparsity()
+    nz = np.zeros((model.ng, model.nq), dtype=bool)
+    r, c = sp.get_triplet()
+    nz[np.asarray(r, int), np.asarray(c, int)] = True
+    needs = [{j for j, (_, cb) in enumerate(bl) if j != i and nz[np.ix_(rows, cb)].any()}
+             for i, (rows, _) in enumerate(bl)]
+    order, done = [], set()
+    while len(order) < len(bl):
+        ready = [i for i in range(len(bl)) if i not in done and needs[i] <= done]
+        if not ready:  # not triangular after all: one block
+            return [(np.arange(model.ng), np.arange(model.nq))]
+        order += ready
+        done |= set(ready)
+    return [bl[i] for i in order]
+
+
+def group_links(model) -> list[list[str]]:
+    """The links whose unknowns each group solves (how events and resumes name a group)."""
+    names = [nm.split(".")[0] for nm, _ in model.sym.unknowns]
+    return [sorted({names[j] for j in cols}) for _, cols in blocks(model)]
+
+
+def modes(model, J, L) -> tuple[np.ndarray, np.ndarray]:
+    """(mode, conditioning) of every group at one pose or many: J is g_q, (ng, nq) or
+    (n, ng, nq). mode is the sign of the block's determinant (0 where the block is within
+    SIGN_TOL of singular, or tall); conditioning is sigma_min / sigma_max of the block with
+    its columns scaled to O(1)."""
+    J = np.asarray(J, float)
+    one = J.ndim == 2
+    J = J[None] if one else J
+    n, bl = J.shape[0], blocks(model)
+    sign, cond = np.zeros((n, len(bl)), int), np.zeros((n, len(bl)))
+    c = model.column_scale(L)
+    for i, (rows, cols) in enumerate(bl):
+        B = J[:, rows][:, :, cols] * c[cols]
+        good = np.isfinite(B).all(axis=(1, 2))
+        if not good.any():
+            continue
+        s = np.linalg.svd(B[good], compute_uv=False)
+        cond[good, i] = s[:, -1] / np.maximum(s[:, 0], np.finfo(float).tiny)
+        if B.shape[1] == B.shape[2]:
+            sign[good, i] = np.sign(np.linalg.det(B[good])) * (cond[good, i] >= SIGN_TOL)
+    return (sign[0], cond[0]) if one else (sign, cond)
+
+
+# --- group by group assembly ---
+
+
+def _block_newton(model, q, u, p, L, i, max_iter=30):
+    """The one Newton (kincas/core/newton.py) on group i alone, the other unknowns fixed, its
+    residual measured against its own length: (q, relative residual)."""
+    rows, cols = blocks(model)[i]
+    eq, qs = model.scales(u, p) if hasattr(model, "scales") else (np.full(model.ng, L), np.where(model.sym.is_length, L, 1.0))
+    q = q.copy()
+    calls = model._block_calls() if hasattr(model, "_block_calls") else None
+    own = calls is not None and len(calls) == len(blocks(model))
+
+    def F(x):
+        q[cols] = x
+        if own:
+            g, J = calls[i](q, u, p)
+            return g.ravel().copy(), J.copy()
+        g, J = model.resjac(q, u, p)
+        return g[rows], J[np.ix_(rows, cols)]
+    res = newton(F, q[cols], qs[cols], eq[rows], max_iter=max_iter)
+    q[cols] = res.x
+    return q, res.residual
+
+
+def _starts(model, cols, L, near, count):
+    """Start values for a block's unknowns: the reference pose's first, then a spread."""
+    is_len = model.sym.is_length[cols]
+    out = [] if near is None else [np.asarray(near, float)[cols]]
+    k = len(cols)
+    grid = np.array([0.3, 2.4, -1.8, 1.2, -0.6, 3.0, -2.7, 0.9])
+    rng = np.random.default_rng(k)  # a local, seeded generator: reproducible starts
+    for i in range(count):
+        if k <= 2 and i < len(grid):  # a dyad: spread over both circles
+            v = np.array([grid[i], grid[(3 * i + 1) % len(grid)]])[:k]
+        else:
+            v = rng.uniform(-np.pi, np.pi, k)
+        out.append(np.where(is_len, v * L, v))
+    return out
+
+
+def _candidates(model, q, u, p, L, i, target, near, starts):
+    """Solutions of group i (the groups before it fixed in q): first one in mode `target`
+    (from the reference pose's start, then spread starts), then one in another mode."""
+    rows, cols = blocks(model)[i]
+    other = None
+    for s in _starts(model, cols, L, near, starts if len(cols) <= 2 else 4 * starts):
+        q0 = q.copy()
+        q0[cols] = s
+        qs, r = _block_newton(model, q0, u, p, L, i)
+        if r > ACCEPT:
+            continue
+        mode = modes(model, model.jac(qs, u, p), L)[0][i]
+        if mode == target:
+            yield qs
+            target = None  # one per mode
+        elif other is None and mode != 0:
+            other = qs
+        if target is None and other is not None:
+            break
+    if other is not None:
+        yield other
+
+
+def assemble(model, u, p, L, want=None, near=None, starts: int = 8) -> Solution | None:
+    """A pose assembled group by group, each group in its mode `want[i]` (+1 or -1; default
+    +1), the solution nearest `near` (unknowns of a reference pose) first. Where a group has
+    no assembly in the wanted mode, or the groups after it have none, its other mode is
+    tried. None where no combination assembles: decided by a few block Newton runs per
+    group, without an optimiser."""
+    bl = blocks(model)
+    u, p = np.asarray(u, float), np.asarray(p, float)
+
+    def place(i, q):
+        if i == len(bl):
+            return q
+        target = 1 if want is None or want[i] == 0 else int(want[i])
+        for qs in _candidates(model, q, u, p, L, i, target, near, starts):
+            done = place(i + 1, qs)
+            if done is not None:
+                return done
+        return None
+
+    q = place(0, np.zeros(model.nq) if near is None else np.array(near, float))
+    if q is None:
+        return None
+    sol = model.newton(q, u, p, L)  # the whole system, from the assembled groups: a polish
+    return sol if sol.ok else None
+
+
+# --- exactly at a singular position ---
+
+
+def _jv_function(model):
+    """f(q, u, p, v) -> (g, g_q v, d[g; g_q v]/dq, g_q): the singular-pose system's parts."""
+    memo = model.__dict__.setdefault("_assembly_jv", [])
+    if not memo:
+        sym = model.sym
+        v = ca.SX.sym("v", sym.nq)
+        Jv = ca.mtimes(sym.Jq, v)
+        F = ca.vertcat(sym.g, Jv)
+        memo.append(ca.Function("jv", [sym.q, sym.u, sym.p, v], [sym.g, Jv, ca.jacobian(F, sym.q), sym.Jq]))
+    return memo[0]
+
+
+def polish_singular(model, q, u, p, L, groups, max_iter: int = 30):
+    """The pose at inputs u where each group in `groups` (indices) is exactly singular,
+    from q nearby: Gauss-Newton on g(q) = 0 and, per group, g_q[rows, cols] v = 0 with
+    v0.v = 1. Returns q there, or None where no such pose lies within rounding of q (then
+    q is only near a singular position, and an ordinary pose)."""
+    f, bl = _jv_function(model), blocks(model)
+    nq, ng = model.nq, model.ng
+    c = model.column_scale(L)
+    vs, v0s = [], []
+    J = model.jac(q, u, p)
+    for i in groups:
+        rows, cols = bl[i]
+        v = np.linalg.svd(J[np.ix_(rows, cols)] * c[cols])[2][-1] * c[cols]
+        vs.append(v)
+        v0s.append(v / (v @ v))
+    q = np.array(q, float)
+    for it in range(max_iter + 1):
+        F, A = [], []
+        for k, i in enumerate(groups):
+            rows, cols = bl[i]
+            v = np.zeros(nq)
+            v[cols] = vs[k]
+            g, Jv, D, Jq = (np.asarray(a) for a in f(q, u, p, v))
+            if k == 0:
+                F.append(g.ravel() / L)
+                A.append(np.hstack([Jq / L, np.zeros((ng, sum(len(bl[j][1]) for j in groups)))]))
+            row = np.zeros((len(rows) + 1, nq + sum(len(bl[j][1]) for j in groups)))
+            row[:len(rows), :nq] = D[ng + rows]
+            off = nq + sum(len(bl[j][1]) for j in groups[:k])
+            row[:len(rows), off:off + len(cols)] = Jq[np.ix_(rows, cols)]
+            row[len(rows), off:off + len(cols)] = v0s[k]
+            A.append(row)
+            F.append(np.r_[Jv.ravel()[rows], v0s[k] @ vs[k] - 1])
+        F, A = np.concatenate(F), np.vstack(A)
+        if np.abs(F).max() <= 1e-14 or it == max_iter:
+            break
+        step = np.linalg.lstsq(A, -F, rcond=None)[0]
+        if not np.all(np.isfinite(step)):
+            return None
+        q = q + step[:nq]
+        off = nq
+        for k, i in enumerate(groups):
+            n = len(bl[i][1])
+            vs[k] = vs[k] + step[off:off + n]
+            off += n
+    if np.abs(F[:ng]).max() > TOL or np.abs(F[ng:]).max() > 1e-10:
+        return None
+    return q
+
+
+# --- the first pose: from the guess, or group by group ---
+
+
+def no_assembly(model, q) -> Solution:
+    return Solution(np.array(q, float), np.inf, 0, False, None)
+
+
+def ambiguous(model) -> bool:
+    """Whether group-by-group assembly may miss an assembly that exists: only a dyad's block
+    Newton from spread starts is conclusive (two circle or circle-line intersections); larger
+    groups and tall systems (redundant joints) get IPOPT as a last resort."""
+    return not model.square or any(len(c) > 2 for _, c in blocks(model))
+
+
+def first_pose(model, u, p, L, guess) -> Solution:
+    """The first pose of a sweep (and where `kincas modes` and `kincas range` start): from
+    the guessed points (the nearest assembly), or without a guess group by group in the
+    default modes (above)."""
+    return settle_first(model, _assembled(model, u, p, L, guess), u, p, L)  # gears: angles in (-pi, pi]
+
+
+def _assembled(model, u, p, L, guess) -> Solution:
+    if model.nq == 0:
+        return model.newton(np.zeros(0), u, p, L)
+    if not guess:
+        sol = assemble(model, u, p, L)
+        if sol is not None or not ambiguous(model):
+            return sol if sol is not None else no_assembly(model, np.zeros(model.nq))
+    q0 = model.initial_q(u, p, guess, L)
+    sol = model.newton(q0, u, p, L)
+    if not sol.ok and guess:  # group by group from the guessed pose, then IPOPT if in doubt
+        sol = assemble(model, u, p, L, near=q0) or sol
+    if not sol.ok and ambiguous(model):  # IPOPT: the assembly nearest the guessed points
+        sol = model.nearest_assembly(q0, u, p, {k: np.array(v) for k, v in guess.items()}, L)
+    return sol
