@@ -439,3 +439,38 @@ def test_html_page_draws_the_cam(tmp_path):
     px, py = round(ox + sx * x), round(oy - sx * y)
     assert any(max(abs(a - b) for a, b in zip(img.getpixel((px + dx, py + dy)), (0xC0, 0x39, 0x2B))) <= 40
                for dx in (-1, 0, 1) for dy in (-1, 0, 1))
+
+
+def test_optimize_a_cam_eccentricity(capsys, tmp_path):
+    """`kincas optimize` through a cam: the eccentricity giving the roller's centre a 30 mm
+    rise and fall over the turn (optimize locates the extremes between samples), checked with
+    the closed form (circle intersections) on a fine grid."""
+    sc = scene("roller_cam")
+    sc["optimize"] = {"vary": {"e": [5, 25]}, "minimize": "(max(F.y) - min(F.y) - 30)^2"}
+    code, out, err = run_cli(capsys, "optimize", write_scene(tmp_path, sc), "--json")
+    assert code == 0 and out["ok"], err
+    e = out["varied"]["e"]
+    th = np.linspace(0, 2 * np.pi, 720001)
+    c = e * np.stack([np.cos(th), np.sin(th)])
+    A = np.array([[60.0], [60.0]])
+    d = c - A
+    L = np.hypot(*d)
+    a = (55 ** 2 - 50 ** 2 + L * L) / (2 * L)
+    h = np.sqrt(55 ** 2 - a * a)
+    n = np.stack([-d[1], d[0]]) / L
+    F = A + a * d / L - h * n
+    assert np.ptp(F[1]) == pytest.approx(30, abs=1e-6)
+
+
+def test_study_refuses_designs_whose_gears_do_not_mesh(capsys, tmp_path):
+    """`kincas study` over the ring's radius: only rr = 60 (|60 - 15| = 45, the arm) meshes;
+    its arm turns at a third of the sun's rate 3 (Willis)."""
+    import csv
+    sc = scene("planetary")
+    sc["study"] = {"vary": {"rr": [59, 61]}, "grid": [3], "report": ["max(arm.omega)"]}
+    out_csv = tmp_path / "study.csv"
+    code, out, err = run_cli(capsys, "study", write_scene(tmp_path, sc), "--out", out_csv)
+    rows = list(csv.DictReader(open(out_csv, encoding="utf-8")))
+    assert [r["status"].split(" at ")[0] for r in rows] == ["gears do not mesh", "ok", "gears do not mesh"]
+    assert float(rows[1]["max(arm.omega)"]) == pytest.approx(1.0, abs=1e-12)
+    assert rows[0]["max(arm.omega)"] in ("", "nan")

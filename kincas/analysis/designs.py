@@ -54,8 +54,8 @@ from ..model.mechanism import Mechanism, as_param
 from .continuation import _continue, _det_sign, _first
 from .sweeps import _input_table
 
-OK, NO_ASSEMBLY, NOT_SOLVED, BRANCH_LOST = 0, 1, 2, 3
-STATUS = ("ok", "no assembly", "not solved", "branch lost")
+OK, NO_ASSEMBLY, NOT_SOLVED, BRANCH_LOST, NO_MESH = 0, 1, 2, 3, 4
+STATUS = ("ok", "no assembly", "not solved", "branch lost", "gears do not mesh")
 BLOCK = 32  # designs per C call (a thread's unit of work)
 STEP = 0.05  # largest parameter change per continuation step, relative to the size
 NEWTON = 8  # Newton iterations per continuation step at most
@@ -224,6 +224,7 @@ def sweep_designs(m: Mechanism, params, inputs=None, *, names=None, rates=None,
     if gaps == "resume":
         job.resume_gaps(names)
     job.fill_values()
+    job.check_gears()
     keys = [i.key for i in m.inputs]
     return DesignSweep(names=names, params=X, inputs={k: U[:, j].copy() for j, k in enumerate(keys)},
                        values={nm: job.vals[:, i, :] for i, nm in enumerate(report)}, code=job.code)
@@ -244,6 +245,19 @@ class _Job:
         nu = model.nu
         self.S = np.full((nd, nq + nq * nq + 2 * (nq * nu + nu)), np.nan)  # kernel states
         self.kernel = DesignKernel(model, report, compile) if model.square and model.nq and model.nu else None
+
+    def check_gears(self):
+        """A design whose gear centres are not r1 + r2 (or |r2 - r1|) apart at its first
+        solved pose is refused as a scene would be (kincas/core/joints.py): every pose of it
+        gets the status "gears do not mesh" and no values."""
+        if not self.m.gears:
+            return
+        from ..core.joints import first_pose_problems
+        for d in range(self.P.shape[0]):
+            solved = np.flatnonzero(self.code[d] == OK)
+            if solved.size and first_pose_problems(self.model, self.Q[d, solved[0]], self.U[solved[0]],
+                                                   self.P[d], self.Ls[d]):
+                self.code[d], self.vals[d] = NO_MESH, np.nan
 
     # --- 1. first poses: continuation in the parameters from the nominal design ---
     def first_poses(self, p0, L0):

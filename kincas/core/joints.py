@@ -141,7 +141,8 @@ def polar_radius(sym, prof, phi):
 # --- quantities (an extension module of Symbolic: `check` and `expression`) ---
 
 _REL_Q = {"angle": 0, "omega": 1, "alpha": 2, "jerk": 3}
-_CONTACT_Q = {"x": (0, 0), "y": (1, 0), "vx": (0, 1), "vy": (1, 1), "ax": (0, 2), "ay": (1, 2)}
+_CONTACT_Q = {"x": (0, 0), "y": (1, 0), "vx": (0, 1), "vy": (1, 1), "ax": (0, 2), "ay": (1, 2),
+              "jx": (0, 3), "jy": (1, 3)}
 
 
 def _parse(sym, name: str):
