@@ -164,7 +164,7 @@ def mobility(scene: dict) -> int:
 # optimisation studies (tests/test_optimize.py); forces and geometry (tests/test_forces_examples.py).
 NO_CLOSED_FORM = {"assur_triad", "stephenson3", "eightbar"}
 # Gears, racks, cams, relative inputs, fixed pins in moving slots: tests/test_joint_examples.py
-JOINT_EXAMPLES = {"geared_fivebar", "planetary", "rack_fourbar", "eccentric_cam", "roller_cam",
+JOINT_EXAMPLES = {"designed_cam", "geared_fivebar", "planetary", "rack_fourbar", "eccentric_cam", "roller_cam",
                   "flat_tappet", "elbow_arm", "whitworth"}
 
 

@@ -35,6 +35,8 @@ def careful_pose(model: Model, m: Mechanism, U, p, L, guess, k: int, j: int | No
     if j is None:
         return _first(model, u, p, L, guess)
     fresh = j == k - 1
+    if not fresh and not _ambiguous(model):  # in or after a gap: decided group by group
+        return _resume(model, U, p, L, k, j, run, events)
     prev = (run.Q[j - 1], U[j - 1]) if fresh and j >= 1 and run.solved[j - 1] else None
     sol = _continue(model, run.Q[j], U[j], u, p, L, depth=8 if fresh else 0, prev=prev)
     if sol is None:
@@ -53,6 +55,23 @@ def careful_pose(model: Model, m: Mechanism, U, p, L, guess, k: int, j: int | No
         names = group_links(model)
         events.append({"kind": "resume", "pose": int(k), "branch": "other" if changed.size else "same"}
                       | ({"groups": [names[i] for i in changed]} if changed.size else {}))
+    return sol
+
+
+def _resume(model: Model, U, p, L, k, j, run, events) -> Solution:
+    """Pose k after poses with no assembly (the last solved is j), where every group's
+    assembly is conclusive (`_ambiguous`): in the modes of pose j, nearest it, or where a
+    group's mode does not assemble its other mode (named in the "resume" event); no
+    assembly when a group's circles miss each other (a discriminant: no Newton at all)."""
+    before = modes(model, model.jac(run.Q[j], U[j], p), L)[0]
+    sol = assemble(model, U[k], p, L, want=before, near=run.Q[j])
+    if sol is None:
+        return _no_assembly(model, run.Q[j])
+    after = modes(model, sol.J, L)[0]
+    changed = np.flatnonzero((before != after) & (before != 0) & (after != 0))
+    names = group_links(model)
+    events.append({"kind": "resume", "pose": int(k), "branch": "other" if changed.size else "same"}
+                  | ({"groups": [names[i] for i in changed]} if changed.size else {}))
     return sol
 
 

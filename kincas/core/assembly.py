@@ -165,10 +165,82 @@ def _starts(model, cols, L, near, count):
     return out
 
 
+# --- a dyad of two angles: its circle intersections ---
+
+
+def _dyad(model, q, u, p, L, i):
+    """Group i's equations, where it is a dyad of two angles, in the form
+    g(t1, t2) = c + R(t1) m1 + R(t2) m2 (the other unknowns fixed at q): (c, m1, m2), read
+    off five evaluations of g and checked at a sixth; None for any other group."""
+    rows, cols = blocks(model)[i]
+    if len(rows) != 2 or len(cols) != 2 or model.sym.is_length[cols].any():
+        return None
+
+    def g(t1, t2):
+        x = q.copy()
+        x[cols] = t1, t2
+        return model.residual(x, u, p)[rows]
+    g00, gp0, g0p = g(0.0, 0.0), g(np.pi, 0.0), g(0.0, np.pi)
+    a1, a2 = (g00 - gp0) / 2, (g00 - g0p) / 2  # M1 e1, M2 e1
+    b1 = g(np.pi / 2, 0.0) - (g00 + gp0) / 2  # M1 e2
+    b2 = g(0.0, np.pi / 2) - (g00 + g0p) / 2  # M2 e2
+    c = (g00 + gp0) / 2 - a2
+    M1, M2 = np.column_stack([a1, b1]), np.column_stack([a2, b2])
+    rot = lambda M: abs(M[0, 0] - M[1, 1]) + abs(M[0, 1] + M[1, 0]) <= 1e-12 * (np.abs(M).max() + L)
+    if not (rot(M1) and rot(M2)):
+        return None  # not two rotations (a reflected frame, a slide): Newton's business
+    t = np.array([0.7, -1.9])
+    e = lambda a: np.array([np.cos(a), np.sin(a)])
+    if np.abs(c + M1 @ e(t[0]) + M2 @ e(t[1]) - g(*t)).max() > 1e-12 * L:
+        return None
+    return c, a1, a2
+
+
+def _dyad_solutions(model, q, u, p, L, i, near):
+    """The dyad's assemblies (its two circle intersections; one at a limit, none where the
+    circles miss each other: the discriminant decides), each angle taken nearest the
+    reference pose's; None where group i is not such a dyad."""
+    form = _dyad(model, q, u, p, L, i)
+    if form is None:
+        return None
+    c, m1, m2 = form
+    v, r1, r2 = -c, float(np.hypot(*m1)), float(np.hypot(*m2))
+    d = float(np.hypot(*v))
+    if d <= 1e-12 * L:
+        return None if abs(r1 - r2) <= 1e-12 * L else []  # concentric: a continuum, or none
+    x = (d * d + r1 * r1 - r2 * r2) / (2 * d)
+    h2 = r1 * r1 - x * x
+    if h2 < -1e-12 * L * L:
+        return []  # the circles miss each other: no assembly
+    h = np.sqrt(max(h2, 0.0))
+    e = v / d
+    n = np.array([-e[1], e[0]])
+    cols = blocks(model)[i][1]
+    ref = q[cols] if near is None else np.asarray(near, float)[cols]
+    out = []
+    for side in ((1,) if h == 0 else (1, -1)):
+        X = x * e + side * h * n
+        t = np.array([np.arctan2(X[1], X[0]) - np.arctan2(m1[1], m1[0]),
+                      np.arctan2(v[1] - X[1], v[0] - X[0]) - np.arctan2(m2[1], m2[0])])
+        t += 2 * np.pi * np.round((ref - t) / (2 * np.pi))  # the turn of the reference pose
+        qs = q.copy()
+        qs[cols] = t
+        out.append(qs)
+    return out
+
+
 def _candidates(model, q, u, p, L, i, target, near, starts):
     """Solutions of group i (the groups before it fixed in q): first one in mode `target`
-    (from the reference pose's start, then spread starts), then one in another mode."""
+    (from the reference pose's start, then spread starts), then one in another mode. A
+    dyad of two angles gets its circle intersections instead of Newton runs."""
     rows, cols = blocks(model)[i]
+    closed = _dyad_solutions(model, q, u, p, L, i, near)
+    if closed is not None:
+        c = np.where(model.sym.is_length, 1.0 / L, 1.0)
+        far = lambda qs: 0.0 if near is None else float(np.abs((qs - near) * c).sum())
+        found = [(modes(model, model.jac(qs, u, p), L)[0][i], far(qs), qs) for qs in closed]
+        yield from (t[2] for t in sorted(found, key=lambda t: (target != 0 and t[0] != target, t[1])))
+        return
     other = None
     for s in _starts(model, cols, L, near, starts if len(cols) <= 2 else 4 * starts):
         q0 = q.copy()
@@ -200,7 +272,7 @@ def assemble(model, u, p, L, want=None, near=None, starts: int = 8) -> Solution 
     def place(i, q):
         if i == len(bl):
             return q
-        target = 1 if want is None or want[i] == 0 else int(want[i])
+        target = 1 if want is None else int(want[i])  # 0: the nearest, in either mode
         for qs in _candidates(model, q, u, p, L, i, target, near, starts):
             done = place(i + 1, qs)
             if done is not None:
