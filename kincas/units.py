@@ -36,17 +36,21 @@ def param_unit(units: dict, mech, name: str) -> str:
     return units.get("angle", "deg") if angular else units.get("length", "")
 
 
-def unit_label(units: dict, mech, name: str) -> str:
+def unit_label(units: dict, mech, name: str, extra=None) -> str:
     """The unit of quantity `name` in a scene's `units` ({"length", "angle", "time"}):
     'mm/s' for a point's velocity, 'deg' for an angle, 'mm per a' for a sensitivity.
-    `mech` (the mechanism, or None) tells driven parameters and slides' jerks apart."""
+    `mech` (the mechanism, or None) tells driven parameters and slides' jerks apart;
+    `extra(name, length_unit)` gives the unit of other quantities (forces...), or None."""
     L, A, T = units.get("length", ""), units.get("angle", "deg"), units.get("time", "s")
     kind, obj, attr = parse_quantity(name)
     if kind == "sens":  # Q's unit per the parameter's: mm/mm, deg/mm
-        uq, up = unit_label(units, mech, obj), param_unit(units, mech, attr)
+        uq, up = unit_label(units, mech, obj, extra), param_unit(units, mech, attr)
         return f"{uq or '1'}/{up}" if up else (f"{uq} per {attr}" if uq else "")
     if mech is not None and name in mech.param_values:  # a driven parameter: a length, or an angle
         return param_unit(units, mech, name)
+    other = extra(name, L) if extra is not None else None
+    if other is not None:
+        return other
     base = A if is_angular(name, mech) else L  # input keys L.angle included
     order = _ORDER.get(attr, 0)
     return base + ("" if order == 0 else f"/{T}" if order == 1 else f"/{T}^{order}")

@@ -215,7 +215,7 @@ def test_rocker_driven_through_its_limit_reports_no_wrong_velocity():
     assert sw.ok.all()
     C = np.array([d + c * math.cos(phi), c * math.sin(phi)])
     B = C / np.linalg.norm(C) * a  # crank and coupler in line at the limit
-    assert np.hypot(sw["B.x"][1] - B[0], sw["B.y"][1] - B[1]) <= 1e-9
+    assert np.hypot(sw["B.x"][1] - B[0], sw["B.y"][1] - B[1]) <= 1e-12
     assert sw.flags[1] == "limit"
     assert np.isnan(sw["B.vx"][1]) and np.isnan(sw["crank.omega"][1])
 
@@ -330,3 +330,37 @@ def test_driven_crank_alone_from_the_command_line(tmp_path, capsys):
     code, out, err = run_cli(capsys, "solve", write_scene(tmp_path, scene), "--json")
     assert code == 0, err
     assert out["status"] == ["ok"] * 3
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e-6])
+def test_sweep_that_approaches_a_limit_to_rounding(scale):
+    # Positions on the branch, the limit located, velocities null where rounding of the input
+    # alone moves them by more than 1e-6; further away, the velocity loop's exact value.
+    a, b, c, d = 1, 1.9, 3, 4
+    lim = math.acos((a * a + d * d - (b + c) ** 2) / (2 * a * d))
+    for eps in (0.0, 1e-15, 1e-12, 1e-10, 1e-6):
+        th = np.array([lim - 0.3, lim - 0.1, lim - eps])
+        sw = kincas.sweep(fourbar(a, b, c, d, (3.2, 2.5), scale), {"crank.angle": th},
+                          report=["C.x", "C.y", "C.vx"])
+        assert sw.ok.all()
+        t = th[-1]
+        B = a * np.array([math.cos(t), math.sin(t)])
+        if eps <= 1e-15:  # at the limit coupler and rocker are in line: C = D + c (B - D) / (b + c)
+            C = np.array([d, 0.0]) + c * (B - [d, 0.0]) / (b + c)
+        else:
+            C = fourbar_C(th[-1:], a, b, c, d, 1)[0]
+        # (4 ulps of the input from the limit the positions are sqrt(1e-15) from its own)
+        tol = 1e-7 if eps == 1e-15 else 1e-8
+        assert np.hypot(sw["C.x"][-1] / scale - C[0], sw["C.y"][-1] / scale - C[1]) <= tol
+        if eps <= 1e-10:
+            assert sw.flags[-1] == "limit" and np.isnan(sw["C.vx"][-1])
+            lims = events(sw, "limit")
+            assert len(lims) == 1 and abs(lims[0]["inputs"]["crank.angle"] - lim) <= 1e-9
+        else:  # velocity loop: B' + b phi' e(phi)^perp = c psi' e(psi)^perp
+            phi = math.atan2(*(C - B)[::-1])
+            psi = math.atan2(C[1], C[0] - d)
+            Bd = a * np.array([-math.sin(t), math.cos(t)])
+            M = np.array([[b * math.sin(phi), -c * math.sin(psi)], [-b * math.cos(phi), c * math.cos(psi)]])
+            _, psid = np.linalg.solve(M, Bd)
+            assert sw.flags[-1] is None
+            assert abs(sw["C.vx"][-1] / scale - (-c * psid * math.sin(psi))) <= 1e-6 * abs(c * psid)

@@ -310,3 +310,19 @@ def test_gear_pair_effort_by_its_ratio_and_reactions_refused(capsys, tmp_path):
     scene["output"] = {"report": ["reaction(B, left).x"]}
     code, _, err = run_cli(capsys, "solve", write_scene(tmp_path, scene), "--json")
     assert code == 2 and "gears, racks or cams" in err
+
+
+def test_optimize_a_counterweight_over_efforts():
+    # a crank carrying its own weight (centre of gravity at cw along it) and a load at its pin:
+    # the static torque is (m g cw + F r) cos(theta), zero for cw = -F r / (m g)
+    from kincas.optimize import optimize
+    mass, r, F = 2.0, 1.0, 5.0
+    m = Mechanism(parameters={"cw": 0.3}, ground={"A": (0, 0), "D": (4, 0)},
+                  links=[Link("crank", {"A": (0, 0), "B": (r, 0)}, mass=mass, cg=("cw", 0)),
+                         Link.bar("coupler", "B", "C", 3.5), Link.bar("rocker", "D", "C", 3)],
+                  inputs=[Input.angle("crank")], guess={"C": (3.6, 2.9)}, gravity=G,
+                  loads=[Load.force("B", (0, -F))])
+    res = optimize(m, {"crank.angle": np.linspace(0.2, 1.4, 7)}, vary={"cw": (-2, 2)},
+                   minimize="sum(abs(effort(crank.angle))^2)", rates=0.0)
+    assert res.ok, res.message
+    assert abs(res.varied["cw"] + F * r / (mass * 9.81)) < 1e-8

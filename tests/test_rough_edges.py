@@ -79,6 +79,19 @@ def test_ctrl_c_exits_130_in_one_line(capsys, tmp_path, monkeypatch):
 # --- sizes that cannot fit: refused before any memory is taken ---
 
 
+@pytest.fixture(autouse=True)
+def default_memory_budget(monkeypatch):
+    monkeypatch.delenv("KINCAS_MEMORY", raising=False)
+
+
+def test_the_memory_budget_can_be_raised(monkeypatch):
+    from kincas.cli import bounds
+    monkeypatch.setenv("KINCAS_MEMORY", "16GB")
+    assert bounds.default_budget() == 16e9
+    monkeypatch.delenv("KINCAS_MEMORY")
+    assert bounds.default_budget() <= 2e9
+
+
 def test_a_huge_sweep_is_refused_up_front(capsys, tmp_path):
     text = FAIRBAIRN.replace("steps = 361", "steps = 1000000000")
     code, out, err = run_cli(capsys, "solve", write_scene(tmp_path, text))
@@ -95,8 +108,9 @@ def test_huge_tolerance_samples_are_refused_up_front(capsys, tmp_path):
 
 
 def test_huge_modes_starts_are_refused_up_front(capsys, tmp_path):
-    code, out, err = run_cli(capsys, "modes", write_scene(tmp_path, FAIRBAIRN), "--starts", "10000000000")
-    one_line_exit_2(code, err, "--starts", "GB")
+    for starts in ("10000000", "10000000000"):  # the typo, and a worse one
+        code, out, err = run_cli(capsys, "modes", write_scene(tmp_path, FAIRBAIRN), "--starts", starts)
+        one_line_exit_2(code, err, "--starts", "GB")
 
 
 # --- messages ---

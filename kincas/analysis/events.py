@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.assembly import NEAR, group_links, modes, polish_singular
+from ..core.assembly import NEAR, group_links, modes, polish_singular, refine
 from ..core.symbolic import parse_quantity
 from .singular import FLAG_SIGMA, classify, locate_singular, scaled_jacobians
 
@@ -95,8 +95,18 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma):
     # poses at a singular position: exactly onto it, flagged, one event per group
     for k in np.flatnonzero(ok & ~(sigma > NEAR)):
         groups = [int(i) for i in np.flatnonzero(measure(k)[1] < NEAR)]
-        q = polish_singular(model, Q[k], U[k], p, L, groups) if groups else None
-        if q is None:
+        if not groups:
+            continue
+        q = polish_singular(model, Q[k], U[k], p, L, groups)
+        if q is None:  # next to one, not at it: positions to rounding, derivatives null,
+            # since an error of rounding in the input moves them by more than 1e-6 there
+            Q[k], at[k] = refine(model, Q[k], U[k], p, L), True
+            flags[k] = flags[k] or kind_at(Q[k], U[k], tol=NEAR)
+            step = U[k + 1] - U[k] if k + 1 < n else U[k] - U[k - 1] if k else None
+            for i in groups if step is not None and np.any(step) else ():
+                found = locate_singular(model, Q[k], U[k], p, L, step, group=i)
+                if found is not None and abs(found[2]) <= 1e-3:  # the pose all but reached it
+                    event(kind_at(found[0], found[1]), k, found[1], i)
             continue
         Q[k], at[k] = q, True
         exact.pop(k)
@@ -132,7 +142,19 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma):
                 found = locate_singular(model, Q[k], U[k], p, L, U[nb] - U[k], group=int(i))
                 if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
                     event(kind_at(found[0], found[1]), k, found[1], int(i))
-    return events, at
+    return _distinct(events), at
+
+
+def _distinct(events):
+    """One event per singular position and group (a limit next to a gap may be found from a
+    pose that all but reached it too)."""
+    out = []
+    for e in events:
+        if not any(o["kind"] == e["kind"] and o.get("group") == e.get("group") and o["pose"] == e["pose"]
+                   and all(abs(o["inputs"][k] - v) <= 1e-9 * max(1.0, abs(v)) for k, v in e["inputs"].items())
+                   for o in out):
+            out.append(e)
+    return out
 
 
 # --- values at a singular pose ---

@@ -43,6 +43,9 @@ SIGN_TOL = 1e-8  # a block whose conditioning is below this has no trustworthy s
 # Newton converges only linearly onto a singular position, and stops about sqrt(TOL) from
 # it: a group conditioned below NEAR may be *at* one; `polish_singular` decides.
 NEAR = 1e-5
+# A pose is *at* a singular position when one satisfies g = 0 there to rounding: a pose 1e-12
+# of the input away from a limit is 1e-6 of the size away from the limit's positions.
+ROUNDING = 1e-15
 
 
 # --- the groups: blocks of g_q ---
@@ -286,7 +289,16 @@ def assemble(model, u, p, L, want=None, near=None, starts: int = 8) -> Solution 
     return sol if sol.ok else None
 
 
-# --- exactly at a singular position ---
+# --- at or next to a singular position ---
+
+
+def refine(model, q, u, p, L):
+    """q polished by the one Newton down to rounding (not just to TOL): next to a singular
+    position an error in g of TOL moves the unknowns by TOL / sigma, so the last digits need
+    the extra steps."""
+    eq, qs = model.scales(u, p) if hasattr(model, "scales") else (np.full(model.ng, L), np.where(model.sym.is_length, L, 1.0))
+    res = newton(lambda x: model.resjac(x, u, p), np.array(q, float), qs, eq, tol=0.0, max_iter=8)
+    return res.x if res.ok else np.array(q, float)
 
 
 def _jv_function(model):
@@ -346,7 +358,7 @@ def polish_singular(model, q, u, p, L, groups, max_iter: int = 30):
             n = len(bl[i][1])
             vs[k] = vs[k] + step[off:off + n]
             off += n
-    if np.abs(F[:ng]).max() > TOL or np.abs(F[ng:]).max() > 1e-10:
+    if np.abs(F[:ng]).max() > ROUNDING or np.abs(F[ng:]).max() > 1e-10:
         return None
     return q
 
