@@ -216,9 +216,9 @@ def _demote(md_text: str) -> str:
 
 CONFIG = {
     "full": {"n": 720, "repeats": 5, "n_stiff": 360, "chain": [1, 2, 5, 10, 20, 40], "chain_poses": 100,
-             "budget": 570.0},
+             "budget": 900.0, "api_lengths": (100_000, 3_600, 360), "api_repeats": 7, "cli_runs": 2},
     "quick": {"n": 72, "repeats": 3, "n_stiff": 72, "chain": [1, 4, 10], "chain_poses": 30,
-              "budget": 120.0},
+              "budget": 120.0, "api_lengths": (3_600, 360), "api_repeats": 3, "cli_runs": 1},
 }
 
 
@@ -237,6 +237,9 @@ def main(argv=None) -> int:
     log = lambda s: print(s, file=sys.stderr, flush=True)
     log("installing peers ...")
     installs = install_requirements(args.no_install)
+    log("0. what users call: kincas.sweep and kincas solve against peers at 360 to 100,000 poses ...")
+    from peers.api import study_api
+    api = study_api(cfg, log)
     log("1-2. error against time, throughput against peers ...")
     main_res = study_main(cfg, log)
     log("3. stability ...")
@@ -247,7 +250,7 @@ def main(argv=None) -> int:
     others = [] if args.no_others else other_benchmarks(args.quick, deadline, log)
     from peers.report import write_report
     out = Path(args.out)
-    write_report(out, quick=args.quick, cfg=cfg, installs=installs, machine=machine(), main=main_res,
+    write_report(out, quick=args.quick, cfg=cfg, installs=installs, machine=machine(), api=api, main=main_res,
                  stability=stab, growth=growth, others=others, seconds=time.perf_counter() - t_start)
     log(f"wrote {out / 'RESULTS.md'} in {time.perf_counter() - t_start:.0f} s")
     return 0

@@ -364,3 +364,39 @@ def test_sweep_that_approaches_a_limit_to_rounding(scale):
             _, psid = np.linalg.solve(M, Bd)
             assert sw.flags[-1] is None
             assert abs(sw["C.vx"][-1] / scale - (-c * psid * math.sin(psi))) <= 1e-6 * abs(c * psid)
+
+
+def watt2_rocking(s1, s2):
+    """A Watt II chain whose first loop is a triple rocker (the crank turns back at +-151 deg)
+    and whose second loop has gaps of its own: every gap ends both groups' assembly or the
+    second's alone, and the resume must restore both modes (det g_q, their product, cannot
+    tell (+, +) from (-, -))."""
+    m = Mechanism(ground={"A": (0, 0), "D": (4, 0), "G": (4.6, 3.0)},
+                  links=[Link.bar("crank", "A", "B", 1), Link.bar("coupler", "B", "C", 1.9),
+                         Link("rocker", {"D": (0, 0), "C": (3, 0), "E": (1.5, 1.0)}),
+                         Link.bar("rod", "E", "F", 2.5), Link.bar("arm", "G", "F", 2.0)],
+                  inputs=[Input.angle("crank")])
+
+    def closed(th):
+        C = fourbar_C(th, 1, 1.9, 3, 4, s1)
+        ang = np.arctan2(C[:, 1], C[:, 0] - 4)
+        E = np.array([4.0, 0.0]) + np.stack([1.5 * np.cos(ang) - np.sin(ang), 1.5 * np.sin(ang) + np.cos(ang)], 1)
+        return C, circle_point(E, 2.5, np.array([[4.6, 3.0]]), 2.0, s2)
+    return m, closed
+
+
+@pytest.mark.parametrize("s1, s2", [(1, 1), (-1, -1), (1, -1), (-1, 1)])
+def test_two_groups_resume_in_both_modes_they_left(s1, s2):
+    th = np.radians(np.r_[np.arange(-150.0, 151.0, 4.0), np.arange(150.0, -151.0, -4.0)])
+    m, closed = watt2_rocking(s1, s2)
+    C, F = closed(th)
+    start = int(np.flatnonzero(np.isfinite(F[:, 0]))[0])
+    m = m.with_guess(C=tuple(C[start]), F=tuple(F[start]))
+    sw = kincas.sweep(m, {"crank.angle": th[start:]}, report=["C.x", "C.y", "F.x", "F.y"])
+    C, F = C[start:], F[start:]
+    assembles = np.isfinite(F[:, 0])
+    assert not assembles.all()
+    assert np.array_equal(sw.ok, assembles)
+    assert np.abs(xy(sw, "C")[sw.ok] - C[sw.ok]).max() <= 1e-9
+    assert np.abs(xy(sw, "F")[sw.ok] - F[sw.ok]).max() <= 1e-9
+    assert all(e["branch"] == "same" for e in events(sw, "resume"))

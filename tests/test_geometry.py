@@ -157,3 +157,23 @@ def test_unknown_geometry_names_are_refused():
         kincas.solve(fourbar(), {"crank.angle": 1.0}, report=["coupler/nobody.icx"])
     with pytest.raises(kincas.ModelError, match="Z.curvature"):
         kincas.solve(fourbar(), {"crank.angle": 1.0}, report=["Z.curvature"])
+
+
+def test_scene_input_jerk_and_where_it_is_refused(capsys, tmp_path):
+    from conftest import run_cli, write_scene
+    scene = {"ground": {"A": [0, 0], "D": [4, 0]},
+             "links": {"crank": {"points": ["A", "B"], "length": 1},
+                       "coupler": {"points": ["B", "C"], "length": 3.5},
+                       "rocker": {"points": ["D", "C"], "length": 3}},
+             "inputs": [{"angle": "crank", "value": 30, "rate": 10, "jerk": 40}],
+             "guess": {"C": [3.6, 2.9]}, "output": {"report": ["crank.jerk", "B.jy"]}}
+    code, out, err = run_cli(capsys, "solve", write_scene(tmp_path, scene), "--json")
+    assert code == 0, err
+    assert abs(out["values"]["crank.jerk"][0] - 40) < 1e-9  # degrees in, degrees out
+    # B.y = sin(theta): jerk = cos(th) th''' - 3 sin(th) th' th'' - cos(th) th'^3 (th'' = 0)
+    w, j = math.radians(10), math.radians(40)
+    assert abs(out["values"]["B.jy"][0] - (math.cos(math.pi / 6) * (j - w ** 3))) < 1e-12
+    scene["parameters"] = {"k": 1.0}
+    scene["optimize"] = {"vary": {"k": [0.5, 2]}, "minimize": "sum(B.jy^2)"}
+    code, _, err = run_cli(capsys, "optimize", write_scene(tmp_path, scene), "--json")
+    assert code == 2 and "[optimize]: a jerk quantity with a nonzero input `jerk`" in err

@@ -190,3 +190,19 @@ def test_cli_bad_options_exit_2(tmp_path, capsys):
     p2.write_text(SCENE[:SCENE.index("[study]")])
     code, _, err = run_cli(capsys, "study", p2)
     assert code == 2 and "[study]" in err
+
+
+def test_threads_give_the_numbers_of_one_thread_compiled():
+    # Blocks of designs in the compiled kernel on two threads at once, against one thread and
+    # against kincas.sweep: nothing that one C call reads may be shared or freed under it.
+    m = fourbar()
+    args = (m, {"a4": (84, 96), "a5": (62, 70)}, {"crank.angle": np.linspace(0, 2 * np.pi, 361)},
+            ["max(C.y)", "mean(rocker.omega)"])
+    one = kincas.study(*args, samples=24, seed=2, workers=1, compile=True)
+    two = kincas.study(*args, samples=24, seed=2, workers=2, chunk=3, compile=True)
+    assert one.status == two.status and one.ok.all()
+    for t in args[3]:
+        assert np.array_equal(one.values[t], two.values[t])
+    a4, a5 = two.params[5]
+    s = kincas.sweep(m.with_parameters(a4=a4, a5=a5), args[2], report=["C.y"])
+    assert two.values["max(C.y)"][5] == pytest.approx(s["C.y"].max(), abs=1e-10)

@@ -96,3 +96,13 @@ def test_optimize_reports_units_bounds_and_wrapped_angles(capsys):
     u = doc["curve"]["inputs"]["crank.angle"]
     assert all(0 <= a < 360 for a in u)
     assert doc["at_bound"] == {"r3": "upper"}
+
+
+def test_the_json_names_the_input_rates(capsys, tmp_path):
+    text = SLIDER.replace("sweep = { from = 0, to = 360, steps = 73 }",
+                          "sweep = { from = 0, to = 360, steps = 73 }\nrate = 60\nacceleration = 5")
+    code, doc, err = run_cli(capsys, "solve", write_scene(tmp_path, text), "--json")
+    assert code == 0, err
+    assert doc["rates"] == {"crank.angle": 60} and doc["accelerations"] == {"crank.angle": 5}
+    # and the velocities follow it: the crank's omega is the input rate, in deg/s
+    assert doc["values"]["crank.omega"] == pytest.approx([60.0] * 73, rel=1e-12)

@@ -273,7 +273,8 @@ NOTES = """\
 """
 
 
-def write_report(out: Path, *, quick, cfg, installs, machine, main, stability, growth, others, seconds):
+def write_report(out: Path, *, quick, cfg, installs, machine, main, stability, growth, others, seconds,
+                 api=None):
     from . import kincas_runs as kr
     from .measure import MATCH
 
@@ -288,8 +289,17 @@ def write_report(out: Path, *, quick, cfg, installs, machine, main, stability, g
          f"{time.strftime('%Y-%m-%d %H:%M')} in {seconds:.0f} s. " + machine[0] + ".", "", machine[1] + ".", ""]
     if quick:
         L += ["> **Quick run**: few poses and repeats; the numbers are a smoke test, not results.", ""]
-    L += ["## Headline", "", "The fastest kincas sweep against each peer, same mechanism, poses and outputs, "
-          "same run (medians):", ""] + headline(main) + [""]
+    if api:
+        from .api import api_tables
+        L += ["## Headline: what users call", "",
+              "`kincas.sweep` with its defaults (positions and velocities of every compared point, the "
+              "singular-position pass included) and `kincas solve --json` (a new process per run, scene "
+              "read and JSON written), against the peers on the same poses, medians of one run. Setup "
+              "(building, compiling) is apart: the longest sweep of each case ran first, so its setup is "
+              "the cold one (empty compiled-code cache) and the shorter ones are cached starts.", ""]
+        L += api_tables(api)
+    L += ["## Fastest kincas option per case", "", "The fastest kincas sweep option against each peer, "
+          "same mechanism, poses and outputs, same run (medians):", ""] + headline(main) + [""]
     L += ["## Peers", "", "| requirement | status |", "|---|---|"]
     L += [f"| `{req}` | {'installed' if err is None else 'NOT AVAILABLE: ' + err} |" for req, err in installs.items()]
     L += ["", "## 1. Error against run time", "",

@@ -80,24 +80,29 @@ def _resume(model: Model, U, p, L, k, j, run, events) -> Solution:
 
 def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:
     """Continuation failed: Newton straight from the last pose, kept only where every group
-    stays in its mode; otherwise (and where Newton fails) the assembly in the last pose's
-    modes, group by group; IPOPT only where that is not conclusive (`_ambiguous`)."""
-    want = modes(model, model.jac(last[0], last[1], p), L)[0]
-    sol = model.newton(last[0], u, p, L)
-    if sol.ok:
+    stays in its mode or crossed a singular position of its own on the way (located); else
+    the assembly in the last pose's modes, group by group; a pose where only other modes
+    assemble, reached without such a crossing, has no assembly on this branch. IPOPT only
+    where group assembly is not conclusive (`_ambiguous`)."""
+    J0 = model.jac(last[0], last[1], p)
+    want = modes(model, J0, L)[0]
+
+    def keeps(sol):
         got = modes(model, sol.J, L)[0]
-        if not np.any((got != want) & (got != 0) & (want != 0)):
-            return sol
+        return not np.any((got != want) & (got != 0) & (want != 0))
+    sol = model.newton(last[0], u, p, L)
+    if sol.ok and keeps(sol):
+        return sol
     alt = assemble(model, u, p, L, want=want, near=last[0])
-    if alt is not None:
-        got = modes(model, alt.J, L)[0]
-        if not np.any((got != want) & (got != 0) & (want != 0)) or not sol.ok:
-            return alt  # in the modes left, or (none there) another: the sweep's events say it
-    if sol.ok:
-        return sol  # only another mode assembles here: a crossing, which the events flag
+    if alt is not None and (keeps(alt) or _crossed(model, last[0], last[1], u, J0, alt, p, L)):
+        return alt
+    if sol.ok and _crossed(model, last[0], last[1], u, J0, sol, p, L):
+        return sol  # another mode, through a located singular position: the events say so
     if _ambiguous(model):
         pts = model.points(last[0], last[1], p)
-        return model.nearest_assembly(last[0], u, p, {nm: pts[:, j] for j, nm in enumerate(m.moving_points)}, L)
+        sol = model.nearest_assembly(last[0], u, p, {nm: pts[:, j] for j, nm in enumerate(m.moving_points)}, L)
+        if sol.ok and (keeps(sol) or _crossed(model, last[0], last[1], u, J0, sol, p, L)):
+            return sol
     return _no_assembly(model, last[0])
 
 

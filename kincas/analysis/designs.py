@@ -242,9 +242,8 @@ class _Job:
         self.info = np.full((nd, 5, n), np.nan)
         self.code = np.full((nd, n), NOT_SOLVED, dtype=np.int8)
         self.fast = np.zeros((nd, n), dtype=bool)  # values computed by the kernel
-        nu = model.nu
-        self.S = np.full((nd, nq + nq * nq + 2 * (nq * nu + nu)), np.nan)  # kernel states
         self.kernel = DesignKernel(model, report, compile) if model.square and model.nq and model.nu else None
+        self.S = np.full((nd, self.kernel.sweeper.state_size if self.kernel else 0), np.nan)  # kernel states
 
     def check_gears(self):
         """A design whose gear centres are not r1 + r2 (or |r2 - r1|) apart at its first
@@ -285,7 +284,8 @@ class _Job:
             _, J, Ju, _ = BatchEvaluator(model).derivatives(self.Q[idx, 0], u, self.P[idx])
             T = -_solve(J, Ju)
             cm = lambda a: a.transpose(0, 2, 1).reshape(len(idx), -1)  # column-major rows
-            self.S[idx] = np.concatenate([self.Q[idx, 0], cm(J), cm(T), u, cm(T), u], axis=1)
+            Jd = self.kernel.sweeper.diagonal(J)  # g_q's diagonal blocks, as the kernel keeps them
+            self.S[idx] = np.concatenate([self.Q[idx, 0], Jd, cm(T), u, cm(T), u], axis=1)
 
     def _continue_in_parameters(self, q0, p0, sign0) -> np.ndarray:
         model, P, Ls = self.model, self.P, self.Ls
@@ -293,22 +293,26 @@ class _Job:
         ev = BatchEvaluator(model)
         scale = np.where(model.sym.is_length[None, :], 1.0, 1.0 / Ls[:, None])
         dP = P - p0
-        steps = int(min(64, max(1, math.ceil(np.abs(dP).max(initial=0.0) / (STEP * min(Ls.min(), 1e300))))))
+        # Steps of at most STEP * size in every parameter, counted per design, so that a
+        # design's numbers do not depend on the others computed with it (chunks on a cluster).
+        steps = np.clip(np.ceil(np.abs(dP).max(axis=1, initial=0.0) / (STEP * Ls)), 1, 64).astype(int)
         q, pc = np.repeat(q0[None, :], nd, axis=0), np.repeat(p0[None, :], nd, axis=0)
         ok = np.ones(nd, dtype=bool)
-        for i in range(1, steps + 1):
-            pt = p0 + dP * (i / steps)
-            _, J, _, Gp = ev.derivatives(q, u, pc)
-            q = q - _solve(J, np.einsum("dij,dj->di", Gp, pt - pc))
+        for i in range(1, int(steps.max(initial=1)) + 1):
+            a = np.flatnonzero(i <= steps)
+            qa, ua, La = q[a], u[a], Ls[a]
+            pt = p0 + dP[a] * (i / steps[a])[:, None]
+            _, J, _, Gp = ev.derivatives(qa, ua, pc[a])
+            qa = qa - _solve(J, np.einsum("dij,dj->di", Gp, pt - pc[a]))
             for _ in range(NEWTON):
-                gv, J, _, _ = ev.derivatives(q, u, pt)
-                q = q - _solve(J, gv)
-            gv, J, _, _ = ev.derivatives(q, u, pt)
-            r = np.abs(gv).max(axis=1) / Ls
+                gv, J, _, _ = ev.derivatives(qa, ua, pt)
+                qa = qa - _solve(J, gv)
+            gv, J, _, _ = ev.derivatives(qa, ua, pt)
+            r = np.abs(gv).max(axis=1) / La
             with np.errstate(all="ignore"):
-                s = np.sign(np.linalg.det(J * scale[:, None, :]))
-            ok &= (r <= ACCEPT) & np.isfinite(q).all(axis=1) & ((s == sign0) | (sign0 == 0))
-            pc = pt
+                s = np.sign(np.linalg.det(J * scale[a][:, None, :]))
+            ok[a] &= (r <= ACCEPT) & np.isfinite(qa).all(axis=1) & ((s == sign0) | (sign0 == 0))
+            q[a], pc[a] = qa, pt
         self.Q[ok, 0] = q[ok]
         return ok
 
@@ -352,7 +356,8 @@ class _Job:
         Q, info = np.empty((nb, n, nq)), np.empty((nb, 5, n))
         vals, stops = np.empty((nb, len(self.report), n)), np.empty(nb)
         (Ud, sud), (Udd, sudd) = rows(self.Ud, n, nu), rows(self.Udd, n, nu)
-        lib.kincas_designs(nb, n, ptr(self.U), ptr(P), P.shape[1], ptr(Ls), ptr(_thresholds()), sw.max_evals,
+        thr = _thresholds()  # referenced until the call returns: C reads it by address
+        lib.kincas_designs(nb, n, ptr(self.U), ptr(P), P.shape[1], ptr(Ls), ptr(thr), sw.max_evals,
                            ptr(S), S.shape[1], ptr(Q), ptr(info), ptr(Ud), sud, ptr(Udd), sudd,
                            ptr(vals), ptr(stops))
         stops = stops.astype(int)

@@ -82,6 +82,14 @@ class Scene:
         return sweep(self.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
                      report=self.quantities, **kw)
 
+    def refuse_jerks(self, texts, where: str) -> None:
+        """Only `kincas solve` passes the inputs' `jerk` on; elsewhere they would be taken as 0,
+        so a jerk quantity there with a nonzero input jerk is refused rather than wrong."""
+        import re
+        if any(self.study.jerks.values()) and any(re.search(r"\.(jx|jy|jerk)\b", str(t)) for t in texts):
+            raise SceneError(f"{where}: a jerk quantity with a nonzero input `jerk`: only "
+                             f"`kincas solve` takes the inputs' jerks (here they would be 0)")
+
     def user_inputs(self, s: Sweep) -> dict[str, np.ndarray]:
         """Input values in the scene's units: the numbers as written, not through radians."""
         out = {}

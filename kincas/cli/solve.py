@@ -47,6 +47,7 @@ def cli_run(args) -> int:
     if args.json:
         doc = {"title": sc.study.title, "units": sc.study.units,
                "inputs": {k: _list(v) for k, v in inputs.items()},
+               "rates": _user_rates(sc, sw.rates), "accelerations": _user_rates(sc, sw.accelerations),
                "status": sw.status.tolist(), "flags": list(sw.flags),
                "values": {k: _list(v) for k, v in values.items()},
                "events": [_user_event(sc, e) for e in sw.events]}
@@ -72,6 +73,19 @@ def rate_line(sc, sw) -> str:
         show = lambda v: f"{v.flat[0]:.6g}" if v.size and np.ptp(v) == 0 else "varies"
         parts.append(f"{k} rate {show(r)} {u}/{T}, acceleration {show(a)} {u}/{T}^2")
     return "inputs: " + "; ".join(parts) + " (velocities and accelerations follow these)"
+
+
+def _user_rates(sc, rates: dict) -> dict:
+    """Each input's rate (or acceleration) in the scene's units: one number when it is the
+    same at every pose, else a list."""
+    out = {}
+    for k, v in rates.items():
+        v = np.atleast_1d(np.asarray(v, float))
+        if k.endswith(".angle") and sc.study.deg:
+            v = np.degrees(v)
+        v = np.array([float(f"{x:.15g}") for x in v])  # through radians: 60.00000000000001 is 60
+        out[k] = float(v[0]) if v.size and np.ptp(v) == 0 else _list(v)
+    return out
 
 
 def _user_event(sc, e: dict) -> dict:

@@ -121,6 +121,7 @@ def cli_run(args) -> int:
         raise OutputError(f"--workers: expected a whole number >= 1, got {args.workers}")
     client = _client(args.scheduler) if args.scheduler else None
     st = sc.study
+    sc.refuse_jerks(kw["report"], "[study] report")
     try:
         r = study(sc.mechanism, kw["vary"], st.inputs, kw["report"], grid=kw["grid"],
                   samples=kw["samples"], seed=kw["seed"], rates=st.rates,

@@ -242,7 +242,7 @@ def _candidates(model, q, u, p, L, i, target, near, starts):
         c = np.where(model.sym.is_length, 1.0 / L, 1.0)
         far = lambda qs: 0.0 if near is None else float(np.abs((qs - near) * c).sum())
         found = [(modes(model, model.jac(qs, u, p), L)[0][i], far(qs), qs) for qs in closed]
-        yield from (t[2] for t in sorted(found, key=lambda t: (target != 0 and t[0] != target, t[1])))
+        yield from ((t[0], t[2]) for t in sorted(found, key=lambda t: (target != 0 and t[0] != target, t[1])))
         return
     other = None
     for s in _starts(model, cols, L, near, starts if len(cols) <= 2 else 4 * starts):
@@ -253,10 +253,10 @@ def _candidates(model, q, u, p, L, i, target, near, starts):
             continue
         mode = modes(model, model.jac(qs, u, p), L)[0][i]
         if mode == target:
-            yield qs
+            yield mode, qs
             target = None  # one per mode
         elif other is None and mode != 0:
-            other = qs
+            other = mode, qs
         if target is None and other is not None:
             break
     if other is not None:
@@ -264,10 +264,11 @@ def _candidates(model, q, u, p, L, i, target, near, starts):
 
 
 def assemble(model, u, p, L, want=None, near=None, starts: int = 8) -> Solution | None:
-    """A pose assembled group by group, each group in its mode `want[i]` (+1 or -1; default
-    +1), the solution nearest `near` (unknowns of a reference pose) first. Where a group has
-    no assembly in the wanted mode, or the groups after it have none, its other mode is
-    tried. None where no combination assembles: decided by a few block Newton runs per
+    """A pose assembled group by group, each group in its mode `want[i]` (+1 or -1; 0: the
+    nearest; default +1), the solution nearest `near` (unknowns of a reference pose) first.
+    Without `want`, where a group's default mode does not assemble, or the groups after it
+    have none, its other mode is tried; with `want`, a group whose wanted mode assembles
+    never takes another (a mode is left only through a singular position of its own). None where no combination assembles: decided by a few block Newton runs per
     group, without an optimiser."""
     bl = blocks(model)
     u, p = np.asarray(u, float), np.asarray(p, float)
@@ -276,10 +277,12 @@ def assemble(model, u, p, L, want=None, near=None, starts: int = 8) -> Solution 
         if i == len(bl):
             return q
         target = 1 if want is None else int(want[i])  # 0: the nearest, in either mode
-        for qs in _candidates(model, q, u, p, L, i, target, near, starts):
+        for mode, qs in _candidates(model, q, u, p, L, i, target, near, starts):
             done = place(i + 1, qs)
             if done is not None:
                 return done
+            if want is not None and target != 0 and mode == target:
+                return None  # the mode asked for exists: a group never leaves it for another's sake
         return None
 
     q = place(0, np.zeros(model.nq) if near is None else np.array(near, float))

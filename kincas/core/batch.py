@@ -73,7 +73,7 @@ class DesignKernel:
     def _library(self) -> Library:
         return Library("kincas_designs", self.sweeper.functions, _SWEEP_C + _DESIGNS_C,
                        {"NQ": self.nq, "NU": self.nu, "NO": self.no,
-                        "NM": len(self.sweeper.blocks) + 1},
+                        "NM": len(self.sweeper.blocks) + 1, "NJ": self.sweeper.nj},
                        {"kincas_sweep": _SWEEP_SIG, "kincas_designs": _DESIGNS_SIG})
 
     def lib(self, n: int):

@@ -80,15 +80,29 @@ def block_measures(J, cs, blocks: list[Block]):
     return ca.vertcat(*signs), ca.mmin(ca.vertcat(*sig))
 
 
-def block_change(J0, J, D, blocks: list[Block]):
-    """max over blocks of sum |D^-1 (A0^-1 A - I) D| for the diagonal blocks A0 of J0 and A
-    of J. Below 1 for every block, each A0 + t (A - A0), t in [0, 1], is invertible, hence
-    so is J0 + t (J - J0) (block triangular): det g_q keeps its sign between the two."""
-    out = [ca.SX(0)]
+def diagonal_blocks(J, blocks) -> ca.SX:
+    """The entries of J's diagonal blocks, one block after another (column-major each): all
+    of g_q that the branch test needs from the last pose (sum of size^2, not nq^2)."""
+    parts = [ca.vec(J[b.rows.tolist(), b.cols.tolist()]) for b in blocks]
+    return ca.densify(ca.vertcat(*parts)) if parts else ca.SX(0, 1)
+
+
+def diagonal_size(blocks) -> int:
+    return sum(len(b.cols) ** 2 for b in blocks)
+
+
+def block_change(J0d, J, D, blocks: list[Block]):
+    """max over blocks of sum |D^-1 (A0^-1 A - I) D| for the diagonal blocks A0 (given as
+    `diagonal_blocks` of the last pose's g_q) and A of J. Below 1 for every block, each
+    A0 + t (A - A0), t in [0, 1], is invertible, hence so is J0 + t (J - J0) (block
+    triangular): det g_q keeps its sign between the two."""
+    out, at = [ca.SX(0)], 0
     for blk in blocks:
         r, c = blk.rows.tolist(), blk.cols.tolist()
-        Db = D[c]
-        M = (_small_solve(J0[r, c], J[r, c]) - ca.DM.eye(len(c))) * ca.repmat(Db.T, len(c), 1) / ca.repmat(Db, 1, len(c))
+        n, Db = len(c), D[c]
+        A0 = ca.reshape(J0d[at:at + n * n], n, n)
+        at += n * n
+        M = (_small_solve(A0, J[r, c]) - ca.DM.eye(n)) * ca.repmat(Db.T, n, 1) / ca.repmat(Db, 1, n)
         out.append(ca.sum1(ca.sum2(ca.fabs(M))))
     return ca.mmax(ca.vertcat(*out))
 

@@ -42,7 +42,7 @@ import weakref
 import casadi as ca
 import numpy as np
 
-from .blocks import numeric_signs
+from .blocks import diagonal_size, numeric_signs
 from .compiled import CHUNK, Backend, Library, QuantityEvaluator, ptr, rows, table
 from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, NEAR, RESIDUAL, STEP, SWEEP_C,
                      kernel_functions, state_function, vm_step)
@@ -151,6 +151,8 @@ class FastSweeper:
         self.nq, self.nu, self.max_evals = model.sym.nq, model.sym.nu, int(max_evals)
         model.quantity_function(self.report)  # names checked here
         self.blocks = _model_blocks(model)
+        self.nj = diagonal_size(self.blocks)  # g_q's diagonal blocks, all the state keeps of it
+        self.state_size = self.nq + self.nj + 2 * (self.nq * self.nu + self.nu)
         self._functions = None
         self._lock = threading.RLock()
         self._local = threading.local()  # the virtual machine's buffers, one set per thread
@@ -180,20 +182,26 @@ class FastSweeper:
 
     def _library(self) -> Library:
         return Library("kincas_sweep", self.functions, SWEEP_C,
-                       {"NQ": self.nq, "NU": self.nu, "NO": len(self.report), "NM": len(self.blocks) + 1},
+                       {"NQ": self.nq, "NU": self.nu, "NO": len(self.report), "NM": len(self.blocks) + 1,
+                        "NJ": self.nj},
                        {"kincas_sweep": [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V, _V]})
 
     def state(self, q, u, p) -> np.ndarray:
         """(q, J, T = dq/du, u, T, u) at a solved pose, matrices column-major as in casadi
         (the second T, u stand for the pose before: the first prediction is linear). At a
         singular start T is not finite, and the next pose fails the branch test."""
-        nq, nu = self.nq, self.nu
-        s = np.empty(nq + nq * nq + 2 * (nq * nu + nu))
-        s[:nq], s[nq + nq * nq + nq * nu:][:nu] = np.ravel(q), np.ravel(u)
+        nq, nu, nj = self.nq, self.nu, self.nj
+        s = np.empty(self.state_size)
+        s[:nq], s[nq + nj + nq * nu:][:nu] = np.ravel(q), np.ravel(u)
         f = self._state_call()
-        f(s[:nq], s[nq + nq * nq + nq * nu:][:nu], np.ravel(p), s[nq:nq + nq * nq], s[nq + nq * nq:][:nq * nu])
-        s[nq + nq * nq + nq * nu + nu:] = s[nq + nq * nq:nq + nq * nq + nq * nu + nu]
+        f(s[:nq], s[nq + nj + nq * nu:][:nu], np.ravel(p), s[nq:nq + nj], s[nq + nj:][:nq * nu])
+        s[nq + nj + nq * nu + nu:] = s[nq + nj:nq + nj + nq * nu + nu]
         return s
+
+    def diagonal(self, J: np.ndarray) -> np.ndarray:
+        """(N, nj): the diagonal blocks of N matrices g_q (N, nq, nq), as the state keeps them."""
+        parts = [J[:, b.rows][:, :, b.cols].transpose(0, 2, 1).reshape(len(J), -1) for b in self.blocks]
+        return np.concatenate(parts, axis=1) if parts else np.zeros((len(J), 0))
 
     def _state_call(self) -> "_Buffered":
         f = getattr(self._local, "state", None)
@@ -291,7 +299,7 @@ class FastSweeper:
             nq, nu, no, nm = self.nq, self.nu, len(self.report), len(self.blocks) + 1
             F = self._vm_function()
             buf, call = F.buffer()
-            scratch = [np.zeros((CHUNK, m)) for m in (nq, nq * nq, nq * nu, nu, nq * nu, nu, 6, no, nm,
+            scratch = [np.zeros((CHUNK, m)) for m in (nq, self.nj, nq * nu, nu, nq * nu, nu, 6, no, nm,
                                                       nu, nu, nu)]
             for i, a in enumerate(scratch[:9]):
                 buf.set_res(i, memoryview(a))
@@ -301,7 +309,7 @@ class FastSweeper:
     def _vm_advance(self, r: FastRun, start: int, stop: int, s: np.ndarray) -> int:
         nq, nu = self.nq, self.nu
         _, buf, call, (Qc, Jc, Tc, Uo, T1c, U1c, Ic, Yc, Mc, Uc, Udc, Uddc) = self._vm_buffers()
-        parts = np.split(s.copy(), np.cumsum([nq, nq * nq, nq * nu, nu, nq * nu]))
+        parts = np.split(s.copy(), np.cumsum([nq, self.nj, nq * nu, nu, nq * nu]))
         k = start
         while k < stop:
             m = min(CHUNK, stop - k)

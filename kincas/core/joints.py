@@ -77,7 +77,7 @@ def equations(sym, new) -> list:
     sym.cams = {}
     for c in m.cams:
         phi = new(f"{c.name}.phi", "angle")
-        P, T, size = _profile(sym, c.profile, phi)
+        P, T = _profile(sym, c.profile, phi)
         ox, oy, th = sym.frames[c.body]
         Pw = tuple(o + d for o, d in zip((ox, oy), _rot(th, P)))
         Tw = _rot(th, T)
@@ -95,20 +95,19 @@ def equations(sym, new) -> list:
             fx, fy, fth = sym.frames[who]
             dx, dy = ca.cos(fth), ca.sin(fth)
             eqs += [dx * (Pw[1] - fy) - dy * (Pw[0] - fx), dx * Tw[1] - dy * Tw[0]]
-        sym.cams[c.name] = {"phi": phi, "contact": Pw, "normal": Nw, "point": point, "size": size}
+        sym.cams[c.name] = {"phi": phi, "contact": Pw, "normal": Nw, "point": point}
     return eqs
 
 
 def _profile(sym, prof, phi):
-    """(P, T, size): the profile point and its tangent dP/dphi in the body's frame, and a
-    length of the profile (for the pressure angle's threshold)."""
+    """(P, T): the profile point and its tangent dP/dphi in the body's frame."""
     c, s = ca.cos(phi), ca.sin(phi)
     if isinstance(prof, Circle):
         R = sym.val(prof.radius)
         cx, cy = (sym.val(v) for v in prof.center)
-        return (cx + R * c, cy + R * s), (-R * s, R * c), R
+        return (cx + R * c, cy + R * s), (-R * s, R * c)
     r, dr = polar_radius(sym, prof, phi)
-    return (r * c, r * s), (dr * c - r * s, dr * s + r * c), r
+    return (r * c, r * s), (dr * c - r * s, dr * s + r * c)
 
 
 def polar_radius(sym, prof, phi):

@@ -23,10 +23,13 @@ from __future__ import annotations
 
 import casadi as ca
 
-from .blocks import block_change, block_measures, block_solve
+from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size
+from .tolerances import ACCEPT, TOL
 
-RESIDUAL = 1e-10  # as the careful path's ACCEPT: max |g| / L
-STEP = 1e-13  # the next Newton step (radians, or lengths / L), applied before stopping
+RESIDUAL = ACCEPT  # max |g| / L at an accepted pose, as on the careful path
+# The next Newton step's largest entry (radians, or lengths / L), applied before stopping: the
+# largest entry, not a sum, so that rounding in a long chain of groups does not add up past it
+STEP = TOL
 JAC_CHANGE = 0.9  # per group, sum |entries of D^-1 (A_prev^-1 A - I) D| (below 1 keeps det's sign)
 CORRECTION = 0.25  # ||D^-1 (q - q_pred)||_1: Newton may not wander far from the prediction
 MAX_EVALS = 5  # kN evaluations per pose at most
@@ -45,7 +48,7 @@ def kernel_functions(sym, blocks, report=()) -> list[ca.Function]:
     is O(h^3) on a straight sweep and still O(h^2) where the sweep turns."""
     nq, nu = sym.nq, sym.nu
     solve = lambda A, b: block_solve(A, b, blocks)
-    q, qp, J0 = ca.SX.sym("q", nq), ca.SX.sym("qp", nq), ca.SX.sym("J0", nq, nq)
+    q, qp, J0 = ca.SX.sym("q", nq), ca.SX.sym("qp", nq), ca.SX.sym("J0", diagonal_size(blocks))
     T0, u0, u = ca.SX.sym("T0", nq, nu), ca.SX.sym("u0", nu), ca.SX.sym("u", nu)
     T1, u1 = ca.SX.sym("T1", nq, nu), ca.SX.sym("u1", nu)
     du, dup = u - u0, u0 - u1
@@ -57,10 +60,9 @@ def kernel_functions(sym, blocks, report=()) -> list[ca.Function]:
     cs = ca.if_else(is_length, 1, 1 / L)  # g_q's columns to O(1): 1 (lengths), 1/L (angles)
     g, Jq, Ju = ca.Function("G", [sym.q, sym.u, sym.p], [sym.g, sym.Jq, sym.Ju])(q, u, p)
     step = solve(Jq, g)
-    rs = ca.vertcat(ca.mmax(ca.fabs(g)) / L, ca.norm_1(step / D))  # a sum keeps NaNs
+    rs = ca.vertcat(_max_abs(g) / L, _max_abs(step / D))
     T = -solve(Jq, Ju)
-    # J0 arrives dense but has g_q's sparsity: projecting it keeps the group solves sparse
-    change = block_change(ca.project(J0, Jq.sparsity()), Jq, D, blocks)
+    change = block_change(J0, Jq, D, blocks)
     signs, sigma = block_measures(Jq, cs, blocks)
     if report:
         qf = sym.quantity_function(list(report), lsolve=lambda b: block_solve(sym.Jq, b, blocks))
@@ -71,15 +73,21 @@ def kernel_functions(sym, blocks, report=()) -> list[ca.Function]:
     return [ca.Function("kP", [q, T0, u0, u, T1, u1], [d(pred)], o),
             ca.Function("kN", [q, u, p, L], [d(step), rs], o),
             ca.Function("kF", [q, u, p, L, ud, udd, J0, qp],
-                        [d(Jq), d(T), rs, ca.vertcat(change, ca.norm_1((q - qp) / D)),
+                        [diagonal_blocks(Jq, blocks), d(T), rs, ca.vertcat(change, ca.norm_1((q - qp) / D)),
                          ca.vertcat(signs, sigma), y, d(step)], o)]
 
 
+def _max_abs(v):
+    """max |v_i|, NaN if any v_i is (casadi's mmax skips NaNs; a sum keeps them)."""
+    return ca.mmax(ca.fabs(v)) + 0 * ca.sum1(v) if v.numel() else ca.SX(0)
+
+
 def state_function(sym, blocks) -> ca.Function:
-    """kT(q, u, p) -> (g_q, dq/du) dense: the kernel's state at a pose solved elsewhere."""
+    """kT(q, u, p) -> (g_q's diagonal blocks, dq/du dense): the kernel's state at a pose
+    solved elsewhere."""
     q, u, p = ca.SX.sym("q", sym.nq), ca.SX.sym("u", sym.nu), ca.SX.sym("p", sym.np)
     Jq, Ju = ca.Function("G", [sym.q, sym.u, sym.p], [sym.Jq, sym.Ju])(q, u, p)
-    return ca.Function("kT", [q, u, p], [ca.densify(Jq), ca.densify(-block_solve(Jq, Ju, blocks))],
+    return ca.Function("kT", [q, u, p], [diagonal_blocks(Jq, blocks), ca.densify(-block_solve(Jq, Ju, blocks))],
                        {"cse": True})
 
 
@@ -87,7 +95,7 @@ def vm_step(kP, kN, kF, nq, nu, max_evals) -> ca.Function:
     """One pose for the virtual machine, the compiled loop's arithmetic with a fixed number
     of kN evaluations: once a step is below NEAR, q stays put, so it ends where the loop stops.
     info = (residual, next step, Jacobian change, correction, kN steps, converged)."""
-    q0, J0, T0, u0 = ca.SX.sym("q0", nq), ca.SX.sym("J0", nq, nq), ca.SX.sym("T0", nq, nu), ca.SX.sym("u0", nu)
+    q0, J0, T0, u0 = ca.SX.sym("q0", nq), ca.SX.sym("J0", kF.size1_in(6)), ca.SX.sym("T0", nq, nu), ca.SX.sym("u0", nu)
     u, p, L, thr = ca.SX.sym("u", nu), ca.SX.sym("p", kN.size1_in(2)), ca.SX.sym("L"), ca.SX.sym("t", 5)
     ud, udd, T1, u1 = ca.SX.sym("ud", nu), ca.SX.sym("udd", nu), ca.SX.sym("T1", nq, nu), ca.SX.sym("u1", nu)
     q = qp = kP(q0, T0, u0, u, T1, u1)
@@ -105,8 +113,8 @@ def vm_step(kP, kN, kF, nq, nu, max_evals) -> ca.Function:
                        [q, J, T, u, T0, u0, info, y, meas])
 
 
-# --- the C loop around them (NQ, NU, NO, NM: sizes; state s = q, J, T = dq/du, u at the
-# last pose, then T and u at the one before; matrices column-major) ---
+# --- the C loop around them (NQ, NU, NO, NM, NJ: sizes; state s = q, g_q's diagonal blocks,
+# T = dq/du, u at the last pose, then T and u at the one before; matrices column-major) ---
 
 SWEEP_C = """
 int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const casadi_real* L,
@@ -114,13 +122,13 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
                  casadi_real* info, casadi_int ld, const casadi_real* Ud, casadi_int sud,
                  const casadi_real* Udd, casadi_int sudd, casadi_real* vals, casadi_real* meas) {
   const casadi_real* arg[SZ_ARG]; casadi_real* res[SZ_RES]; casadi_int iw[SZ_IW]; casadi_real w[SZ_W];
-  casadi_real qp[NQ], q[NQ], dq[NQ], J[NQ*NQ], T[NQ*NU], rs[2], rf[2], mc[2], ms[NM], y[NO > 0 ? NO : 1];
+  casadi_real qp[NQ], q[NQ], dq[NQ], J[NJ > 0 ? NJ : 1], T[NQ*NU], rs[2], rf[2], mc[2], ms[NM], y[NO > 0 ? NO : 1];
   casadi_int k, i, it;
   for (k = 0; k < n; ++k) {
     const casadi_real* u = U + k*NU;
     int conv = 0;
-    arg[0] = s; arg[1] = s + NQ + NQ*NQ; arg[2] = s + NQ + NQ*NQ + NQ*NU; arg[3] = u;
-    arg[4] = s + NQ + NQ*NQ + NQ*NU + NU; arg[5] = s + NQ + NQ*NQ + 2*NQ*NU + NU; res[0] = qp;
+    arg[0] = s; arg[1] = s + NQ + NJ; arg[2] = s + NQ + NJ + NQ*NU; arg[3] = u;
+    arg[4] = s + NQ + NJ + NQ*NU + NU; arg[5] = s + NQ + NJ + 2*NQ*NU + NU; res[0] = qp;
     if (kP(arg, res, iw, w, 0)) break;
     for (i = 0; i < NQ; ++i) q[i] = qp[i];
     for (it = 1; ; ++it) {  /* Newton until the step just applied makes the next negligible */
@@ -141,11 +149,11 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     info[k] = rf[0]; info[ld + k] = rf[1]; info[2*ld + k] = mc[0]; info[3*ld + k] = mc[1];
     info[4*ld + k] = (casadi_real) it;
     if (!(conv && mc[0] <= thr[2] && mc[1] <= thr[3])) break;
-    for (i = 0; i < NQ*NU + NU; ++i) s[NQ + NQ*NQ + NQ*NU + NU + i] = s[NQ + NQ*NQ + i];
+    for (i = 0; i < NQ*NU + NU; ++i) s[NQ + NJ + NQ*NU + NU + i] = s[NQ + NJ + i];
     for (i = 0; i < NQ; ++i) s[i] = q[i];
-    for (i = 0; i < NQ*NQ; ++i) s[NQ + i] = J[i];
-    for (i = 0; i < NQ*NU; ++i) s[NQ + NQ*NQ + i] = T[i];
-    for (i = 0; i < NU; ++i) s[NQ + NQ*NQ + NQ*NU + i] = u[i];
+    for (i = 0; i < NJ; ++i) s[NQ + i] = J[i];
+    for (i = 0; i < NQ*NU; ++i) s[NQ + NJ + i] = T[i];
+    for (i = 0; i < NU; ++i) s[NQ + NJ + NQ*NU + i] = u[i];
   }
   return (int) k;
 }

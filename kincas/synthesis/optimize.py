@@ -318,6 +318,7 @@ def run_scene(sc) -> OptimizeResult:
     from ..errors import ModelError, SceneError
 
     kw = read_section(sc)
+    sc.refuse_jerks([kw.get("minimize")] + list(kw.get("constraints", ())), "[optimize]")
     try:
         return optimize(sc.mechanism, kw.pop("samples"), rates=sc.study.rates,
                         accelerations=sc.study.accelerations, **kw)
