@@ -400,3 +400,21 @@ def test_two_groups_resume_in_both_modes_they_left(s1, s2):
     assert np.abs(xy(sw, "C")[sw.ok] - C[sw.ok]).max() <= 1e-9
     assert np.abs(xy(sw, "F")[sw.ok] - F[sw.ok]).max() <= 1e-9
     assert all(e["branch"] == "same" for e in events(sw, "resume"))
+
+
+@pytest.mark.parametrize("method", ["fast", "careful"])
+def test_no_assembly_is_decided_without_the_optimiser(method, monkeypatch):
+    # A triple rocker over a full turn in 1 deg steps: 57 poses have no assembly, each decided
+    # by its dyad's circles (a discriminant), never by IPOPT (about 50 ms a pose).
+    from kincas.core.numeric import Model
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("IPOPT called for a dyad")
+    monkeypatch.setattr(Model, "nearest_assembly", refuse)
+    a, b, c, d = 1, 1.9, 3, 4
+    th = np.radians(np.arange(0.0, 361.0, 1.0))
+    sw = kincas.sweep(fourbar(a, b, c, d, (3.2, 2.5)), {"crank.angle": th}, report=["C.x", "C.y"],
+                      method=method)
+    C = fourbar_C(th, a, b, c, d, 1)
+    assert np.array_equal(sw.ok, np.isfinite(C[:, 0]))
+    assert np.abs(xy(sw, "C")[sw.ok] - C[sw.ok]).max() <= 1e-9

@@ -177,3 +177,10 @@ def test_the_fairbairn_example_has_a_tolerance_section(capsys):
     code, doc, err = run_cli(capsys, "tolerance", EXAMPLES / "fairbairn.toml", "--samples", "200", "--json")
     assert code == 0, err
     assert set(doc["std"]) == {"a1", "a3", "a62"} and doc["agrees"]
+
+
+def test_range_of_a_structure_without_inputs_says_so(capsys, tmp_path):
+    text = (EXAMPLES / "assur_triad.toml").read_text(encoding="utf-8")
+    text = text[:text.index("[[inputs]]")] + text[text.index("\n[guess]"):]
+    code, out, err = run_cli(capsys, "range", write_scene(tmp_path, text))
+    one_line_exit_2(code, err, "[[inputs]]", "range")

@@ -325,11 +325,17 @@ class _Job:
         done = [nd - len(todo)]
         tick = threading.Lock()
 
+        batched = lib is None and self.kernel is not None and n > 1
+        if batched:  # no compiled kernel: all designs advance together, pose by pose
+            blocks = [todo]
+
         def run(block):
             if lib is not None:
                 stops = self._kernel_block(lib, block)
-            else:  # the virtual machine (or no fast pass): design by design
-                stops = [self._fast_from(None, d, 0) for d in block]
+            elif batched:
+                stops = self._batched_pass(block)
+            else:  # no fast pass (no unknowns, or no inputs): the careful path
+                stops = np.ones(len(block), dtype=int)
             for d, k in zip(block, stops):
                 self._finish(lib, int(d), int(k))
             if progress is not None:
@@ -346,6 +352,48 @@ class _Job:
                 run(b)
         if progress is not None:
             progress(nd, nd)
+
+    def _batched_pass(self, todo) -> np.ndarray:
+        """The fast pass without a compiler: every design of `todo` advanced pose by pose
+        together (mapped CasADi evaluations, numpy's batched solves), each pose predicted
+        along the tangent and corrected by Newton, and accepted by the kernel's own tests
+        (residual, the next step, det g_q's sign by the Jacobian-change bound, the size of
+        the correction). Returns each design's first rejected pose (n if none)."""
+        from ..core import fast
+        model, U, n = self.model, self.U, self.U.shape[0]
+        ev = BatchEvaluator(model)
+        stops = np.full(len(todo), n)
+        live = np.arange(len(todo))  # positions in todo still advancing
+        d = todo
+        D = np.where(model.sym.is_length[None, :], self.Ls[d][:, None], 1.0)
+        q = self.Q[d, 0]
+        _, J, Ju, _ = ev.derivatives(q, np.repeat(U[:1], len(d), 0), self.P[d])
+        T = -_solve(J, Ju)
+        for k in range(1, n):
+            if not len(live):
+                break
+            d, Dl = todo[live], D[live]
+            uk, pk, Lk = np.repeat(U[k:k + 1], len(d), 0), self.P[d], self.Ls[d]
+            pred = q + np.einsum("dij,j->di", T, U[k] - U[k - 1])
+            x, conv = pred.copy(), np.zeros(len(d), dtype=bool)
+            for it in range(fast.MAX_EVALS):
+                g, Jk, Juk, _ = ev.derivatives(x, uk, pk)
+                dx = _solve(Jk, g)
+                now = ((np.abs(g).max(axis=1) / Lk <= fast.RESIDUAL)
+                       & (np.abs(dx / Dl).sum(axis=1) <= fast.STEP))
+                conv |= now
+                if conv.all() or it == fast.MAX_EVALS - 1:
+                    break
+                x = np.where(conv[:, None], x, x - dx)
+            with np.errstate(all="ignore"):
+                M = (_solve(J, Jk) - np.eye(model.nq)) * Dl[:, None, :] / Dl[:, :, None]
+                good = (conv & (np.abs(M).sum(axis=(1, 2)) <= fast.JAC_CHANGE)
+                        & (np.abs((x - pred) / Dl).sum(axis=1) <= fast.CORRECTION))
+            self.Q[d[good], k], self.code[d[good], k] = x[good], OK
+            stops[live[~good]] = k
+            live, q, J = live[good], x[good], Jk[good]
+            T = -_solve(J, Juk[good])
+        return stops
 
     def _kernel_block(self, lib, block) -> np.ndarray:
         """One C call: the designs of `block` from their first poses, until each is rejected."""

@@ -71,18 +71,17 @@ def classify(J: np.ndarray, Gu: np.ndarray, tol: float = FLAG_SIGMA) -> str | No
 
 
 def _extended(model):
-    """F(q, u, p, v, v0) = [g; g_q v; v0.v - 1] and its Jacobian in (q, u, v), as a function
-    returning fresh dense numpy arrays (through zero-copy buffers: converting a casadi DM
-    costs milliseconds at 80 unknowns)."""
-    if getattr(model, "_extended", None) is None:
+    """F(q, u, p, v, v0) = [g; g_q v; v0.v - 1] and its Jacobian in (q, u, v), returning dense
+    numpy arrays (through zero-copy buffers: converting a casadi DM costs milliseconds at 80
+    unknowns)."""
+    def build():
         from ..core.numeric import _Call
         sym = model.sym
         v, v0 = ca.SX.sym("v", sym.nq), ca.SX.sym("v0", sym.nq)
         F = ca.vertcat(sym.g, ca.mtimes(sym.Jq, v), ca.dot(v0, v) - 1)
         z = ca.vertcat(sym.q, sym.u, v)
-        call = _Call(ca.Function("extended", [sym.q, sym.u, sym.p, v, v0], [F, ca.jacobian(F, z)]))
-        model._extended = lambda *args: [a.copy() for a in call(*args)]
-    return model._extended
+        return _Call(ca.Function("extended", [sym.q, sym.u, sym.p, v, v0], [F, ca.jacobian(F, z)]))
+    return model.memo("singular.extended", build)
 
 
 def locate_singular(model, q, u, p, L, direction, max_iter: int = 40, group: int | None = None,

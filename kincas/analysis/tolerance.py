@@ -6,12 +6,12 @@ independent normal variables with the given standard deviations sigma_j. Two ans
 * first order: Q(p0 + dp) ~ Q(p0) + sum_j dQ/dp_j dp_j, so std(Q) = sqrt(sum_j (dQ/dp_j sigma_j)^2),
   with the exact sensitivities of the implicit function theorem (`kincas.sensitivity`);
 * Monte Carlo: N mechanisms drawn at random, each solved at every pose. One drawn mechanism
-  is one manufactured part, so the same draw is used at all poses. All N x poses solves run in
-  one vectorised CasADi call (`Function.map`): from the nominal pose q0, a first-order
-  predictor q0 + dq/dp dp, then a few Newton steps with the exact Jacobian. A sample counts
-  only if its residual is below the solver's acceptance and the sign of det(g_q) is the
-  nominal one (the same assembly branch); the others go once through the careful Newton of
-  `kincas.solve`, and those that still fail are counted per pose and left out, never used.
+  is one manufactured part, so the same draw is used at all poses. The draws are the designs
+  of one batched sweep (`kincas.sweep_designs`, the executor of `kincas study`): each is
+  continued from the nominal's first pose in the parameters, keeping the sign of det(g_q)
+  (the nominal's assembly branch), then swept by the compiled fast pass with its checks. A
+  sample that cannot be continued to a pose is counted as failed there and left out, never
+  used, and taken up again at the next pose from the nominal's pose there.
 
 The two agree when the outputs are close to linear over the tolerance band; their ratio is
 reported beside the Monte-Carlo sampling error, 1 / sqrt(2 (N - 1)) relative.
@@ -34,14 +34,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError, SceneError
-from ..core.scatter import sample_function
 from ..core.numeric import model_of
-from ..core.tolerances import ACCEPT
 from ..model.mechanism import Mechanism
 
-NEWTON_STEPS = 5  # after the first-order predictor; quadratic convergence needs few
-CHUNK = 40_000  # columns per mapped call: bounds the memory of very large runs
-RETRY_LIMIT = 1000  # samples per analysis that may take the careful (per-pose) path
+FEW_POSES = 16  # up to this many poses, each is solved from the nominal's (not swept to)
+
 
 
 @dataclass
@@ -161,79 +158,66 @@ def _check_std(m: Mechanism, std, where: str) -> list[str]:
 
 
 def _monte_carlo(m: Mechanism, sw, report, to, dp):
-    """Monte-Carlo std and mean shift (poses x outputs), failures per pose, samples retried."""
-    model = model_of(m)
-    sym, nq = model.sym, model.nq
+    """Monte-Carlo std and mean shift (poses x outputs), failures per pose, restarts.
+
+    Each drawn mechanism is a design of `kincas.sweep_designs`, swept over every run of poses
+    the nominal solved (with FEW_POSES poses or fewer, each pose on its own), from the nominal's first pose of the run (continued in the
+    parameters, keeping det g_q's sign: the nominal's branch). A sample that cannot be
+    continued to a pose counts as failed there, and is taken up again at the next pose,
+    continued in the parameters from the nominal's pose there."""
+    from ..core.numeric import compile
+    from .designs import sweep_designs
+
+    model = compile(m)
     n_s, n_pose = dp.shape[0], len(sw)
-    p0 = np.array([v for _, v in m.parameters], dtype=float)
-    cols = [sym.pnames.index(p) for p in to]
+    pv = dict(m.parameters)
+    p0 = np.array(list(pv.values()), dtype=float)
+    X = np.array([pv[p] for p in to], dtype=float) + dp
     keys = list(sw.inputs)
     U = np.stack([sw.inputs[k] for k in keys], axis=1)
     Ud = np.stack([sw.rates[k] for k in keys], axis=1)
     Udd = np.stack([sw.accelerations[k] for k in keys], axis=1)
-    L = m.size()
     mc = np.full((n_pose, len(report)), np.nan)
     shift = np.full((n_pose, len(report)), np.nan)
     failed = np.zeros(n_pose, dtype=int)
-    ok_poses = np.flatnonzero(sw.ok)
-    if not len(ok_poses):
-        return mc, shift, failed, 0
-    F = sample_function(model, tuple(report), NEWTON_STEPS)
-    # each equation's residual relative to its own group's length, at each pose
-    EQ = np.stack([model.scales(U[k], p0)[0] for k in range(n_pose)]) if n_pose else None
-    det_scale = model.column_scale(L)  # columns to O(1): det signs comparable
-    # Columns: sample-major within each solved pose, so each pose is one contiguous block.
-    Pall = p0[:, None] + np.zeros((len(p0), n_s))
-    Pall[cols, :] += dp.T
-    DP = np.zeros((len(p0), n_s))
-    DP[cols, :] = dp.T
-    total = len(ok_poses) * n_s
-    Qv = np.empty((len(report), total))
-    res = np.empty(total)
-    dets = np.empty(total)
-    qs = np.empty((nq, total))
-    for start in range(0, total, CHUNK):
-        idx = np.arange(start, min(start + CHUNK, total))
-        pose, samp = ok_poses[idx // n_s], idx % n_s
-        f = F.map(len(idx))
-        q, r, J, vals = (np.asarray(a) for a in f(
-            sw.q[pose].T, U[pose].T, np.repeat(p0[:, None], len(idx), 1), DP[:, samp],
-            Ud[pose].T, Udd[pose].T, EQ[pose].T))
-        J = J.T.reshape(len(idx), nq, nq).transpose(0, 2, 1) if nq else np.zeros((len(idx), 0, 0))
-        qs[:, idx], res[idx], Qv[:, idx] = q, r.ravel(), vals
-        dets[idx] = np.linalg.det(J * det_scale) if nq else 1.0
-    # The nominal branch: the sign of det(g_q) at each nominal pose.
-    ref = np.array([np.sign(np.linalg.det(model.jac(sw.q[k], U[k], p0) * det_scale))
-                    if nq else 1.0 for k in ok_poses])
-    good = (res <= ACCEPT) & np.all(np.isfinite(Qv), axis=0) & (np.sign(dets) == np.repeat(ref, n_s))
-    bad = np.flatnonzero(~good)
-    retried = 0
-    for i in bad[:RETRY_LIMIT]:  # the careful path: damped Newton from the predictor
-        k, s = ok_poses[i // n_s], i % n_s
-        start = qs[:, i] if np.all(np.isfinite(qs[:, i])) else sw.q[k]
-        sol = model.newton(start, U[k], Pall[:, s], L)
-        retried += 1
-        if not sol.ok:
-            continue
-        d = np.linalg.det(model.jac(sol.q, U[k], Pall[:, s]) * det_scale) if nq else 1.0
-        if np.sign(d) != ref[i // n_s]:
-            continue
-        Qv[:, i] = model.quantities(list(report), sol.q[None, :], U[k][None, :], Pall[:, s],
-                                    Ud[k][None, :], Udd[k][None, :])[:, 0]
-        good[i] = True
-    angular = np.array([n.endswith(".angle") for n in report])
-    for b, k in enumerate(ok_poses):
-        block = slice(b * n_s, (b + 1) * n_s)
-        g = good[block]
+    ok = np.asarray(sw.ok, dtype=bool)
+    Qv = np.full((len(report), n_s, n_pose), np.nan)
+    good = np.zeros((n_s, n_pose), dtype=bool)
+    if n_pose <= FEW_POSES:  # far apart, as a rule: each from the nominal's pose there
+        todo = [(a, a + 1, np.arange(n_s)) for a in np.flatnonzero(ok)]
+    else:  # swept along each run of poses the nominal solved
+        edges = np.flatnonzero(np.diff(np.r_[0, ok.astype(int), 0]))
+        todo = [(a, b, np.arange(n_s)) for a, b in zip(edges[::2], edges[1::2])]
+    restarts = 0
+    while todo:
+        a, b, idx = todo.pop()
+        pts = model.points(sw.q[a], U[a], p0)
+        guess = {nm: tuple(pts[:, j]) for j, nm in enumerate(m.moving_points)}
+        cut = lambda T: {k: T[a:b, j] for j, k in enumerate(keys)}
+        r = sweep_designs(m, X[idx], cut(U), names=to, rates=cut(Ud), accelerations=cut(Udd),
+                          report=list(report), guess=guess)
+        for i, nm in enumerate(report):
+            Qv[i, idx, a:b] = r.values[nm]
+        good[idx, a:b] = r.ok
+        stopped = ~r.ok.all(axis=1)
+        first = np.argmin(r.ok, axis=1)
+        for f in np.unique(first[stopped]):
+            if a + f + 1 < b:
+                again = idx[stopped & (first == f)]
+                todo.append((a + f + 1, b, again))
+                restarts += len(again)
+    angular = np.array([n.endswith(".angle") for n in report], dtype=bool)
+    for k in np.flatnonzero(ok):
+        g = good[:, k]
         failed[k] = int(n_s - g.sum())
         if g.sum() < 2:
             continue
         nom = np.array([sw[n][k] for n in report])
-        d = Qv[:, block][:, g] - nom[:, None]
+        d = Qv[:, g, k] - nom[:, None]
         d[angular] = np.angle(np.exp(1j * d[angular]))  # deviations of angles across +-pi
         mc[k] = d.std(axis=1, ddof=1)
         shift[k] = d.mean(axis=1)
-    return mc, shift, failed, retried
+    return mc, shift, failed, restarts
 
 
 # --- scenes: the [tolerance] section ---

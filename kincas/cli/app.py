@@ -92,11 +92,14 @@ def _check_args(args) -> None:
     if write and Path(write).exists() and not Path(write).is_dir():
         raise OutputError(f"--write: {write} exists and is not a directory (--write names a directory)")
     starts, samples = getattr(args, "starts", None), getattr(args, "samples", None)
-    if not (starts or args.command == "tolerance"):
+    if not (starts or args.command in ("tolerance", "range")):
         return
     from .scene import load
     from ..core.numeric import compile
     sc = load(args.scene)
+    if args.command == "range" and not sc.study.inputs:
+        raise OutputError("[[inputs]]: none declared, so there is no range of motion to find "
+                          "(kincas range ranges an input; kincas solve solves a structure)")
     nq, nrep = compile(sc.mechanism).sym.nq, len(sc.quantities)
     try:
         if starts:

@@ -18,11 +18,16 @@ def cli_arguments(parser) -> None:
     """Arguments of `kincas optimize`."""
     parser.add_argument("scene", help="the scene file (TOML) with an [optimize] section")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--starts", type=int, metavar="N", help="optimise from N starting designs drawn in the bounds; report the best distinct optima")
+    parser.add_argument("--seed", type=int, help="random seed of the starts (default 0)")
+    parser.add_argument("--scheduler", metavar="ADDRESS", help="run the starts on the Dask cluster at this scheduler address")
 
 
 def cli_run(args) -> int:
     """Run `kincas optimize`: 0 for an optimal design that passed every check, 3 otherwise."""
     sc = load(args.scene)
+    if getattr(args, "starts", None) is not None:
+        return _multistart_run(sc, args)
     r = run_scene(sc)
     doc = report(sc, r)
     if args.json:
@@ -110,3 +115,63 @@ def _print(sc, r: OptimizeResult, doc: dict):
     print("\n[parameters]   # the optimised design" + ("" if r.ok else " (NOT optimal, see above)"))
     for p, v in r.parameters.items():
         print(f"{p} = {v:.12g}")
+
+
+# --- kincas optimize SCENE.toml --starts N ---
+
+
+def _multistart_run(sc, args) -> int:
+    """`kincas optimize --starts N`: the best distinct optima, each reported as one run is;
+    0 when at least one passed every check, 3 otherwise."""
+    import dataclasses
+
+    from ..errors import ModelError, OutputError, SceneError
+    from ..synthesis.multistart import multistart
+    from ..synthesis.optimize import read_section
+
+    if args.starts < 1:
+        raise OutputError(f"--starts: expected a whole number >= 1, got {args.starts}")
+    if args.seed is not None and args.seed < 0:
+        raise OutputError(f"--seed: expected a whole number >= 0, got {args.seed}")
+    kw = read_section(sc)
+    if "curve" in sc.study.raw.get("optimize", {}):
+        raise OutputError("--starts: not with [optimize.curve] (its fitted inputs start from "
+                          "the starting design's curve)")
+    client = None
+    if args.scheduler:
+        from ..analysis.executor import connect
+        try:
+            client = connect(args.scheduler)
+        except ImportError:
+            raise OutputError("--scheduler: needs dask.distributed (pip install 'kincas[dask]')") from None
+        except (OSError, TimeoutError, ValueError) as e:
+            raise OutputError(f"--scheduler: cannot connect to {args.scheduler!r}: {e}") from None
+    samples, vary = kw.pop("samples"), kw.pop("vary")
+    minimize, constraints = kw.pop("minimize"), kw.pop("constraints")
+    try:
+        r = multistart(sc.mechanism, samples, vary, minimize, constraints, starts=args.starts,
+                       seed=args.seed or 0, client=client, rates=sc.study.rates,
+                       accelerations=sc.study.accelerations, **kw)
+    except ModelError as e:
+        raise SceneError([f"[optimize] {p}" for p in e.problems]) from None
+    finally:
+        if client is not None:
+            client.close()
+    docs = []
+    for o in r.optima:
+        i = next(j for j, x in enumerate(r.results) if x is o)
+        start = dataclasses.replace(sc, mechanism=sc.mechanism.with_parameters(
+            **dict(zip(r.names, map(float, r.starts[i])))))
+        docs.append((start, o, report(start, o)))
+    passed = sum(1 for x in r.results if not isinstance(x, Exception) and x.ok)
+    if args.json:
+        json.dump({"starts": r.runs, "seed": args.seed or 0, "passed": passed,
+                   "optima": [d for _, _, d in docs]}, sys.stdout, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        print(f"{sc.study.title or 'kincas'}: {r.runs} starts in the bounds, {passed} optima "
+              f"passed every check, {len(r.optima)} distinct shown (best first)")
+        for k, (start, o, d) in enumerate(docs, 1):
+            print(f"\n--- optimum {k} ---")
+            _print(start, o, d)
+    return 0 if r.optima else 3

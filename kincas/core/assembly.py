@@ -36,7 +36,7 @@ import numpy as np
 
 from .newton import newton
 from .joints import settle_first
-from .numeric import Solution
+from .numeric import Solution, _Call
 from .tolerances import ACCEPT, TOL
 
 SIGN_TOL = 1e-8  # a block whose conditioning is below this has no trustworthy sign (mode 0)
@@ -53,50 +53,10 @@ ROUNDING = 1e-15
 
 def blocks(model) -> list[tuple[np.ndarray, np.ndarray]]:
     """(rows, cols) of each Assur group's block of g_q, in solve order (a block's equations
-    involve only its own unknowns and those of the blocks before it).
-
-    The blocks are `model.blocks` where the model has them, else the block-triangular form of
-    g_q's sparsity (`casadi.Sparsity.btf`); either way they are put in an order that g_q's
-    sparsity proves a solve order. A tall g_q (redundant joints) or a structurally singular
-    one is a single block."""
-    memo = model.__dict__.setdefault("_assembly_blocks", [])
-    if memo:
-        return memo[0]
-    nq, ng = model.nq, model.ng
-    own = getattr(model, "blocks", None)
-    if own is not None:  # already in solve order (kincas/core/structure.py)
-        memo.append([(np.asarray(b.rows, int), np.asarray(b.cols, int)) for b in own])
-        return memo[0]
-    else:
-        out = []
-        if nq and ng == nq:
-            nb, rp, cp, rb, cb, _, ccb = model.sym.Jq.sparsity().btf()
-            if ccb[3] == nq:
-                out = [(np.array(sorted(rp[rb[k]:rb[k + 1]]), dtype=int),
-                        np.array(sorted(cp[cb[k]:cb[k + 1]]), dtype=int)) for k in range(nb)]
-    if nq and not out:
-        out = [(np.arange(ng), np.arange(nq))]
-    memo.append(_solve_order(model, out))
-    return memo[0]
-
-
-def _solve_order(model, bl):
-    """The blocks sorted so that each one's equations use unknowns of blocks before it only
-    (a topological order of the dependencies that g_q's sparsity shows)."""
-    sp = model.sym.Jq.sparsity()
-    nz = np.zeros((model.ng, model.nq), dtype=bool)
-    r, c = sp.get_triplet()
-    nz[np.asarray(r, int), np.asarray(c, int)] = True
-    needs = [{j for j, (_, cb) in enumerate(bl) if j != i and nz[np.ix_(rows, cb)].any()}
-             for i, (rows, _) in enumerate(bl)]
-    order, done = [], set()
-    while len(order) < len(bl):
-        ready = [i for i in range(len(bl)) if i not in done and needs[i] <= done]
-        if not ready:  # not triangular after all: one block
-            return [(np.arange(model.ng), np.arange(model.nq))]
-        order += ready
-        done |= set(ready)
-    return [bl[i] for i in order]
+    involve only its own unknowns and those of the blocks before it): `model.blocks`
+    (kincas/core/structure.py) as index arrays. A tall g_q (redundant joints) is one block."""
+    return model.memo("assembly.blocks", lambda: [(np.asarray(b.rows, int), np.asarray(b.cols, int))
+                                                  for b in model.blocks])
 
 
 def group_links(model) -> list[list[str]]:
@@ -135,18 +95,14 @@ def _block_newton(model, q, u, p, L, i, max_iter=30):
     """The one Newton (kincas/core/newton.py) on group i alone, the other unknowns fixed, its
     residual measured against its own length: (q, relative residual)."""
     rows, cols = blocks(model)[i]
-    eq, qs = model.scales(u, p) if hasattr(model, "scales") else (np.full(model.ng, L), np.where(model.sym.is_length, L, 1.0))
+    eq, qs = model.scales(u, p)
+    call = model._block_calls()[i]
     q = q.copy()
-    calls = model._block_calls() if hasattr(model, "_block_calls") else None
-    own = calls is not None and len(calls) == len(blocks(model))
 
     def F(x):
         q[cols] = x
-        if own:
-            g, J = calls[i](q, u, p)
-            return g.ravel().copy(), J.copy()
-        g, J = model.resjac(q, u, p)
-        return g[rows], J[np.ix_(rows, cols)]
+        g, J = call(q, u, p)
+        return g.ravel(), J
     res = newton(F, q[cols], qs[cols], eq[rows], max_iter=max_iter)
     q[cols] = res.x
     return q, res.residual
@@ -299,21 +255,20 @@ def refine(model, q, u, p, L):
     """q polished by the one Newton down to rounding (not just to TOL): next to a singular
     position an error in g of TOL moves the unknowns by TOL / sigma, so the last digits need
     the extra steps."""
-    eq, qs = model.scales(u, p) if hasattr(model, "scales") else (np.full(model.ng, L), np.where(model.sym.is_length, L, 1.0))
+    eq, qs = model.scales(u, p)
     res = newton(lambda x: model.resjac(x, u, p), np.array(q, float), qs, eq, tol=0.0, max_iter=8)
     return res.x if res.ok else np.array(q, float)
 
 
 def _jv_function(model):
     """f(q, u, p, v) -> (g, g_q v, d[g; g_q v]/dq, g_q): the singular-pose system's parts."""
-    memo = model.__dict__.setdefault("_assembly_jv", [])
-    if not memo:
+    def build():
         sym = model.sym
         v = ca.SX.sym("v", sym.nq)
         Jv = ca.mtimes(sym.Jq, v)
         F = ca.vertcat(sym.g, Jv)
-        memo.append(ca.Function("jv", [sym.q, sym.u, sym.p, v], [sym.g, Jv, ca.jacobian(F, sym.q), sym.Jq]))
-    return memo[0]
+        return _Call(ca.Function("jv", [sym.q, sym.u, sym.p, v], [sym.g, Jv, ca.jacobian(F, sym.q), sym.Jq]))
+    return model.memo("assembly.jv", build)
 
 
 def polish_singular(model, q, u, p, L, groups, max_iter: int = 30):

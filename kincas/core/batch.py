@@ -108,6 +108,10 @@ class BatchEvaluator:
     def derivatives(self, Q, U, P):
         """g (N, ng), g_q (N, ng, nq), g_u (N, ng, nu), g_p (N, ng, np)."""
         n = Q.shape[0]
+        if n == 0:
+            sym = self.model.sym
+            return (np.zeros((0, sym.ng)), np.zeros((0, sym.ng, self.nq)),
+                    np.zeros((0, sym.ng, self.nu)), np.zeros((0, sym.ng, self.np)))
         outs = self._mapped(self._f, n)(np.asarray(Q, float).T, np.asarray(U, float).T,
                                         np.asarray(P, float).T)
         g = np.asarray(outs[0]).T

@@ -1,9 +1,8 @@
-"""Many solves in one vectorised CasADi call: Newton from scattered starts (assembly modes)
-and from a first-order predictor over parameter samples (tolerance Monte Carlo).
+"""Newton from many scattered starts in one vectorised CasADi call (assembly modes).
 
-Both are the scatter phase of their analysis: what they accept is measured with the same
+This is the scatter phase of `kincas modes`: what it accepts is measured with the same
 per-group residual as the careful Newton (`Model.scales`, kincas/core/tolerances.py), and
-what they do not accept goes through the careful Newton (kincas/core/newton.py).
+what it finds is polished by the careful Newton (kincas/core/newton.py).
 
 >>> import numpy as np, kincas
 >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
@@ -78,37 +77,3 @@ def newton_starts(model, Q, u, p, iterations: int):
             break
     r = np.where(np.all(np.isfinite(X), axis=0), r, np.nan)
     return X.T, r
-
-
-# --- parameter samples: predictor and Newton steps ---
-
-
-def sample_function(model, report: tuple[str, ...], newton_steps: int) -> ca.Function:
-    """F(q0, u, p0, dp, u', u'', eq_scale) -> (q, relative residual, g_q, quantities): from the
-    nominal pose q0 a first-order predictor along dq/dp = -g_q^-1 g_p, then `newton_steps`
-    Newton steps with the exact Jacobian, all as one CasADi expression graph (map it over
-    samples); the residual is max |g / eq_scale| as everywhere in the core."""
-    return model.memo(("scatter.sample", report, newton_steps),
-                      lambda: _build_sample_function(model, report, newton_steps))
-
-
-def _build_sample_function(model, report, newton_steps):
-    sym = model.sym
-    q0, u, p0, dp = (ca.SX.sym(n, k) for n, k in
-                     (("q0", sym.nq), ("u", sym.nu), ("p0", sym.np), ("dp", sym.np)))
-    ud, udd, eq = ca.SX.sym("ud", sym.nu), ca.SX.sym("udd", sym.nu), ca.SX.sym("eq", sym.ng)
-    p = p0 + dp
-    gp = ca.Function("gp", [sym.q, sym.u, sym.p], [ca.jacobian(sym.g, sym.p)])
-    if sym.nq:
-        # Predictor: the tangent of the solution manifold, dq/dp = -g_q^-1 g_p, at the nominal.
-        _, J0 = sym.f_resjac(q0, u, p0)
-        q = q0 - ca.solve(J0, ca.mtimes(gp(q0, u, p0), dp))
-        for _ in range(newton_steps):  # Newton with the exact Jacobian: g_q dq = -g
-            g, J = sym.f_resjac(q, u, p)
-            q = q - ca.solve(J, g)
-        g, J = sym.f_resjac(q, u, p)
-        r = ca.mmax(ca.fabs(g / eq))
-    else:
-        q, J, r = ca.SX(0, 1), ca.SX(0, 0), ca.SX(0)
-    vals = model.quantity_function(report)(q, u, p, ud, udd)
-    return ca.Function("tolerance_sample", [q0, u, p0, dp, ud, udd, eq], [q, r, ca.vec(J), vals])
