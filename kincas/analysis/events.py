@@ -122,9 +122,11 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma):
         if sv[-1] <= FLAG_SIGMA * max(sv[0], 1.0):
             flags[k] = flags[k] or classify(J, Gu)
     # a group changing mode between two solved poses crossed a singular position of its own
-    for k in np.flatnonzero(ok[:-1] & ok[1:]):
-        a, b = signs[k], signs[k + 1]
-        for i in np.flatnonzero((a != b) & (a != 0) & (b != 0)):
+    # (the changes found for all poses at once: a Python loop over every pose cost more than
+    # the compiled solve of a long sweep)
+    flips = (signs[:-1] != signs[1:]) & (signs[:-1] != 0) & (signs[1:] != 0)
+    for k in np.flatnonzero(ok[:-1] & ok[1:] & flips.any(axis=1)):
+        for i in np.flatnonzero(flips[k]):
             c0, c1 = measure(k)[1][i], measure(k + 1)[1][i]
             start, other = (k, k + 1) if c0 <= c1 else (k + 1, k)
             found = locate_singular(model, Q[start], U[start], p, L, U[other] - U[start], group=int(i))
@@ -134,7 +136,8 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma):
             else:  # crossed, but not located: said all the same
                 event("singular", k + 1, U[k + 1], int(i))
     # a solved pose next to one with no assembly: the limits between them
-    for k in np.flatnonzero(ok):
+    gap = np.r_[False, ~ok[:-1]] | np.r_[~ok[1:], False]
+    for k in np.flatnonzero(ok & gap):
         for nb in (k - 1, k + 1):
             if not 0 <= nb < n or ok[nb] or np.allclose(U[nb], U[k]):
                 continue
