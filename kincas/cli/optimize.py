@@ -10,7 +10,7 @@ import numpy as np
 
 from ..model.names import is_angular
 from ..synthesis.optimize import OptimizeResult, run_scene
-from .common import _list, _param_unit
+from .common import _list, _param_unit, _unit
 from .scene import load
 
 
@@ -59,7 +59,7 @@ def report(sc, r: OptimizeResult) -> dict:
         "title": sc.study.title, "units": sc.study.units, "ok": r.ok, "converged": r.converged,
         "status": r.status, "message": r.message, "problems": r.problems,
         "iterations": r.iterations, "objective": num(r.objective),
-        "initial_objective": num(r.initial_objective),
+        "initial_objective": num(r.initial_objective), "objective_unit": _objective_unit(sc),
         "parameters": r.parameters, "varied": r.varied,
         "initial": {p: sc.mechanism.parameter(p) for p in r.varied},
         "bounds": {p: list(bounds[p]) for p in r.varied},
@@ -75,6 +75,34 @@ def report(sc, r: OptimizeResult) -> dict:
     }
 
 
+def _objective_unit(sc) -> str | None:
+    """The objective's unit in the scene's units (`kincas.synthesis.dimensions`): that of
+    `minimize`, and with a target curve a squared length; None where it cannot be decided."""
+    from ..errors import ModelError
+    from ..synthesis.dimensions import expression_unit, format_unit, parse_label
+    from ..synthesis.expressions import parse
+
+    t = sc.study.raw["optimize"]
+    L, angle = sc.study.units.get("length", ""), sc.study.units.get("angle", "deg")
+    params = sc.mechanism.param_values
+
+    def label(name):
+        if name == "__angle__":
+            return angle
+        return _param_unit(sc, name) if name in params else _unit(sc, name)
+
+    units = []
+    if "curve" in t:  # the sum of squared distances to the targets
+        units.append(format_unit(parse_label(f"{L}^2")) if L else None)
+    if t.get("minimize") is not None:
+        data = list((t.get("data") or {}).keys()) if isinstance(t.get("data"), dict) else []
+        try:
+            units.append(expression_unit(parse(t["minimize"], "minimize", data=data), label))
+        except ModelError:
+            return None
+    return units[0] if len(set(units)) == 1 else None
+
+
 def _at_bound(v: float, lo: float, hi: float) -> str | None:
     """"lower" or "upper" when v sits on that bound (to 1e-9 of the range), else None."""
     tol = 1e-9 * max(abs(hi - lo), abs(hi), abs(lo), 1e-300)
@@ -87,7 +115,8 @@ def _print(sc, r: OptimizeResult, doc: dict):
     print(r.message)
     for p in r.problems[1:]:
         print(f"  also: {p}")
-    print(f"objective: {r.initial_objective:.8g} (initial design) -> {r.objective:.8g}")
+    unit = f" [{doc['objective_unit']}]" if doc["objective_unit"] else ""
+    print(f"objective{unit}: {r.initial_objective:.8g} (initial design) -> {r.objective:.8g}")
     print(f"{'parameter':>12}  {'initial':>14}  {'optimised':>14}  {'low':>10}  {'high':>10}  unit")
     for p, v in r.varied.items():
         lo, hi = doc["bounds"][p]
