@@ -17,7 +17,7 @@ from . import _aliases
 from .errors import KincasError, ModelError, SceneError
 from .model import Input, Link, Load, Mechanism, Param, Slide
 from .results import Pose, Sweep
-from .core.numeric import compile
+from .core.numeric import compile, model_of
 from .analysis.sweeps import solve, sweep
 from .analysis.designs import sweep_designs
 from .synthesis.study import study
@@ -30,7 +30,7 @@ def __getattr__(name):
 
 
 __all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "sweep",
-           "sweep_designs", "study", "compile",
+           "sweep_designs", "study", "model_of", "compile",
            "sensitivities", "analyse", "optimize", "find_modes", "input_range",
            "Pose", "Sweep", "KincasError", "ModelError", "SceneError"]
 __version__ = "0.1.0"

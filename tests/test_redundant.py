@@ -144,15 +144,34 @@ def test_sensitivities_exact_where_the_change_keeps_the_chain_mobile():
 
 
 def test_not_a_parallelogram_is_still_an_error():
-    """With the crank 1.2 long the third link jams the chain: the rank test refuses it."""
+    """With the crank 1.2 long the third link jams the chain: the rank test refuses it, at
+    the first solve (declaring a mechanism runs no numerics; this test once expected the
+    error from the declaration itself)."""
+    m = triple().with_parameters(a=1.2)
     with pytest.raises(ModelError, match=r"0 degree\(s\) of freedom.*1 input\(s\)"):
-        triple().with_parameters(a=1.2)
+        kincas.sweep(m, {"crank.angle": [0.3]})
+    with pytest.raises(ModelError, match=r"0 degree\(s\) of freedom.*1 input\(s\)"):
+        m.redundant
 
 
 def test_wrong_input_count_is_still_an_error():
     """Two inputs for the one freedom of the redundant chain: the rank shows one freedom."""
+    m = triple(inputs=[Input.angle("crank"), Input.angle("rocker")])
     with pytest.raises(ModelError, match=r"but 2 input\(s\).*gives it 1 degree"):
-        triple(inputs=[Input.angle("crank"), Input.angle("rocker")])
+        kincas.solve(m, {"crank.angle": 0.3, "rocker.angle": 0.3})
+
+
+def test_declaring_runs_no_numerics(monkeypatch):
+    """The rank test is the core's, run at the first solve, not when a mechanism is built."""
+    import kincas.core.redundant as red
+
+    def refuse(*a, **k):
+        raise AssertionError("rank test run while declaring a mechanism")
+    monkeypatch.setattr(red, "rank_test", refuse)
+    m = triple().with_parameters(c=3.9)  # a new value (still a parallelogram): not decided before
+    assert m.mobility == 0
+    monkeypatch.undo()
+    assert m.redundant == 1
 
 
 def scene(inputs) -> dict:

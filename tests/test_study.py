@@ -206,3 +206,20 @@ def test_threads_give_the_numbers_of_one_thread_compiled():
     a4, a5 = two.params[5]
     s = kincas.sweep(m.with_parameters(a4=a4, a5=a5), args[2], report=["C.y"])
     assert two.values["max(C.y)"][5] == pytest.approx(s["C.y"].max(), abs=1e-10)
+
+
+def test_gaps_resume_finishes_a_design_as_kincas_sweep_does():
+    # A crank that cannot turn fully: the sweep loses the assembly and finds it again.
+    m = fourbar(a=30, b=50, c=45, d=70)
+    stop = kincas.sweep_designs(m, {"a4": [45.0, 45.2]}, {"crank.angle": TH}, report=["C.y"])
+    res = kincas.sweep_designs(m, {"a4": [45.0, 45.2]}, {"crank.angle": TH}, report=["C.y"],
+                               gaps="resume")
+    for d, a4 in enumerate([45.0, 45.2]):
+        s = kincas.sweep(m.with_parameters(a4=a4), {"crank.angle": TH}, report=["C.y"])
+        ok = np.array(s.ok)
+        first = int(np.argmin(ok))
+        assert 0 < first and ok[first:].any()  # a gap, then solved poses again
+        assert stop.ok[d, :first].all() and not stop.ok[d, first:].any()
+        assert (stop.status[d, first + 1:] == "not solved").all()
+        assert np.array_equal(res.ok[d], ok)
+        assert np.allclose(res.values["C.y"][d, ok], s["C.y"][ok], rtol=0, atol=1e-9)

@@ -69,3 +69,37 @@ def test_a_worker_killed_mid_study_loses_nothing():
     # every design exactly once, in order, with the numbers the local run gives
     assert len({tuple(r) for r in remote.params}) == 60
     _same(local, remote)
+
+
+def test_cli_scheduler_writes_the_local_rows(tmp_path, capsys):
+    from conftest import EXAMPLES, run_cli
+
+    text = (EXAMPLES / "study_fourbar.toml").read_text()
+    text = text.replace("steps = 360", "steps = 37").replace("grid = [41, 41]", "grid = [5, 4]")
+    scene = tmp_path / "s.toml"
+    scene.write_text(text)
+    code, _, err = run_cli(capsys, "study", scene, "--out", tmp_path / "local.csv")
+    assert code == 3, err  # designs with a4 - a5 > 37.25 do not assemble
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster:
+        code, _, err = run_cli(capsys, "study", scene, "--out", tmp_path / "dask.csv",
+                               "--scheduler", cluster.scheduler_address)
+    assert code == 3, err
+    assert (tmp_path / "dask.csv").read_text() == (tmp_path / "local.csv").read_text()
+
+
+def test_multistart_on_a_cluster_gives_the_local_optima():
+    from kincas.synthesis.multistart import multistart
+
+    m = Mechanism(parameters={"d": 4.0}, ground={"A": (0, 0), "D": ("d", 0)},
+                  links=[Link.bar("crank", "A", "B", 1), Link.bar("coupler", "B", "C", 3.5),
+                         Link.bar("rocker", "D", "C", 3)],
+                  inputs=[Input.angle("crank")], guess={"C": (3.6, 2.9)})
+    args = (m, {"crank.angle": np.array([0.5])}, {"d": (2.0, 6.0)}, "sum((C.y - 2.9)^2)")
+    local = multistart(*args, starts=4, seed=1)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        remote = multistart(*args, starts=4, seed=1, client=client)
+    assert [o.varied for o in remote.optima] == [o.varied for o in local.optima]
+    assert len(local.optima) == 2

@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.assembly import NEAR, assemble, blocks, group_links, modes, polish_singular
-from ..core.joints import settle_first
+# the first pose of a sweep (its home is the core: `kincas modes` and `range` start there too)
+from ..core.assembly import ambiguous as _ambiguous, first_pose as _first, no_assembly as _no_assembly  # noqa: F401
 from ..core.numeric import Model, Solution
 from ..model.mechanism import Mechanism
 
@@ -75,39 +76,6 @@ def _resume(model: Model, U, p, L, k, j, run, events) -> Solution:
 
 
 # --- one pose: from the guess, from the previous pose, after a failure ---
-
-
-def _no_assembly(model: Model, q) -> Solution:
-    return Solution(np.array(q, float), np.inf, 0, False, None)
-
-
-def _ambiguous(model: Model) -> bool:
-    """Whether group-by-group assembly may miss an assembly that exists: only a dyad's block
-    Newton from spread starts is conclusive (two circle or circle-line intersections); larger
-    groups and tall systems (redundant joints) get IPOPT as a last resort."""
-    return not model.square or any(len(c) > 2 for _, c in blocks(model))
-
-
-def _first(model: Model, u, p, L, guess) -> Solution:
-    """The first pose: from the guessed points (the nearest assembly), or without a guess
-    group by group in the default modes (see kincas/core/assembly.py)."""
-    return settle_first(model, _assembled(model, u, p, L, guess), u, p, L)  # gears: angles in (-pi, pi]
-
-
-def _assembled(model: Model, u, p, L, guess) -> Solution:
-    if model.nq == 0:
-        return model.newton(np.zeros(0), u, p, L)
-    if not guess:
-        sol = assemble(model, u, p, L)
-        if sol is not None or not _ambiguous(model):
-            return sol if sol is not None else _no_assembly(model, np.zeros(model.nq))
-    q0 = model.initial_q(u, p, guess, L)
-    sol = model.newton(q0, u, p, L)
-    if not sol.ok and guess:  # group by group from the guessed pose, then IPOPT if in doubt
-        sol = assemble(model, u, p, L, near=q0) or sol
-    if not sol.ok and _ambiguous(model):  # IPOPT: the assembly nearest the guessed points
-        sol = model.nearest_assembly(q0, u, p, {k: np.array(v) for k, v in guess.items()}, L)
-    return sol
 
 
 def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:

@@ -164,9 +164,22 @@ def _distinct(events):
 
 
 def null_derivatives(model, report, values, Q, U, p, at) -> None:
-    """At poses exactly at a singular position (`at`): positions recomputed from the exact
-    pose, every quantity that needs g_q's inverse (velocities, accelerations, sensitivities)
-    set to NaN. The flag says why."""
+    """At poses at (or next to) a singular position: positions recomputed from the exact
+    pose, every quantity that needs g_q's inverse (velocities, accelerations, jerks,
+    sensitivities, efforts) set to NaN; the pose's flag says why.
+
+    Parameters
+    ----------
+    model : kincas.core.numeric.Model
+    report : list of str
+        The quantity names, one per row of `values`.
+    values : numpy.ndarray
+        (len(report), n), changed in place.
+    Q, U, p : numpy.ndarray
+        Unknowns and inputs per pose, parameter values.
+    at : numpy.ndarray of bool
+        The poses concerned (as `sweep_events` returns them).
+    """
     idx = np.flatnonzero(at)
     if idx.size == 0 or not report:
         return

@@ -28,7 +28,7 @@ def connect(address: str):
     """A `dask.distributed.Client` for the scheduler at `address` (ImportError without dask)."""
     from distributed import Client
 
-    return Client(address)
+    return Client(address, timeout="10s")
 
 
 def run_chunks(fn, chunks, *, client=None, workers: int | None = None, progress=None,

@@ -29,21 +29,21 @@ True
 """
 from __future__ import annotations
 
-import json
 import math
 import re
-import sys
 import tomllib
 from dataclasses import dataclass, field
-from pathlib import Path
 
-import casadi as ca
 import numpy as np
 
 from ..errors import ModelError, SceneError
 from ..model.mechanism import Mechanism
 from ..results import wrap_angle
-from ..core.numeric import ACCEPT, MAX_STEP, TOL, compile
+from ..core.assembly import first_pose
+from ..core.scatter import newton_starts
+from ..core.numeric import model_of
+from ..core.tolerances import ACCEPT, BRANCH
+from .inputs import input_table
 
 SAME = 1e-6  # two assemblies are one mode when every point agrees to this times the size
 CONVERGED = 1e-8  # a start whose relative residual reaches this is worth polishing
@@ -96,7 +96,7 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
     """
     if starts < 1:
         raise ModelError(f"starts: expected a whole number >= 1, got {starts!r}")
-    model = compile(m)
+    model = model_of(m)
     u = _input_vector(m, inputs)
     driven = {i.target: float(u[k]) for k, i in enumerate(m.inputs) if i.kind == "parameter"}
     m_at = m.with_parameters(**driven) if driven else m
@@ -106,22 +106,20 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
     # The mechanism's own guess is start 0, so the mode a sweep would take is always found.
     guess = {k: (m_at.value(x), m_at.value(y)) for k, (x, y) in m.guess}
     Q = np.vstack([model.initial_q(u, p, guess, L), _scatter(m_at, model, starts - 1, L, seed)])
-    Q, r = _batch_newton(model, Q, u, p, L, iterations)
+    Q, r = newton_starts(model, Q, u, p, iterations)
     Q = Q[np.isfinite(r) & (r <= CONVERGED)]
     Q = Q[_unique(_point_rows(model, Q, u, p), 10 * SAME * L)]  # many starts, few modes
 
     found = [sol.q for sol in (model.newton(q, u, p, L) for q in Q) if sol.ok]  # polish
-    from .sweeps import sweep  # the assembly a sweep from the mechanism's guess starts on
-    first = sweep(m, {k: [v] for k, v in zip([i.key for i in m.inputs], u)}, report=[])
-    picked = first.q[0] if first.ok[0] else None
+    first = first_pose(model, u, p, L, guess)  # the assembly a sweep from the guess starts on
+    picked = first.q if first.ok else None
     from ..frames import Modes  # a list, with to_pandas() and to_xarray()
     return Modes(_distinct(m, model, found + ([picked] if picked is not None else []), u, p, L, picked))
 
 
 def _input_vector(m: Mechanism, inputs) -> np.ndarray:
     """One finite value per input (the pose at which the modes are wanted)."""
-    from .sweeps import _input_table
-    U = _input_table(m, {} if inputs is None and not m.inputs else inputs, "inputs", None)
+    U = input_table(m, {} if inputs is None and not m.inputs else inputs, "inputs", None)
     if U.shape[0] != 1:
         raise ModelError("inputs: expected one value per input (modes are found at one pose)")
     return U[0]
@@ -142,47 +140,6 @@ def _scatter(m: Mechanism, model, n: int, L: float, seed: int) -> np.ndarray:
             centre = ground[rng.integers(len(ground), size=n)]
             Q[:, j], Q[:, jy] = (centre + rng.uniform(-L, L, size=(n, 2))).T
     return Q
-
-
-# --- Newton from every start at once ---
-
-def _step_function(model) -> ca.Function:
-    """(q, u, p, L) -> (q after one Newton step, relative residual at q), one start.
-
-    The step solves g_q dq = -g with the exact Jacobian and is shortened so that no angle
-    moves by more than MAX_STEP rad and no coordinate by more than MAX_STEP * L: a trust
-    region that keeps a start from being thrown across the workspace by a near-singular
-    Jacobian. Where g_q is singular the step is NaN and that start is dropped.
-    """
-    def build():
-        sym = model.sym
-        Ls = ca.SX.sym("L")
-        dq = -ca.solve(sym.Jq, sym.g)
-        scale = ca.if_else(ca.DM(sym.is_length.astype(float)), MAX_STEP * Ls, MAX_STEP)
-        shrink = ca.fmax(1, ca.mmax(ca.fabs(dq) / scale)) if sym.nq else ca.SX(1)
-        r = ca.mmax(ca.fabs(sym.g)) / Ls if sym.nq else ca.SX(0)
-        return ca.Function("newton_step", [sym.q, sym.u, sym.p, Ls], [sym.q + dq / shrink, r])
-    return model.memo("modes.newton_step", build)
-
-
-def _batch_newton(model, Q, u, p, L, iterations):
-    """Trust-region Newton on every row of Q at once; returns the iterates and their
-    relative residuals (NaN where a start diverged)."""
-    n = Q.shape[0]
-    if model.nq == 0:
-        return Q, np.full(n, np.abs(model.residual(np.zeros(0), u, p)).max(initial=0.0) / L)
-    step = _step_function(model).map(n)
-    U, P = np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)
-    X, r = Q.T.copy(), np.full(n, np.inf)
-    for _ in range(iterations):
-        Xn, rn = (np.asarray(a) for a in step(X, U, P, L))
-        r = rn.ravel()
-        done = ~np.isfinite(r) | (r <= TOL)
-        X = np.where(done, X, Xn)  # a converged start stays where it is
-        if done.all():
-            break
-    r = np.where(np.all(np.isfinite(X), axis=0), r, np.nan)
-    return X.T, r
 
 
 # --- duplicates ---
@@ -228,7 +185,7 @@ def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
                         points={nm: (float(pts[2 * j]), float(pts[2 * j + 1]))
                                 for j, nm in enumerate(names)},
                         angles={lk: float(wrap_angle(a)) for lk, a in zip(links, ang)},
-                        residual=res, orientation=int(np.sign(det)) if abs(det) > 1e-12 else 0,
+                        residual=res, orientation=int(np.sign(det)) if abs(det) > BRANCH else 0,
                         from_guess=bool(picked is not None and np.abs(pts - picked).max() <= SAME * L),
                         inputs={i.key: float(v) for i, v in zip(m.inputs, u)}))
     return [md for md in out if md.residual <= ACCEPT]  # each checked by its residual
@@ -274,78 +231,3 @@ def scene_with_guess(text: str, mode: Mode, note: str = "") -> str:
         raise SceneError("[guess]: not written as a [guess] table, so it cannot be replaced; "
                          "copy the printed [guess] block into the scene instead")
     return out
-
-
-# --- the command line: kincas modes SCENE.toml ---
-
-
-def cli_arguments(parser) -> None:
-    """Arguments of `kincas modes`."""
-    parser.add_argument("scene", help="the scene file (TOML)")
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--starts", type=int, default=512,
-                        help="number of scattered Newton starts (default 512)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the scattered starts")
-    parser.add_argument("--write", metavar="DIR",
-                        help="also write DIR/<scene>_mode<k>.toml: the scene with mode k's [guess]")
-
-
-def cli_run(args) -> int:
-    """Find the modes at the scene's first pose; print them (and write scenes with --write).
-    Exit status 0 when at least one assembly was found, 3 when none."""
-    from ..cli.scene import load
-    if args.starts < 1:
-        raise SceneError(f"--starts: expected a whole number >= 1, got {args.starts}")
-    sc = load(args.scene)
-    at = {k: float(v[0]) for k, v in sc.study.inputs.items()}
-    modes = find_modes(sc.mechanism, at, starts=args.starts, seed=args.seed)
-    deg = sc.study.deg
-    user_in = {k: (math.degrees(v) if deg and k.endswith(".angle") else v) for k, v in at.items()}
-    user_ang = [{lk: (math.degrees(a) if deg else a) for lk, a in md.angles.items()} for md in modes]
-    if args.write:
-        _write_scenes(args.scene, args.write, modes)
-    if args.json:
-        doc = {"title": sc.study.title, "units": sc.study.units, "inputs": user_in,
-               "starts": args.starts, "seed": args.seed,
-               "modes": [{"points": {p: list(xy) for p, xy in md.points.items()},
-                          "angles": ang, "residual": md.residual, "orientation": md.orientation,
-                          "from_guess": md.from_guess, "guess": md.guess_block()}
-                         for md, ang in zip(modes, user_ang)]}
-        json.dump(doc, sys.stdout, allow_nan=False)
-        sys.stdout.write("\n")
-    else:
-        _print_modes(sc, modes, user_in, user_ang, args)
-    return 0 if modes else 3
-
-
-def _print_modes(sc, modes, user_in, user_ang, args):
-    units = sc.study.units
-    unit = {k: units.get("angle", "deg") if k.endswith(".angle") else
-            units.get("length", "") if k.endswith(".s") else "" for k in user_in}
-    at = ", ".join(f"{k} = {v:.6g}" + (f" {unit[k]}" if unit[k] else "") for k, v in user_in.items())
-    print(sc.study.title or "kincas")
-    n = len(modes)
-    print(f"{n} assembly mode{'s' if n != 1 else ''}" + (f" at {at}" if at else "")
-          + f" ({args.starts} starts, seed {args.seed})")
-    for k, (md, ang) in enumerate(zip(modes, user_ang), 1):
-        mark = "  <- the scene's [guess] gives this one" if md.from_guess else ""
-        print(f"\nmode {k} of {n}: residual {md.residual:.1e}, orientation {md.orientation:+d}{mark}")
-        print("  angles: " + ", ".join(f"{lk} {a:.6g}" for lk, a in ang.items())
-              + f" {units.get('angle', 'deg')}")
-        print(md.guess_block(), end="")
-    if not modes:
-        print("no assembly found: the mechanism cannot be put together at this input")
-
-
-def _write_scenes(path, directory, modes) -> list[Path]:
-    """DIR/<scene>_mode<k>.toml for every mode: the scene as written, with that mode's guess."""
-    src, out = Path(path), Path(directory)
-    text = src.read_text(encoding="utf-8")
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-    for k, md in enumerate(modes, 1):
-        target = out / f"{src.stem}_mode{k}.toml"
-        note = f"assembly mode {k} of {len(modes)}, found by `kincas modes {src.name}`"
-        target.write_text(scene_with_guess(text, md, note), encoding="utf-8")
-        written.append(target)
-    return written

@@ -27,7 +27,6 @@ input turns back (a limit) or an angle input has made a full turn.
 """
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass, field
 
 import casadi as ca
@@ -155,18 +154,20 @@ def input_range(m: Mechanism, inputs: dict, key: str | None = None, *, max_steps
     """Range of input `key` (default: the first) on the branch of the pose at `inputs`,
     the other inputs held at their values. Limits are located to rounding precision."""
     from ..core.numeric import compile
-    from .sweeps import sweep
+    from ..core.assembly import first_pose
+    from .inputs import input_table
     model = compile(m)
     keys = [i.key for i in m.inputs]
     key = key or keys[0]
     i = keys.index(key)
-    start = sweep(m, inputs, report=[])  # the starting pose, solved once
-    if not start.ok[0]:
-        raise ValueError(f"the mechanism does not assemble at {inputs}")
     p = np.array([v for _, v in m.parameters], float)
     L = m.size()
-    u0 = np.array([start.inputs[k][0] for k in keys])
-    q0 = start.q[0]
+    u0 = input_table(m, inputs, "inputs", None)[0]
+    guess = {k: (m.value(x), m.value(y)) for k, (x, y) in m.guess}
+    start = first_pose(model, u0, p, L, guess)  # the starting pose, as a sweep's first
+    if not start.ok:
+        raise ValueError(f"the mechanism does not assemble at {inputs}")
+    q0 = start.q
     is_angle = m.inputs[i].kind == "angle"
     cq, cu = _scales(model, L)
     # unknowns / scale are O(1): angles as they are, lengths over the size
@@ -253,54 +254,3 @@ def _correct(model, zp, t, u, p, L, i, scale, max_iter=12):
             return None
         z = z + d
     return None
-
-
-# --- `kincas range SCENE.toml` ---
-
-
-def cli_arguments(ap):
-    ap.add_argument("scene", help="the scene file (TOML)")
-    ap.add_argument("--input", help="the input whose range is wanted (default: every input)")
-    ap.add_argument("--json", action="store_true", help="print one JSON object")
-
-
-def cli_run(args) -> int:
-    """Range of motion of each input (the others held at their first values) on the branch
-    of the scene's first pose; limits located to rounding precision."""
-    import json
-    import math
-
-    from ..errors import SceneError
-    from ..cli.scene import load
-    sc = load(args.scene)
-    m = sc.mechanism
-    keys = [i.key for i in m.inputs]
-    if args.input and args.input not in keys:
-        raise SceneError(f"--input: {args.input!r} is not an input of the scene (inputs: {keys})")
-    start = {k: float(v[0]) for k, v in sc.study.inputs.items()}
-    out, text = {}, []
-    for i, key in enumerate(keys):
-        if args.input and key != args.input:
-            continue
-        conv = math.degrees if (m.inputs[i].kind == "angle" and sc.study.deg) else float
-        unit = sc.study.units.get("angle") if m.inputs[i].kind == "angle" else sc.study.units.get("length", "")
-        try:
-            r = input_range(m, start, key)
-        except ValueError:
-            print(f"kincas: the mechanism does not assemble at its first pose ({key} = "
-                  f"{conv(start[key]):.12g} {unit})", file=sys.stderr)
-            return 3
-        out[key] = {"from": conv(r.low), "to": conv(r.high), "full_turn": r.full_turn,
-                    "start": conv(r.start),
-                    "limits": [{"kind": k, "input": conv(v)} for k, v in r.limits]}
-        if r.full_turn:
-            text.append(f"{key}: a full turn (no limit on this branch)")
-        else:
-            text.append(f"{key}: from {conv(r.low):.12g} to {conv(r.high):.12g} {unit}"
-                        + "".join(f"\n  {k} at {conv(v):.12g} {unit}" for k, v in r.limits))
-    if args.json:
-        print(json.dumps({"title": sc.study.title, "units": sc.study.units, "ranges": out}))
-    else:
-        print(sc.study.title or "kincas range")
-        print("\n".join(text))
-    return 0

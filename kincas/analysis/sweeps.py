@@ -16,7 +16,6 @@ one before along the exact tangent dq/du = -g_q^-1 g_u, so the branch is kept.
 """
 from __future__ import annotations
 
-from typing import Mapping
 
 import numpy as np
 
@@ -29,6 +28,7 @@ from ..core.symbolic import default_report, needs_jerk
 from .continuation import careful_pose
 from .events import null_derivatives
 from ..core.joints import check_first_pose
+from .inputs import input_table as _input_table
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
 
@@ -36,34 +36,6 @@ NO_ASSEMBLY = "no assembly"
 
 
 # --- sweeps ---
-
-
-def _input_table(m: Mechanism, inputs, what: str, default: float | None) -> np.ndarray:
-    """(N x nu) array of one value per input and pose from a mapping key -> scalar or array."""
-    keys = [i.key for i in m.inputs]
-    if inputs is None:
-        if default is None and keys:
-            raise ModelError(f"{what}: give a value for each of {keys}")
-        inputs = {}
-    elif not isinstance(inputs, Mapping):
-        if len(keys) != 1:
-            raise ModelError(f"{what}: the mechanism has inputs {keys}; give a mapping")
-        inputs = {keys[0]: inputs}
-    problems = [f"{what}: {k!r} is not an input (inputs: {keys})" for k in inputs if k not in keys]
-    if default is None:
-        problems += [f"{what}: no value for input {k!r}" for k in keys if k not in inputs]
-    if problems:
-        raise ModelError(problems)
-    if not keys:  # a structure (no freedom): one pose
-        return np.zeros((1, 0))
-    cols = [np.atleast_1d(np.asarray(inputs.get(k, default), dtype=float)) for k in keys]
-    bad = [k for k, c in zip(keys, cols) if c.ndim != 1 or not np.isfinite(c).all()]
-    if bad:
-        raise ModelError([f"{what}: {k!r}: expected finite numbers (one per pose)" for k in bad])
-    n = max(len(c) for c in cols)
-    if any(len(c) not in (1, n) for c in cols):
-        raise ModelError(f"{what}: inputs that sweep advance together, so their lengths must agree")
-    return np.stack([np.broadcast_to(c, (n,)) for c in cols], axis=1)
 
 
 def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,

@@ -28,14 +28,13 @@ reported beside the Monte-Carlo sampling error, 1 / sqrt(2 (N - 1)) relative.
 """
 from __future__ import annotations
 
-import json
 import math
-import sys
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import ModelError, SceneError
+from ..core.numeric import model_of
 from ..model.mechanism import Mechanism
 
 FEW_POSES = 16  # up to this many poses, each is solved from the nominal's (not swept to)
@@ -226,7 +225,6 @@ def _monte_carlo(m: Mechanism, sw, report, to, dp):
 
 def read_section(sc) -> dict:
     """The `[tolerance]` section as analyse()'s keywords; SceneError naming the field."""
-    from ..core.numeric import compile
     from ..core.symbolic import parse_quantity
 
     t = sc.study.raw.get("tolerance")
@@ -248,83 +246,10 @@ def read_section(sc) -> dict:
     if not isinstance(report, list) or not all(isinstance(n, str) for n in report):
         problems.append("[tolerance] report: expected a list of quantity names")
     else:
-        problems += compile(sc.mechanism).sym.check_names(report, "[tolerance] report")
+        problems += model_of(sc.mechanism, check=False).sym.check_names(report, "[tolerance] report")
         problems += [f"[tolerance] report: {n!r}: a sensitivity has no spread to analyse"
                      for n in report if parse_quantity(n)[0] == "sens"]
     if problems:
         raise SceneError(problems)
     return {"std": {k: float(v) for k, v in t["std"].items()}, "samples": samples,
             "seed": seed, "report": report}
-
-
-# --- the command line: kincas tolerance SCENE.toml ---
-
-
-def cli_arguments(parser) -> None:
-    """Arguments of `kincas tolerance`."""
-    parser.add_argument("scene", help="the scene file (TOML) with a [tolerance] section")
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--samples", type=int, help="Monte-Carlo samples (overrides the scene)")
-    parser.add_argument("--seed", type=int, help="random seed (overrides the scene)")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
-
-
-def cli_run(args) -> int:
-    """Run `kincas tolerance`: 0 when every pose and sample was solved, 3 otherwise."""
-    from ..cli.app import _list, _unit, progress_for
-    from ..core.symbolic import is_angular
-
-    from ..cli.scene import load
-
-    sc = load(args.scene)
-    kw = read_section(sc)
-    for k in ("samples", "seed"):
-        if getattr(args, k) is not None:
-            kw[k] = getattr(args, k)
-    if kw["samples"] < 2:
-        raise SceneError(f"--samples: expected a whole number >= 2, got {kw['samples']}")
-    st = sc.study
-    sc.refuse_jerks(sc.quantities, "[tolerance]")
-    r = analyse(sc.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
-                progress=progress_for(args), **kw)
-    user = lambda n, v: np.degrees(v) if is_angular(n, sc.mechanism) and st.deg else np.asarray(v, float)
-    inputs = {k: user(k, v) for k, v in r.inputs.items()}
-    from ..cli.numbers import snap  # a spread that is zero to rounding is printed as 0
-    fo = {n: snap(user(n, r.first_order[n]), 0.0) for n in r.names}
-    mc = {n: snap(user(n, r.monte_carlo[n]), 0.0) for n in r.names}
-    if args.json:
-        doc = {"title": st.title, "units": st.units, "samples": r.samples, "seed": r.seed,
-               "std": r.std, "inputs": {k: _list(v) for k, v in inputs.items()},
-               "status": [str(s) for s in r.status], "failed": r.failed.tolist(),
-               "nominal": {n: _list(user(n, r.nominal[n])) for n in r.names},
-               "first_order": {n: _list(v) for n, v in fo.items()},
-               "monte_carlo": {n: _list(v) for n, v in mc.items()},
-               "agreement": {n: _list(v) for n, v in r.agreement.items()},
-               "standard_error": r.standard_error, "agrees": r.agrees()}
-        json.dump(doc, sys.stdout, allow_nan=False)
-        sys.stdout.write("\n")
-    else:
-        _print(sc, r, inputs, fo, mc, lambda n: _unit(sc, n))
-    unsolved = any(s != "ok" for s in r.status) or int(r.failed.sum()) > 0
-    return 3 if unsolved else 0
-
-
-def _print(sc, r: ToleranceResult, inputs, fo, mc, unit):
-    stds = ", ".join(f"{p} {s:g}" for p, s in r.std.items())
-    print(f"{sc.study.title or 'kincas'}: tolerance analysis, {r.samples} samples (seed {r.seed})")
-    print(f"standard deviations: {stds}")
-    print("first-order std (exact sensitivities) and Monte-Carlo std, per pose:")
-    cols = [(k, v, unit(k)) for k, v in inputs.items()]
-    for n in r.names:
-        cols += [(f"std {n}", fo[n], unit(n)), (f"mc {n}", mc[n], unit(n))]
-    heads = [f"{h} [{u}]" if u else h for h, _, u in cols]
-    width = [max(12, len(h)) for h in heads]
-    print("  ".join(h.rjust(w) for h, w in zip(heads, width)) + "  failed")
-    for i in range(len(r.status)):
-        cells = [("-" if not math.isfinite(v[i]) else f"{v[i]:.6g}").rjust(w)
-                 for (_, v, _), w in zip(cols, width)]
-        tail = f"  {r.failed[i]}" if r.status[i] == "ok" else f"  ({r.status[i]})"
-        print("  ".join(cells) + tail)
-    verdict = "agree" if r.agrees() else "differ (the outputs are not linear over the tolerances)"
-    print(f"Monte Carlo and first order {verdict}: sampling error {100 * r.standard_error:.2g} %; "
-          f"{int(r.failed.sum())} sample poses did not assemble on the nominal branch")

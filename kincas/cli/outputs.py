@@ -48,7 +48,7 @@ def heading(name: str, scene=None) -> str:
     >>> heading("rocker.alpha")
     'rocker.alpha [rad/s^2]'
     """
-    from .app import _unit
+    from .common import _unit
     u = _unit(_units_of(scene), name)
     return f"{name} [{u}]" if u else name
 
@@ -394,7 +394,7 @@ def _dxf(path, m, sweep, scene, pose, paths):
 
 
 def _caption(scene, sweep, inputs, i) -> str:
-    from .app import _unit
+    from .common import _unit
     parts = []
     for k, v in inputs.items():
         u = _unit(scene, k)
@@ -416,7 +416,7 @@ def _save_drawing(path, m, sweep, pose, paths, captions, length, evolute=(), cen
 
 def _rendering(args):
     """A progress bar labelled "rendering" where `kincas solve` would show one."""
-    from .app import progress_for
+    from .common import progress_for
     bar = progress_for(args)
     if bar is not None:
         bar.label = "rendering"

@@ -33,6 +33,7 @@ import numpy as np
 
 from ..errors import KincasError, SceneError
 from ..model.mechanism import GROUND, Input, Link, Mechanism, Param, Slide
+from ..model.names import parse_quantity, plain_quantity
 from ..results import Sweep
 
 LARGEST = 1e100  # beyond it, squared lengths overflow double precision
@@ -392,9 +393,13 @@ class _Reader:
         return report, sens
 
     def check_quantities(self, m: Mechanism, report: list[str], sens: list[str]):
-        from ..core.numeric import compile
-        from ..core.symbolic import parse_quantity
-        sym = compile(m).sym
+        """Point, link and slide quantities are checked from the declarations; only a scene
+        that names other quantities (efforts, reactions, curvature, ...) builds the model
+        to check them, so reading an ordinary scene runs no CasADi."""
+        if all(plain_quantity(m, n) for n in [*report, *sens]):
+            return
+        from ..core.numeric import model_of
+        sym = model_of(m, check=False).sym
         bad = sym.check_names(report)
         # each `of` name and each `to` name once, under the field they were written in
         of = list(dict.fromkeys(parse_quantity(n)[1] for n in sens))

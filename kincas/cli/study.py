@@ -105,7 +105,7 @@ def cli_arguments(parser) -> None:
 
 def cli_run(args) -> int:
     """Run `kincas study`: 0 when every design was solved, 3 otherwise."""
-    from .app import progress_for
+    from .common import progress_for
     from .scene import load
 
     sc = load(args.scene)

@@ -35,6 +35,7 @@ import casadi as ca
 import numpy as np
 
 from .newton import newton
+from .joints import settle_first
 from .numeric import Solution, _Call
 from .tolerances import ACCEPT, TOL
 
@@ -65,10 +66,37 @@ def group_links(model) -> list[list[str]]:
 
 
 def modes(model, J, L) -> tuple[np.ndarray, np.ndarray]:
-    """(mode, conditioning) of every group at one pose or many: J is g_q, (ng, nq) or
-    (n, ng, nq). mode is the sign of the block's determinant (0 where the block is within
-    SIGN_TOL of singular, or tall); conditioning is sigma_min / sigma_max of the block with
-    its columns scaled to O(1)."""
+    """Each Assur group's mode and conditioning at one pose or many.
+
+    Parameters
+    ----------
+    model : kincas.core.numeric.Model
+    J : numpy.ndarray
+        g_q at one pose (ng, nq) or at many (n, ng, nq).
+    L : float
+        The mechanism's size (columns of angles are scaled by 1/L: only positive factors,
+        so the signs are those of the unscaled blocks).
+
+    Returns
+    -------
+    mode : numpy.ndarray of int
+        (groups,) or (n, groups): the sign of each block's determinant, 0 where the block is
+        within SIGN_TOL of singular (or tall: redundant joints).
+    conditioning : numpy.ndarray
+        Same shape: sigma_min / sigma_max of each column-scaled block.
+
+    Examples
+    --------
+    >>> import numpy as np, kincas
+    >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+    ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 4),
+    ...            kincas.Link.bar("rocker", "D", "C", 1)], inputs=[kincas.Input.angle("crank")])
+    >>> model = kincas.compile(m)
+    >>> q = np.array([np.pi / 2, 0.0])  # a parallelogram at 90 deg (rocker, coupler angles)
+    >>> mode, cond = modes(model, model.jac(q, np.array([np.pi / 2]), np.zeros(0)), 4.0)
+    >>> mode.tolist(), bool(cond[0] > 0.1)
+    ([1], True)
+    """
     J = np.asarray(J, float)
     one = J.ndim == 2
     J = J[None] if one else J
@@ -219,12 +247,43 @@ def _candidates(model, q, u, p, L, i, target, near, starts):
 
 
 def assemble(model, u, p, L, want=None, near=None, starts: int = 8) -> Solution | None:
-    """A pose assembled group by group, each group in its mode `want[i]` (+1 or -1; 0: the
-    nearest; default +1), the solution nearest `near` (unknowns of a reference pose) first.
-    Without `want`, where a group's default mode does not assemble, or the groups after it
-    have none, its other mode is tried; with `want`, a group whose wanted mode assembles
-    never takes another (a mode is left only through a singular position of its own). None where no combination assembles: decided by a few block Newton runs per
-    group, without an optimiser."""
+    """A pose assembled group by group, without a guess.
+
+    Parameters
+    ----------
+    model : kincas.core.numeric.Model
+    u, p : numpy.ndarray
+        Inputs and parameter values.
+    L : float
+        The mechanism's size.
+    want : sequence of int, optional
+        Each group's mode (+1 or -1; 0: the one nearest `near`). Default: +1 for every group,
+        and where a group's +1 mode does not assemble (here, or for a group built on it), its
+        other mode. With `want`, a group whose wanted mode assembles never takes another (a
+        mode is left only through a singular position of its own).
+    near : numpy.ndarray, optional
+        Unknowns of a reference pose: its values start each group's search, angles are taken
+        in its turn, and among solutions of a mode the nearest is taken.
+    starts : int
+        Spread starts per group where it is not a dyad of two angles (a dyad gets its two
+        circle intersections).
+
+    Returns
+    -------
+    Solution or None
+        None where no combination of modes assembles: decided by a dyad's discriminant, or a
+        few block Newton runs for other groups, without an optimiser.
+
+    Examples
+    --------
+    >>> import numpy as np, kincas
+    >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+    ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 1.9),
+    ...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
+    >>> model = kincas.compile(m)  # a triple rocker: no assembly at 180 deg
+    >>> assemble(model, np.array([np.pi]), np.zeros(0), m.size()) is None
+    True
+    """
     bl = blocks(model)
     u, p = np.asarray(u, float), np.asarray(p, float)
 
@@ -318,3 +377,40 @@ def polish_singular(model, q, u, p, L, groups, max_iter: int = 30):
     if np.abs(F[:ng]).max() > ROUNDING or np.abs(F[ng:]).max() > 1e-10:
         return None
     return q
+
+
+# --- the first pose: from the guess, or group by group ---
+
+
+def no_assembly(model, q) -> Solution:
+    return Solution(np.array(q, float), np.inf, 0, False, None)
+
+
+def ambiguous(model) -> bool:
+    """Whether group-by-group assembly may miss an assembly that exists: only a dyad's block
+    Newton from spread starts is conclusive (two circle or circle-line intersections); larger
+    groups and tall systems (redundant joints) get IPOPT as a last resort."""
+    return not model.square or any(len(c) > 2 for _, c in blocks(model))
+
+
+def first_pose(model, u, p, L, guess) -> Solution:
+    """The first pose of a sweep (and where `kincas modes` and `kincas range` start): from
+    the guessed points (the nearest assembly), or without a guess group by group in the
+    default modes (above)."""
+    return settle_first(model, _assembled(model, u, p, L, guess), u, p, L)  # gears: angles in (-pi, pi]
+
+
+def _assembled(model, u, p, L, guess) -> Solution:
+    if model.nq == 0:
+        return model.newton(np.zeros(0), u, p, L)
+    if not guess:
+        sol = assemble(model, u, p, L)
+        if sol is not None or not ambiguous(model):
+            return sol if sol is not None else no_assembly(model, np.zeros(model.nq))
+    q0 = model.initial_q(u, p, guess, L)
+    sol = model.newton(q0, u, p, L)
+    if not sol.ok and guess:  # group by group from the guessed pose, then IPOPT if in doubt
+        sol = assemble(model, u, p, L, near=q0) or sol
+    if not sol.ok and ambiguous(model):  # IPOPT: the assembly nearest the guessed points
+        sol = model.nearest_assembly(q0, u, p, {k: np.array(v) for k, v in guess.items()}, L)
+    return sol

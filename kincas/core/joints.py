@@ -36,8 +36,8 @@ from ..errors import ModelError
 from ..model import spline
 from ..model.joints import Circle, split_relative
 from ..model.mechanism import GROUND, as_param
+from ..model.names import ANGULAR_ATTRS  # noqa: F401  (cam quantities: angles, kept here too)
 
-ANGULAR_ATTRS = {"phi", "pressure"}  # cam quantities in the scene's angle unit
 _PRESSURE_FLOOR = 1e-9  # a follower slower than this times the inputs' speed scale stands
 
 

@@ -1,6 +1,6 @@
 """Numeric evaluation of a mechanism's symbolic model: residuals, Newton, placement, IPOPT.
 
-`compile(m)` gives the `Model` of m's structure, built once and cached (parameter values are
+`model_of(m)` (also `kincas.compile`, its first name) gives the `Model` of m's structure, built once and cached (parameter values are
 numeric inputs, so changing them does not rebuild it). Every CasADi call on a hot path goes
 through zero-copy numpy buffers (one set per thread). Newton solves the Assur groups of the
 structure one after another (kincas/core/structure.py), each aiming at a residual of `TOL`
@@ -13,7 +13,7 @@ point, reach the same relative accuracy.
 ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
 ...            kincas.Link.bar("rocker", "D", "C", 3)],
 ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
->>> model, p = compile(m), np.zeros(0)
+>>> model, p = model_of(m), np.zeros(0)
 >>> q0 = model.initial_q(np.array([0.5]), p, {"C": (3.6, 2.9)}, m.size())
 >>> sol = model.newton(q0, np.array([0.5]), p, m.size())
 >>> sol.ok, bool(sol.residual < 1e-13)
@@ -28,9 +28,11 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from ..model.mechanism import Mechanism
+from ..model import mechanism as _mechanism
+from ..model.mechanism import Mechanism, needs_rank_test
 from . import joints as _joints
 from .newton import lsolve as _lsolve, newton as _newton
+from .redundant import decide
 from .structure import Structure
 from .symbolic import Symbolic
 from .tolerances import ACCEPT, MAX_ITER, MAX_STEP, TOL  # noqa: F401  (their old home)
@@ -49,11 +51,36 @@ _CACHE: dict = {}
 _CACHE_LOCK = threading.Lock()
 
 
-def compile(m: Mechanism) -> "Model":
-    """The compiled model of `m`'s structure (cached: changing parameters does not recompile).
+def model_of(m: Mechanism, check: bool = True) -> "Model":
+    """The numeric model of `m`'s structure: its residuals, Jacobians, Newton and quantity
+    functions as CasADi Functions (built once per structure and cached; parameter values
+    stay numeric inputs, so changing them rebuilds nothing; nothing is compiled to C here).
 
     Safe from several threads: the cache is guarded by a lock, and a `Model` holds no numeric
-    state shared between calls."""
+    state shared between calls. With `check`, a mechanism whose count of freedoms falls
+    short of its inputs is first put to the rank test of redundant joints (`ModelError`
+    when its inputs are genuinely wrong in number).
+
+    Parameters
+    ----------
+    m : Mechanism
+    check : bool
+        Run the deferred mobility check (kincas/core/redundant.py).
+
+    Returns
+    -------
+    Model
+
+    Examples
+    --------
+    >>> import kincas
+    >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+    ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+    ...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
+    >>> model = model_of(m)
+    >>> model.nq, [b.size for b in model.blocks], model_of(m.with_parameters()) is model
+    (2, [2], True)
+    """
     key = _structure_key(m)
     with _CACHE_LOCK:
         model = _CACHE.get(key)
@@ -63,7 +90,19 @@ def compile(m: Mechanism) -> "Model":
             model = _CACHE.setdefault(key, model)
             while len(_CACHE) > 64:
                 _CACHE.pop(next(iter(_CACHE)))
+    if check and needs_rank_test(m):
+        decide(m, model)
     return model
+
+
+compile = model_of  # its first name (kincas 0.1): it compiles nothing
+
+
+def _redundant(m: Mechanism) -> int:
+    return decide(m, model_of(m, check=False))
+
+
+_mechanism._rank_decision = _redundant  # `Mechanism.redundant` asks the core (kincas/model)
 
 
 class _Call:

@@ -3,8 +3,10 @@
 Counting (Gruebler: unknowns minus equations) assumes every equation independent. A
 parallelogram four-bar with a third parallel link has 3 unknown angles and 4 closure
 equations, a count of 0, yet it moves with 1 degree of freedom: at every assembly one
-closure equation is implied by the others. `kincas.model` asks this module only when the
-count gives fewer freedoms than inputs (so ordinary mechanisms never pay for it).
+closure equation is implied by the others. Where the count gives fewer freedoms than inputs,
+`decide(m)` runs the test below once per mechanism, at its first solve (`kincas.compile`)
+or when `Mechanism.redundant` is read; declaring a mechanism runs no numerics, and ordinary
+mechanisms never pay for it.
 
 With x = (q, u) (unknowns and inputs) and G = g_x = [g_q g_u], an assembly x* (g(x*) = 0)
 where the ranks are locally constant decides:
@@ -30,10 +32,15 @@ the configuration manifold has none of them.
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 
-RANK_TOL = 1e-8  # a scaled singular value below this times the largest one counts as zero
+from ..errors import ModelError
+from ..model import mechanism as _mechanism
+from .newton import newton
+from .tolerances import ACCEPT, RANK as RANK_TOL
+
 GAP = 1e-4  # ... and the smallest one kept must stand above this (a regular assembly)
 
 
@@ -60,57 +67,40 @@ def _start_inputs(m) -> np.ndarray:
 
 
 def _assemble(model, x, p, L, scale, max_iter=60):
-    """Gauss-Newton on g(q, u) = 0 in x = (q, u), minimum-norm steps in scaled coordinates
-    (angles as they are, lengths over L), backtracking on the residual. Returns (x, residual)."""
+    """Gauss-Newton on g(q, u) = 0 in x = (q, u) (kincas/core/newton.py: minimum-norm steps
+    in scaled coordinates, angles as they are and lengths over L). Returns (x, residual, G)
+    with G = [g_q g_u] in scaled coordinates."""
     nq = model.nq
 
-    def ev(x):
-        g, J, Ju = model._tangent(x[:nq], x[nq:], p)
-        return g.ravel().copy(), np.hstack([J, Ju]) * scale
+    def F(x):
+        _, J, Ju = model._tangent(x[:nq], x[nq:], p)
+        g = model.residual(x[:nq], x[nq:], p)
+        return g, np.hstack([J, Ju])
 
-    g, G = ev(x)
-    r = np.abs(g).max(initial=0.0) / L
-    for _ in range(max_iter):
-        if r <= 1e-14:
-            break
-        dz = np.linalg.lstsq(G, -g, rcond=None)[0]
-        dz /= max(1.0, np.abs(dz).max() / 0.5)  # at most half a radian (or L/2) per step
-        t = 1.0
-        while t >= 1 / 64:
-            xn = x + t * dz * scale
-            gn, Gn = ev(xn)
-            rn = np.abs(gn).max(initial=0.0) / L
-            if rn < r:
-                break
-            t /= 2
-        if not rn < r:
-            break
-        x, g, G, r = xn, gn, Gn, rn
-    return x, r, G
+    res = newton(F, x, scale, np.full(model.ng, L), max_iter=max_iter)
+    return res.x, res.residual, res.J * scale
 
 
-def rank_test(m):
+def rank_test(m, model):
     """(real freedoms, redundant equations, ok) of `m` at a generic assembly near its guess.
 
     `ok` when the inputs drive the chain exactly (rank g_q = rank [g_q g_u] = nq); the real
     freedoms are those of the chain's coordinates (q and the inputs that are not driven
     parameters): their number less the rank of their Jacobian. None for both numbers when
     no assembly was found near the guess."""
-    from .numeric import compile
-    from ..analysis.singular import _scales
-    model = compile(m)
     nq = model.nq
     p = np.array([v for _, v in m.parameters], float)
     L = m.size()
     guess = {k: (m.value(x), m.value(y)) for k, (x, y) in m.guess}
     u0 = _start_inputs(m)
-    cq, cu = _scales(model, L)
+    cq = model.column_scale(L)
+    cu = np.array([1.0 / L if i.kind == "angle" else 1.0 for i in m.inputs])
     scale = 1.0 / np.concatenate([cq, cu]) / L  # scaled coordinate * scale = coordinate
     rng = np.random.default_rng(7)  # fixed seed: the same answer every time
     x = np.concatenate([model.initial_q(u0, p, guess, L), u0])
     x = x + 1e-3 * rng.standard_normal(x.size) * scale  # off any special position
     x, r, G = _assemble(model, x, p, L, scale)
-    if r > 1e-10:
+    if r > ACCEPT:
         return None, None, False
     # a small generic step within the configuration manifold, then back onto it
     _, s, vt = np.linalg.svd(G)
@@ -119,7 +109,7 @@ def rank_test(m):
     if null.shape[0]:
         x, r, G = _assemble(model, x + 0.05 * (rng.standard_normal(null.shape[0]) @ null) * scale,
                             p, L, scale)
-        if r > 1e-10:
+        if r > ACCEPT:
             return None, None, False
     s_all = np.linalg.svd(G, compute_uv=False)
     s_q = np.linalg.svd(G[:, :nq], compute_uv=False)
@@ -132,3 +122,40 @@ def rank_test(m):
     regular = rank_q == nq and (nq == 0 or s_q[nq - 1] > GAP * top)
     ok = regular and rank_g == nq
     return free, model.sym.g.numel() - rank_g, ok
+
+
+# --- the decision, once per mechanism ---
+
+_DECIDED: dict = {}  # mechanism -> redundant equations, or the ModelError message
+_LOCK = threading.Lock()
+
+
+def decide(m, model) -> int:
+    """The number of redundant equations of `m`; `ModelError` (naming [inputs]) when the
+    inputs are genuinely wrong in number. Counting decides where it can; the rank test runs
+    only where counting gives fewer freedoms than inputs, once per mechanism value, on
+    `model` (the model of m's structure).
+
+    >>> import kincas
+    >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+    ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 4),
+    ...            kincas.Link.bar("rocker", "D", "C", 1)],
+    ...     inputs=[kincas.Input.angle("crank")], guess={"C": (4.5, 0.8)})
+    >>> decide(m, None)  # a four-bar: counting suffices
+    0
+    """
+    if not _mechanism.needs_rank_test(m):
+        return 0
+    with _LOCK:
+        known = _DECIDED.get(m)
+    if known is None:
+        free, redundant, ok = rank_test(m, model)
+        known = redundant if ok else _mechanism.mobility_problem(m, free, tested=True)
+        with _LOCK:
+            _DECIDED[m] = known
+            while len(_DECIDED) > 256:
+                _DECIDED.pop(next(iter(_DECIDED)))
+    if isinstance(known, str):
+        raise ModelError([known])
+    return known
+

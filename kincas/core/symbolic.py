@@ -28,23 +28,17 @@ Efforts, reactions and shaking forces (kincas/core/dynamics.py) and the kinemati
 """
 from __future__ import annotations
 
-import re
-
 import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import GROUND, Mechanism, as_param
+from ..model.names import LINK_Q, POINT_Q, SENS, SLIDE_Q, is_angular, parse_quantity  # noqa: F401
 from . import joints as _joints
 
-# --- quantity names ---
+# --- quantity names (kincas/model/names.py: parsed without the solver) ---
 
-_POINT_Q = {"x": (0, 0), "y": (1, 0), "vx": (0, 1), "vy": (1, 1), "ax": (0, 2), "ay": (1, 2),
-            "jx": (0, 3), "jy": (1, 3)}
-_LINK_Q = {"angle": 0, "omega": 1, "alpha": 2, "jerk": 3}
-_SLIDE_Q = {"s": 0, "v": 1, "a": 2, "jerk": 3}
-# d(Q)/d(p), where Q may itself hold one level of brackets: d(effort(crank.angle))/d(a1)
-_SENS = re.compile(r"^d\((?P<q>(?:[^()]|\([^()]*\))+)\)/d\((?P<p>[^()]+)\)$")
+_POINT_Q, _LINK_Q, _SLIDE_Q, _SENS = POINT_Q, LINK_Q, SLIDE_Q, SENS
 
 
 def _extras():
@@ -52,26 +46,6 @@ def _extras():
     not theirs, else a list of problems; `expression(sym, name, t)` -> SX)."""
     from . import dynamics, geometry
     return geometry, dynamics, _joints
-
-
-def parse_quantity(name: str):
-    """('sens', Q, p) for `d(Q)/d(p)`, else (kind, object, attribute) for `OBJ.attr`."""
-    m = _SENS.match(name)
-    if m:
-        return ("sens", m["q"], m["p"])
-    obj, _, attr = name.rpartition(".")
-    return ("plain", obj, attr)
-
-
-def is_angular(name: str, mech: Mechanism | None = None) -> bool:
-    """Whether a quantity is an angle or an angle's rate (converted to degrees at the edge).
-    `S.jerk` of a slide is a length's: give the mechanism to tell it from a link's `L.jerk`."""
-    kind, a, b = parse_quantity(name)
-    if kind == "sens":
-        return is_angular(a, mech)
-    if b == "jerk" and mech is not None and a in {s.name for s in mech.slides}:
-        return False
-    return b in _LINK_Q or b in _joints.ANGULAR_ATTRS
 
 
 def needs_jerk(name: str) -> bool:

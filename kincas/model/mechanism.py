@@ -41,6 +41,9 @@ class Param:
 
 Num = Union[float, int, str, Param]
 GROUND = "ground"
+# How a mechanism whose count falls short learns its redundant equations: kincas.core
+# installs its rank test here when it is imported (declarations never import the solver).
+_rank_decision = None
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
 NAME_RULE = "a name starts with an ASCII letter or _, then ASCII letters, digits, _ or -"
 
@@ -249,7 +252,6 @@ class Mechanism:
     gravity: tuple[Num, Num] = (0.0, 0.0)  # acceleration vector, length/time²
     loads: tuple[Load, ...] = ()
     structure: Structure = field(init=False, repr=False, compare=False)
-    redundant: int = field(init=False, repr=False, compare=False, default=0)
 
     def __post_init__(self):
         def items(v):
@@ -271,12 +273,23 @@ class Mechanism:
         extra_q, extra_g = _joints.counts(self)  # gears, racks, cams: one freedom each
         object.__setattr__(self, "structure", replace(st, n_unknowns=st.n_unknowns + extra_q,
                                                       n_equations=st.n_equations + extra_g))
-        problems, redundant = _check_mobility(self)
+        problems = _check_mobility(self)
         if problems:
             raise ModelError(problems)
-        object.__setattr__(self, "redundant", redundant)  # equations implied by the others
 
     # --- lookups ---
+    @property
+    def redundant(self) -> int:
+        """Equations implied by the others (redundant joints): 0 where counting gives as many
+        freedoms as inputs; otherwise decided by the constraint Jacobian's rank at an
+        assembly near the guess (kincas.core.redundant, run once per mechanism), which
+        raises `ModelError` if the inputs are genuinely wrong in number."""
+        if not needs_rank_test(self):
+            return 0
+        if _rank_decision is None:  # pragma: no cover - kincas/__init__ installs it
+            raise ModelError("[inputs]: the rank test needs kincas.core (import kincas)")
+        return _rank_decision(self)
+
     @property
     def param_values(self) -> dict[str, float]:
         return dict(self.parameters)
@@ -449,25 +462,38 @@ def _check(m: Mechanism) -> list[str]:
     return out + _joints.value_problems(m)
 
 
-def _check_mobility(m: Mechanism) -> tuple[list[str], int]:
-    """(problems, redundant equations). Where counting gives fewer freedoms than inputs, a
-    redundant joint may hide one: the Jacobian's rank decides (kincas/redundant.py)."""
-    st = m.structure
-    n_param = sum(inp.kind == "parameter" for inp in m.inputs)
-    dof = st.mobility + n_param
-    if dof == len(m.inputs) and st.mobility >= 0:
-        return [], 0
+def counted_freedoms(m: Mechanism) -> int:
+    """Degrees of freedom by counting: unknowns minus equations, plus driven parameters."""
+    return m.structure.mobility + sum(inp.kind == "parameter" for inp in m.inputs)
+
+
+def needs_rank_test(m: Mechanism) -> bool:
+    """Whether counting gives fewer freedoms than inputs: a redundant joint may hide the
+    missing ones, and only the constraint Jacobian's rank at an assembly can tell
+    (kincas/core/redundant.py decides, at the first solve: a declaration runs no numerics)."""
+    return counted_freedoms(m) < len(m.inputs)
+
+
+def mobility_problem(m: Mechanism, free: int | None = None, tested: bool = False) -> str:
+    """The message for a wrong number of inputs; `tested`: the rank test ran and found
+    `free` freedoms (None: no assembly near the guess to test)."""
+    st, dof = m.structure, counted_freedoms(m)
+    n_param = dof - st.mobility
     detail = (f"{st.n_unknowns} unknown coordinates, {st.n_equations} equations"
               + (f", plus {n_param} driven parameter(s)" if n_param else ""))
     hint = ""
-    if dof < len(m.inputs):  # fewer freedoms than expected: perhaps a redundant constraint
-        from ..core.redundant import rank_test
-        free, redundant, ok = rank_test(m)
-        if ok:
-            return [], redundant
+    if tested:
         hint = ("; a redundant joint would add freedoms to this count, but "
                 + ("no assembly was found near the guess to test for one" if free is None else
                    f"the constraint Jacobian at an assembly near the guess gives it "
                    f"{free + n_param} degree(s) of freedom"))
-    return [f"[inputs]: the mechanism has {dof} degree(s) of freedom ({detail}) "
-            f"but {len(m.inputs)} input(s) drive it; give one input per degree of freedom{hint}"], 0
+    return (f"[inputs]: the mechanism has {dof} degree(s) of freedom ({detail}) "
+            f"but {len(m.inputs)} input(s) drive it; give one input per degree of freedom{hint}")
+
+
+def _check_mobility(m: Mechanism) -> list[str]:
+    """Problems with the number of inputs that counting alone proves (too few inputs)."""
+    dof = counted_freedoms(m)
+    if (dof == len(m.inputs) and m.structure.mobility >= 0) or needs_rank_test(m):
+        return []
+    return [mobility_problem(m)]

@@ -1,0 +1,83 @@
+"""`kincas modes SCENE.toml`: the distinct assembly modes at the scene's first pose, printed
+as [guess] blocks or written as scenes (kincas/analysis/modes.py finds them)."""
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+
+from ..analysis.modes import find_modes, scene_with_guess
+from ..errors import SceneError
+from .scene import load
+
+
+def cli_arguments(parser) -> None:
+    """Arguments of `kincas modes`."""
+    parser.add_argument("scene", help="the scene file (TOML)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--starts", type=int, default=512,
+                        help="number of scattered Newton starts (default 512)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the scattered starts")
+    parser.add_argument("--write", metavar="DIR",
+                        help="also write DIR/<scene>_mode<k>.toml: the scene with mode k's [guess]")
+
+
+def cli_run(args) -> int:
+    """Find the modes at the scene's first pose; print them (and write scenes with --write).
+    Exit status 0 when at least one assembly was found, 3 when none."""
+    if args.starts < 1:
+        raise SceneError(f"--starts: expected a whole number >= 1, got {args.starts}")
+    sc = load(args.scene)
+    at = {k: float(v[0]) for k, v in sc.study.inputs.items()}
+    modes = find_modes(sc.mechanism, at, starts=args.starts, seed=args.seed)
+    deg = sc.study.deg
+    user_in = {k: (math.degrees(v) if deg and k.endswith(".angle") else v) for k, v in at.items()}
+    user_ang = [{lk: (math.degrees(a) if deg else a) for lk, a in md.angles.items()} for md in modes]
+    if args.write:
+        _write_scenes(args.scene, args.write, modes)
+    if args.json:
+        doc = {"title": sc.study.title, "units": sc.study.units, "inputs": user_in,
+               "starts": args.starts, "seed": args.seed,
+               "modes": [{"points": {p: list(xy) for p, xy in md.points.items()},
+                          "angles": ang, "residual": md.residual, "orientation": md.orientation,
+                          "from_guess": md.from_guess, "guess": md.guess_block()}
+                         for md, ang in zip(modes, user_ang)]}
+        json.dump(doc, sys.stdout, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        _print_modes(sc, modes, user_in, user_ang, args)
+    return 0 if modes else 3
+
+
+def _print_modes(sc, modes, user_in, user_ang, args):
+    units = sc.study.units
+    unit = {k: units.get("angle", "deg") if k.endswith(".angle") else
+            units.get("length", "") if k.endswith(".s") else "" for k in user_in}
+    at = ", ".join(f"{k} = {v:.6g}" + (f" {unit[k]}" if unit[k] else "") for k, v in user_in.items())
+    print(sc.study.title or "kincas")
+    n = len(modes)
+    print(f"{n} assembly mode{'s' if n != 1 else ''}" + (f" at {at}" if at else "")
+          + f" ({args.starts} starts, seed {args.seed})")
+    for k, (md, ang) in enumerate(zip(modes, user_ang), 1):
+        mark = "  <- the scene's [guess] gives this one" if md.from_guess else ""
+        print(f"\nmode {k} of {n}: residual {md.residual:.1e}, orientation {md.orientation:+d}{mark}")
+        print("  angles: " + ", ".join(f"{lk} {a:.6g}" for lk, a in ang.items())
+              + f" {units.get('angle', 'deg')}")
+        print(md.guess_block(), end="")
+    if not modes:
+        print("no assembly found: the mechanism cannot be put together at this input")
+
+
+def _write_scenes(path, directory, modes) -> list[Path]:
+    """DIR/<scene>_mode<k>.toml for every mode: the scene as written, with that mode's guess."""
+    src, out = Path(path), Path(directory)
+    text = src.read_text(encoding="utf-8")
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for k, md in enumerate(modes, 1):
+        target = out / f"{src.stem}_mode{k}.toml"
+        note = f"assembly mode {k} of {len(modes)}, found by `kincas modes {src.name}`"
+        target.write_text(scene_with_guess(text, md, note), encoding="utf-8")
+        written.append(target)
+    return written

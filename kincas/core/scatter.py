@@ -1,0 +1,79 @@
+"""Newton from many scattered starts in one vectorised CasADi call (assembly modes).
+
+This is the scatter phase of `kincas modes`: what it accepts is measured with the same
+per-group residual as the careful Newton (`Model.scales`, kincas/core/tolerances.py), and
+what it finds is polished by the careful Newton (kincas/core/newton.py).
+
+>>> import numpy as np, kincas
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
+>>> model = kincas.model_of(m)
+>>> Q, r = newton_starts(model, np.array([[1.0, 2.0], [-1.0, -2.0]]), np.array([0.5]), np.zeros(0), 60)
+>>> bool(np.all(r <= 1e-13))
+True
+"""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+from .tolerances import MAX_STEP, TOL
+
+
+# --- Newton from every start at once ---
+
+
+def _step_function(model) -> ca.Function:
+    """(q, u, p, eq_scale, q_scale) -> (q after one Newton step, relative residual at q).
+
+    The step solves g_q dq = -g with the exact Jacobian and is shortened so that no unknown
+    moves by more than MAX_STEP of its scale (radians, or its group's length): a trust region
+    that keeps a start from being thrown across the workspace by a near-singular Jacobian.
+    Where g_q is singular the step is NaN and that start is dropped."""
+    def build():
+        sym = model.sym
+        eq, qs = ca.SX.sym("eq", sym.ng), ca.SX.sym("qs", sym.nq)
+        dq = -ca.solve(sym.Jq, sym.g)
+        shrink = ca.fmax(1, ca.mmax(ca.fabs(dq) / (MAX_STEP * qs))) if sym.nq else ca.SX(1)
+        r = ca.mmax(ca.fabs(sym.g / eq)) if sym.nq else ca.SX(0)
+        return ca.Function("newton_step", [sym.q, sym.u, sym.p, eq, qs], [sym.q + dq / shrink, r])
+    return model.memo("scatter.newton_step", build)
+
+
+def newton_starts(model, Q, u, p, iterations: int):
+    """Trust-region Newton on every row of Q (starts, n x nq) at once, at inputs u and
+    parameters p; returns the iterates and their relative residuals (NaN where a start
+    diverged). A start stops where its residual reaches TOL.
+
+    Parameters
+    ----------
+    model : kincas.core.numeric.Model
+    Q : numpy.ndarray
+        One start per row.
+    u, p : numpy.ndarray
+        Inputs and parameters (the same for every start).
+    iterations : int
+        Newton steps at most.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        The iterates (n x nq) and their residuals, each equation relative to its group.
+    """
+    n = Q.shape[0]
+    eq, qs = model.scales(u, p)
+    if model.nq == 0:
+        return Q, np.full(n, np.abs(model.residual(np.zeros(0), u, p) / eq).max(initial=0.0))
+    step = _step_function(model).map(n)
+    U, P = np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)
+    X, r = Q.T.copy(), np.full(n, np.inf)
+    for _ in range(iterations):
+        Xn, rn = (np.asarray(a) for a in step(X, U, P, eq, qs))
+        r = rn.ravel()
+        done = ~np.isfinite(r) | (r <= TOL)
+        X = np.where(done, X, Xn)  # a converged start stays where it is
+        if done.all():
+            break
+    r = np.where(np.all(np.isfinite(X), axis=0), r, np.nan)
+    return X.T, r

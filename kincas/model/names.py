@@ -1,0 +1,68 @@
+"""Quantity names (`C.x`, `rocker.omega`, `guide.s`, `d(C.y)/d(a)`): parsing and the plain
+checks that need no solver.
+
+A quantity is an object and an attribute: a point's coordinates and their rates, a link's
+angle and its rates, a slide's coordinate and its rates, or a sensitivity d(Q)/d(p) of one of
+them to a parameter. Other quantities (efforts, reactions, instant centres, curvature) are
+defined by kincas.core's extensions, which check them against the built model.
+
+>>> parse_quantity("d(C.y)/d(a)"), parse_quantity("rocker.omega")
+(('sens', 'C.y', 'a'), ('plain', 'rocker', 'omega'))
+"""
+from __future__ import annotations
+
+import re
+
+# attribute -> (coordinate, derivative order) of a point; derivative order of a link's angle
+# and of a slide's coordinate
+POINT_Q = {"x": (0, 0), "y": (1, 0), "vx": (0, 1), "vy": (1, 1), "ax": (0, 2), "ay": (1, 2),
+           "jx": (0, 3), "jy": (1, 3)}
+LINK_Q = {"angle": 0, "omega": 1, "alpha": 2, "jerk": 3}
+SLIDE_Q = {"s": 0, "v": 1, "a": 2, "jerk": 3}
+ANGULAR_ATTRS = {"phi", "pressure"}  # cam quantities (kincas/core/joints.py) are angles too
+# d(Q)/d(p), where Q may itself hold one level of brackets: d(effort(crank.angle))/d(a1)
+SENS = re.compile(r"^d\((?P<q>(?:[^()]|\([^()]*\))+)\)/d\((?P<p>[^()]+)\)$")
+
+
+def parse_quantity(name: str):
+    """('sens', Q, p) for `d(Q)/d(p)`, else (kind, object, attribute) for `OBJ.attr`."""
+    m = SENS.match(name)
+    if m:
+        return ("sens", m["q"], m["p"])
+    obj, _, attr = name.rpartition(".")
+    return ("plain", obj, attr)
+
+
+def is_angular(name: str, mech=None) -> bool:
+    """Whether a quantity is an angle or an angle's rate (converted to degrees at the edge).
+    `S.jerk` of a slide is a length's: give the mechanism to tell it from a link's `L.jerk`.
+
+    >>> is_angular("rocker.omega"), is_angular("C.vx"), is_angular("d(crank.angle)/d(a)")
+    (True, False, True)
+    """
+    kind, a, b = parse_quantity(name)
+    if kind == "sens":
+        return is_angular(a, mech)
+    if b == "jerk" and mech is not None and a in {s.name for s in mech.slides}:
+        return False
+    return b in LINK_Q or b in ANGULAR_ATTRS
+
+
+def plain_quantity(m, name: str) -> bool:
+    """Whether `name` is a point, link or slide quantity of `m` (or a sensitivity of one to a
+    parameter that no input drives): checked from the declarations alone.
+
+    >>> from kincas.model import Mechanism, Link, Input
+    >>> m = Mechanism(ground={"A": (0, 0), "D": (4, 0)}, parameters={"c": 3.0},
+    ...     links=[Link.bar("crank", "A", "B", 1), Link.bar("coupler", "B", "C", 3.5),
+    ...            Link.bar("rocker", "D", "C", "c")], inputs=[Input.angle("crank")])
+    >>> [plain_quantity(m, n) for n in ("C.vx", "rocker.alpha", "d(C.y)/d(c)", "E.x", "C.s")]
+    [True, True, True, False, False]
+    """
+    kind, a, b = parse_quantity(name)
+    if kind == "sens":
+        driven = {i.target for i in m.inputs if i.kind == "parameter"}
+        return plain_quantity(m, a) and b in m.param_values and b not in driven
+    points = set(m.ground_points) | {p for lk in m.links for p in lk.point_names}
+    return ((b in POINT_Q and a in points) or (b in LINK_Q and a in {lk.name for lk in m.links})
+            or (b in SLIDE_Q and a in {s.name for s in m.slides}))

@@ -1,0 +1,197 @@
+"""The architecture, checked from the source: the import graph of kincas/ (every import
+statement, also those inside functions; not those for type annotations only) has no cycle, the layers depend one way
+(model <- core <- analysis <- synthesis <- cli), and CasADi is imported only in kincas/core.
+Reading a scene builds no model, and declaring a mechanism runs no solver.
+"""
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+from conftest import ROOT
+
+PKG = ROOT / "kincas"
+# what each layer may import (besides itself and the neutral modules)
+NEUTRAL = {"kincas.errors", "kincas.results", "kincas.units", "kincas._aliases"}
+LAYERS = ["kincas.model", "kincas.core", "kincas.analysis", "kincas.synthesis", "kincas.cli"]
+
+
+def module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def modules() -> dict[str, Path]:
+    return {module_name(p): p for p in PKG.rglob("*.py")}
+
+
+def imports(name: str, path: Path, known: set[str], toplevel: bool = False) -> set[str]:
+    """kincas modules (and 'casadi') that `name` imports anywhere in its source (`toplevel`:
+    only at import time, not inside functions)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    out = set()
+    for node in _walk(tree, toplevel):
+        if isinstance(node, ast.Import):
+            targets = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                up = package.split(".")
+                up = up[:len(up) - node.level + 1]
+                base = ".".join(up + ([base] if base else []))
+            # `from pkg import sub` imports the submodule when there is one
+            targets = [f"{base}.{a.name}" if f"{base}.{a.name}" in known else base for a in node.names]
+        else:
+            continue
+        for t in targets:
+            if t.split(".")[0] == "casadi":
+                out.add("casadi")
+            while t and t not in known:
+                t = t.rpartition(".")[0]
+            if t and t.startswith("kincas"):
+                out.add(t)
+    # importing a module imports its parent packages anyway: not a dependency of the design
+    return {t for t in out if not name.startswith(t + ".") and t != name}
+
+
+def _walk(node, toplevel=False):
+    """ast.walk, without the bodies of `if TYPE_CHECKING:` (imports for annotations only),
+    and with `toplevel` without function bodies either."""
+    for child in ast.iter_child_nodes(node):
+        if isinstance(child, ast.If) and "TYPE_CHECKING" in ast.unparse(child.test):
+            yield from (n for c in child.orelse for n in [c, *_walk(c, toplevel)])
+            continue
+        if toplevel and isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
+            continue
+        yield child
+        yield from _walk(child, toplevel)
+
+
+def graph(toplevel: bool = False) -> dict[str, set[str]]:
+    mods = modules()
+    return {n: imports(n, p, set(mods), toplevel) for n, p in mods.items()}
+
+
+def layer(name: str) -> int | None:
+    return next((i for i, L in enumerate(LAYERS) if name == L or name.startswith(L + ".")), None)
+
+
+def cycles(g: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module (Tarjan)."""
+    g = {n: {t for t in ts if t in g} for n, ts in g.items()}
+    index, low, stack, on, out, counter = {}, {}, [], set(), [], [0]
+
+    def visit(v):
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in g[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in g:
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_import_cycle():
+    """No circle of imports at import time anywhere in kincas; and none at all, lazy imports
+    inside functions included, among the layers that do the work (model, core, analysis,
+    synthesis). (The command line and the presentation modules defer some imports to
+    break circles at run time: those are not design dependencies checked here.)"""
+    assert cycles(graph(toplevel=True)) == []
+    work = {n: ts for n, ts in graph().items() if layer(n) is not None and layer(n) < 4}
+    assert cycles(work) == []
+
+
+def test_the_cycle_finder_finds_cycles():
+    assert cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+
+
+def test_layers_depend_one_way():
+    bad = []
+    for n, ts in graph().items():
+        ln = layer(n)
+        if ln is None:
+            continue
+        for t in ts:
+            lt = layer(t)
+            if lt is not None and lt > ln:
+                bad.append(f"{n} imports {t}")
+    assert not bad, bad
+
+
+# Modules that still build CasADi expressions outside kincas/core (issue [8].5, not yet
+# moved): each must leave this list when it is fixed, and no module may join it.
+CASADI_OUTSIDE_CORE = {
+    "kincas.analysis.singular",  # the extended system locating a limit (issue [9]'s module)
+    "kincas.synthesis.expressions",  # objective/constraint expressions of optimize
+    "kincas.synthesis.simultaneous",  # the simultaneous IPOPT problem of optimize
+    "kincas.cli.plot",  # pose functions of the drawings
+    "kincas.cli.draw_joints",  # pose functions of gears, racks and cams in the drawings
+}
+
+
+def test_casadi_only_in_core():
+    bad = {n for n, ts in graph().items() if "casadi" in ts and layer(n) != LAYERS.index("kincas.core")}
+    assert bad <= CASADI_OUTSIDE_CORE, f"casadi imported outside kincas/core: {sorted(bad - CASADI_OUTSIDE_CORE)}"
+    fixed = CASADI_OUTSIDE_CORE - bad
+    assert not fixed, f"no longer import casadi (take them off the list): {sorted(fixed)}"
+
+
+def test_the_graph_sees_imports():
+    """The checks above can fail: the graph finds known edges, lazy ones included."""
+    g = graph()
+    assert "casadi" in g["kincas.core.numeric"]
+    assert "kincas.core.numeric" in g["kincas.analysis.sweeps"]
+    assert "kincas.analysis.modes" in g["kincas.cli.modes"]
+
+
+def test_reading_a_scene_builds_no_model(monkeypatch):
+    """Names of points, links and slides are checked from the declarations; only a scene that
+    reports quantities of the core's extensions (efforts, cams, ...) builds the model to
+    check them."""
+    import tomllib
+
+    import kincas.core.numeric as numeric
+    from kincas.cli.scene import load
+    from kincas.model.names import plain_quantity
+    from conftest import EXAMPLES
+
+    built = []
+    monkeypatch.setattr(numeric, "_CACHE", {})  # nothing cached: any model asked for is built
+    init = numeric.Model.__init__
+
+    def spy(self, *a, **k):
+        built.append(1)
+        init(self, *a, **k)
+    monkeypatch.setattr(numeric.Model, "__init__", spy)
+    plain = 0
+    for path in sorted(EXAMPLES.glob("*.toml")):
+        before = len(built)
+        m = load(path).mechanism
+        out = tomllib.loads(path.read_text(encoding="utf-8")).get("output", {})
+        sens = out.get("sensitivity", {})
+        names = out.get("report", []) + [f"d({q})/d({p})" for q in sens.get("of", []) for p in sens.get("to", [])]
+        if all(plain_quantity(m, n) for n in names):
+            plain += 1
+            assert len(built) == before, f"{path.name}: a model was built while reading it"
+    assert plain >= 10
