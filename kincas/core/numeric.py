@@ -162,6 +162,9 @@ class Model:
         self.f_local = ca.Function("local", [sym.u, sym.p], [ca.vertcat(*locs)])
         gxy = [c for g, _ in m.ground for c in sym.points[g]]
         self.f_ground = ca.Function("ground", [sym.u, sym.p], [ca.vertcat(*gxy) if gxy else ca.SX(0, 1)])
+        # both at once through buffers: every Newton asks for them (its groups' lengths)
+        self._geometry = _Call(ca.Function("geometry", [sym.u, sym.p],
+                                           [self.f_local(sym.u, sym.p), self.f_ground(sym.u, sym.p)]))
         self._nlp = None
         self._qfun: dict[tuple, ca.Function] = {}
         self._memo: dict = {}
@@ -184,9 +187,8 @@ class Model:
         per unknown, the scale of a step (1 for an angle, a length for a length unknown).
         Both come from the unknown's or equation's own group (its block's bodies), not from
         the whole drawing, so a far point elsewhere loosens nobody's tolerance."""
-        local = np.asarray(self.f_local(u, p), float).ravel()
-        ground = np.asarray(self.f_ground(u, p), float).ravel()
-        Lb = self.structure.block_lengths(local, ground, self.sym.mech.size())
+        local, ground = (a.ravel() for a in self._geometry(u, p))
+        Lb = self.structure.block_lengths(local, ground)
         eq, qs = np.ones(self.ng), np.ones(self.nq)
         for b, L in zip(self.blocks, Lb):
             eq[b.rows] = L
@@ -276,13 +278,12 @@ class Model:
         whose position is guessed (or already known); with none, angle 0.
         """
         m, sym = self.sym.mech, self.sym
-        loc_flat = np.asarray(self.f_local(u, p)).ravel()
+        loc_flat, gflat = (a.ravel() for a in self._geometry(u, p))
         loc, k = {}, 0
         for lk in m.links:
             for pt, _ in lk.points:
                 loc[(lk.name, pt)] = loc_flat[k:k + 2]
                 k += 2
-        gflat = np.asarray(self.f_ground(u, p)).ravel()
         gv = {g: gflat[2 * k:2 * k + 2] for k, (g, _) in enumerate(m.ground)}
         known = dict(gv)
         guessed = {k: np.asarray(v, float) for k, v in guess.items()}

@@ -99,12 +99,14 @@ class Structure:
         ground = [i for i, (g, _) in enumerate(m.ground) if g in pts]
         return near, ground
 
-    def block_lengths(self, local: np.ndarray, ground: np.ndarray, fallback: float) -> np.ndarray:
+    def block_lengths(self, local: np.ndarray, ground: np.ndarray) -> np.ndarray:
         """Each block's length: the largest distance between two points of one body its loops
         pass through (a link of the block or next to it, or the ground points they carry).
 
         `local` is every link's points in its own frame (as `Model.f_local` gives them),
-        `ground` the ground points' coordinates; `fallback` serves a block with no extent."""
+        `ground` the ground points' coordinates, both at the parameter values in use. A block
+        with no extent takes the whole mechanism's length (`Mechanism.size()`'s definition,
+        from these same values: the model is shared by every parameter value)."""
         m = self.sym.mech
         ext, k = [], 0
         for lk in m.links:
@@ -116,7 +118,10 @@ class Structure:
         out = np.empty(len(self.blocks))
         for i, (near, gidx) in enumerate(self._extent_links):
             span = max((math.dist(gxy[a], gxy[b]) for a in gidx for b in gidx), default=0.0)
-            out[i] = max([span] + [ext[j] for j in near]) or fallback
+            out[i] = max([span] + [ext[j] for j in near])
+        if not out.all():
+            box = np.ptp(gxy, axis=0) if len(gxy) else np.zeros(2)
+            out[out == 0] = max(max(ext, default=0.0), math.hypot(*box)) or 1.0
         return out
 
 
