@@ -24,7 +24,6 @@ the contact points; `JointArtists` makes the artists once and moves them to any 
 """
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,9 +31,6 @@ import numpy as np
 from ..model import spline
 from ..model.joints import Circle
 from ..model.mechanism import GROUND
-
-_FUNCTIONS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-
 
 @dataclass
 class JointGeometry:
@@ -58,23 +54,27 @@ def _bodies(m) -> list[str]:
 
 
 def _function(model):
-    if model not in _FUNCTIONS:
-        import casadi as ca
-        sym, m = model.sym, model.sym.mech
-        out = [c for b in _bodies(m) for c in sym.frames[b]]
-        out += [c for cam in m.cams for c in sym.cams[cam.name]["contact"]]
-        nums = []
-        for g in m.gears:
-            nums += [sym.val(r) for r in g.radii]
-        for r in m.racks:
-            nums.append(sym.val(r.radius))
-        for c in m.cams:
-            nums.append(sym.val(c.roller_radius) if c.roller else ca.SX(0))
-            nums += ([*(sym.val(v) for v in c.profile.center), sym.val(c.profile.radius)]
-                     if isinstance(c.profile, Circle) else [sym.val(v) for v in c.profile.radii])
-        _FUNCTIONS[model] = (ca.Function("joints_pose", [sym.q, sym.u, sym.p], [ca.vertcat(*out)]),
-                             ca.Function("joints_numbers", [sym.p], [ca.vertcat(*nums)]))
-    return _FUNCTIONS[model]
+    """(q, u, p) -> the bodies' frames and the cams' contacts; p -> the joints' numbers;
+    built once per model (`Model.memo`)."""
+    return model.memo("draw_joints.functions", lambda: _build_functions(model))
+
+
+def _build_functions(model):
+    import casadi as ca
+    sym, m = model.sym, model.sym.mech
+    out = [c for b in _bodies(m) for c in sym.frames[b]]
+    out += [c for cam in m.cams for c in sym.cams[cam.name]["contact"]]
+    nums = []
+    for g in m.gears:
+        nums += [sym.val(r) for r in g.radii]
+    for r in m.racks:
+        nums.append(sym.val(r.radius))
+    for c in m.cams:
+        nums.append(sym.val(c.roller_radius) if c.roller else ca.SX(0))
+        nums += ([*(sym.val(v) for v in c.profile.center), sym.val(c.profile.radius)]
+                 if isinstance(c.profile, Circle) else [sym.val(v) for v in c.profile.radii])
+    return (ca.Function("joints_pose", [sym.q, sym.u, sym.p], [ca.vertcat(*out)]),
+            ca.Function("joints_numbers", [sym.p], [ca.vertcat(*nums)]))
 
 
 def joint_geometry(model, Q, U, p, ok) -> JointGeometry | None:

@@ -18,8 +18,6 @@ shows exactly the poses that were solved; poses not "ok" are left out of paths.
 """
 from __future__ import annotations
 
-import threading
-import weakref
 from collections import Counter
 from dataclasses import dataclass, field
 
@@ -72,31 +70,25 @@ class Geometry:
         return self.xy[:, self.names.index(name)]
 
 
-_POSE_FUNCTIONS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-_POSE_LOCK = threading.Lock()  # threads drawing at once build each function once
-
-
 def _pose_function(model):
     """(q, u, p) -> ground points, moving points, and for each slide its line's point
     `through` and direction angle, all in world coordinates (a body's frame is origin
-    (ox, oy) and angle th: a local vector v maps to origin + R(th) v)."""
-    with _POSE_LOCK:
-        return _POSE_FUNCTIONS[model] if model in _POSE_FUNCTIONS else _build_pose_function(model)
+    (ox, oy) and angle th: a local vector v maps to origin + R(th) v). Built once per model
+    (`Model.memo`: threads drawing at once build it once)."""
+    return model.memo("plot.pose", lambda: _build_pose_function(model))
 
 
 def _build_pose_function(model):
-    if model not in _POSE_FUNCTIONS:
-        import casadi as ca
-        sym, m = model.sym, model.sym.mech
-        out = [c for g in m.ground_points for c in sym.points[g]]
-        out += [c for p in m.moving_points for c in sym.points[p]]
-        for sl in m.slides:
-            ox, oy, th = sym.frames[sl.along]
-            tx, ty = (sym.val(v) for v in sl.through)
-            out += [ox + ca.cos(th) * tx - ca.sin(th) * ty, oy + ca.sin(th) * tx + ca.cos(th) * ty,
-                    th + sym.val(sl.angle)]
-        _POSE_FUNCTIONS[model] = ca.Function("pose", [sym.q, sym.u, sym.p], [ca.vertcat(*out)])
-    return _POSE_FUNCTIONS[model]
+    import casadi as ca
+    sym, m = model.sym, model.sym.mech
+    out = [c for g in m.ground_points for c in sym.points[g]]
+    out += [c for p in m.moving_points for c in sym.points[p]]
+    for sl in m.slides:
+        ox, oy, th = sym.frames[sl.along]
+        tx, ty = (sym.val(v) for v in sl.through)
+        out += [ox + ca.cos(th) * tx - ca.sin(th) * ty, oy + ca.sin(th) * tx + ca.cos(th) * ty,
+                th + sym.val(sl.angle)]
+    return ca.Function("pose", [sym.q, sym.u, sym.p], [ca.vertcat(*out)])
 
 
 def geometry(m: Mechanism, sweep: Sweep) -> Geometry:

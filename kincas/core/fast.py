@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import ctypes
 import threading
-import weakref
 
 import casadi as ca
 import numpy as np
@@ -363,27 +362,16 @@ def _model_blocks(model):
     return list(model.blocks)
 
 
-# --- one sweeper per compiled model and report ---
-
-_MEMO: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-_MEMO_LOCK = threading.Lock()
-
-
-def _memo(model, key, make):
-    with _MEMO_LOCK:
-        memo = _MEMO.setdefault(model, {})
-        if key not in memo:
-            memo[key] = make()
-        return memo[key]
+# --- one sweeper per compiled model and report (kept by the model: `Model.memo`) ---
 
 
 def sweeper_for(model, report=(), compile=None) -> FastSweeper:
     """The `FastSweeper` of a compiled model and report (kept as long as the model is);
     `compile`: None (compile when cached or long), True or False."""
-    return _memo(model, ("sweep", tuple(report), compile),
-                 lambda: FastSweeper(model, report, compile=compile))
+    return model.memo(("sweep", tuple(report), compile),
+                      lambda: FastSweeper(model, report, compile=compile))
 
 
 def evaluator_for(model, names) -> QuantityEvaluator:
     """The `QuantityEvaluator` of a compiled model for these quantity names."""
-    return _memo(model, ("eval", tuple(names)), lambda: QuantityEvaluator(model, names))
+    return model.memo(("eval", tuple(names)), lambda: QuantityEvaluator(model, names))
