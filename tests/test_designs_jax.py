@@ -154,7 +154,8 @@ def test_translation_keeps_constants_exact_and_comparisons_numeric():
                    (x[0] < x[1]) + (x[1] < x[2]), ca.logic_and(x[0] > 0, x[2] >= 1) * 3.0,
                    ca.atan2(x[1], -x[2]), ca.fmax(x[0], x[2]) ** 2.5)
     f = ca.Function("f", [x], [e])
-    jf = jax_backend.to_jax(f)
+    import jax
+    jf = jax.jit(jax_backend.to_jax(f))
     for v in ([0.3, 0.7, 1.2], [0.9, 0.2, -0.4]):
         with jax_backend.x64():
             got = np.asarray(jf(np.array(v))[0])
@@ -172,3 +173,37 @@ def test_unknown_backend_and_missing_jax_are_one_line_errors(monkeypatch):
     assert not jax_backend.available()
     with pytest.raises(kincas.ModelError, match=r"kincas\[gpu\]"):
         kincas.sweep_designs(slider_crank(), {"r": [45.0]}, U, report=["B.y"], backend="jax")
+
+
+# --- kincas study --backend jax ---
+
+
+def test_cli_study_backend_jax_writes_the_rows_of_the_casadi_backend(tmp_path, capsys, monkeypatch):
+    import csv
+
+    from conftest import EXAMPLES, run_cli
+    text = (EXAMPLES / "study_fourbar.toml").read_text()
+    text = text[:text.index("[study]")].replace("to = 359, steps = 360", "to = 360, steps = 73")
+    # the quantities of FOURBAR in its order: the JAX functions of the tests above serve
+    text += ('[study]\nvary = { a4 = [90, 100], a5 = [60, 70] }\ngrid = [3, 2]\nreport = ["max(C.x)", '
+             '"max(C.y)", "max(rocker.angle) - min(rocker.angle)", "max(C.vx)", "max(C.vy)", "max(rocker.omega)"]\n')
+    p = tmp_path / "s.toml"
+    p.write_text(text)
+    rows = {}
+    for backend in ("casadi", "jax"):
+        out = tmp_path / f"{backend}.csv"
+        code, _, err = run_cli(capsys, "study", p, "--out", out, "--no-progress", "--backend", backend)
+        assert code == 3, err  # (100, 60): a4 - a5 > 37.25, the crank cannot turn
+        rows[backend] = list(csv.DictReader(out.open()))
+    assert [r["status"] for r in rows["jax"]] == [r["status"] for r in rows["casadi"]]
+    assert sum(r["status"] != "ok" for r in rows["jax"]) == 1
+    for a, b in zip(rows["casadi"], rows["jax"]):
+        for k, v in a.items():
+            if k != "status":
+                assert (v == "" and b[k] == "") or abs(float(v) - float(b[k])) <= 1e-10 * max(1.0, abs(float(v)))
+    code, _, err = run_cli(capsys, "study", p, "--backend", "gpu")
+    assert code == 2 and "--backend" in err
+    from kincas.cli import study as cli_study
+    monkeypatch.setattr(cli_study, "_has", lambda mod: mod not in ("jax", "jaxadi"))
+    code, _, err = run_cli(capsys, "study", p, "--backend", "jax")
+    assert code == 2 and "kincas[gpu]" in err and len(err.strip().splitlines()) == 1
