@@ -139,22 +139,11 @@ def test_layers_depend_one_way():
     assert not bad, bad
 
 
-# Modules that still build CasADi expressions outside kincas/core (issue [8].5, not yet
-# moved): each must leave this list when it is fixed, and no module may join it.
-CASADI_OUTSIDE_CORE = {
-    "kincas.analysis.singular",  # the extended system locating a limit (issue [9]'s module)
-    "kincas.synthesis.expressions",  # objective/constraint expressions of optimize
-    "kincas.synthesis.simultaneous",  # the simultaneous IPOPT problem of optimize
-    "kincas.cli.plot",  # pose functions of the drawings
-    "kincas.cli.draw_joints",  # pose functions of gears, racks and cams in the drawings
-}
-
-
 def test_casadi_only_in_core():
+    """Symbolic expressions are built only in kincas/core (issue [8].5): every other module
+    works on numpy values and calls core functions."""
     bad = {n for n, ts in graph().items() if "casadi" in ts and layer(n) != LAYERS.index("kincas.core")}
-    assert bad <= CASADI_OUTSIDE_CORE, f"casadi imported outside kincas/core: {sorted(bad - CASADI_OUTSIDE_CORE)}"
-    fixed = CASADI_OUTSIDE_CORE - bad
-    assert not fixed, f"no longer import casadi (take them off the list): {sorted(fixed)}"
+    assert not bad, f"casadi imported outside kincas/core: {sorted(bad)}"
 
 
 def test_the_graph_sees_imports():

@@ -29,28 +29,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import casadi as ca
 import numpy as np
 
-from ..core.assembly import blocks
+from ..core.limits import _scales, locate_singular, scaled_jacobians  # noqa: F401  (their old home)
 from ..model.mechanism import Mechanism
 
 FLAG_SIGMA = 1e-7  # relative smallest singular value at which a pose *is* singular
 
 
 # --- scaled Jacobians and classification ---
-
-
-def _scales(model, L):
-    cu = np.array([1.0 / L if i.kind == "angle" else 1.0 for i in model.sym.mech.inputs])
-    return model.column_scale(L), cu
-
-
-def scaled_jacobians(model, q, u, p, L):
-    """(J, Gu): g_q and g_u with columns scaled so a size-L mechanism gives O(1) entries."""
-    _, J, Ju = model._tangent(q, u, p)
-    cq, cu = _scales(model, L)
-    return J * cq, Ju * cu
 
 
 def classify(J: np.ndarray, Gu: np.ndarray, tol: float = FLAG_SIGMA) -> str | None:
@@ -65,74 +52,6 @@ def classify(J: np.ndarray, Gu: np.ndarray, tol: float = FLAG_SIGMA) -> str | No
     if sg[J.shape[1] - 1] <= tol * max(sg[0], 1.0) * 1e3:  # rank [J Gu] < nq
         return "change point"
     return "limit" if Gu.shape[1] == 1 else "singular"
-
-
-# --- locating a limit exactly ---
-
-
-def _extended(model):
-    """F(q, u, p, v, v0) = [g; g_q v; v0.v - 1] and its Jacobian in (q, u, v), returning dense
-    numpy arrays (through zero-copy buffers: converting a casadi DM costs milliseconds at 80
-    unknowns)."""
-    def build():
-        from ..core.numeric import _Call
-        sym = model.sym
-        v, v0 = ca.SX.sym("v", sym.nq), ca.SX.sym("v0", sym.nq)
-        F = ca.vertcat(sym.g, ca.mtimes(sym.Jq, v), ca.dot(v0, v) - 1)
-        z = ca.vertcat(sym.q, sym.u, v)
-        return _Call(ca.Function("extended", [sym.q, sym.u, sym.p, v, v0], [F, ca.jacobian(F, z)]))
-    return model.memo("singular.extended", build)
-
-
-def locate_singular(model, q, u, p, L, direction, max_iter: int = 40, group: int | None = None,
-                    probe: bool = False):
-    """Newton on the extended system from a pose near a singular position, moving the
-    inputs along u + s * direction. Returns (q*, u*, s*) there, or None.
-
-    `group` (an index into the Assur groups, kincas/core/assembly.py) locates where that
-    group alone is singular: g = 0, g_q[rows, cols] v = 0 with v nonzero only on the group's
-    unknowns. The residual is measured scale-free: g over the size, g_q v as the pure number
-    it is (v is the null direction of the column-scaled block, in unscaled unknowns).
-    `probe`: return s after max_iter steps, converged or not (a cheap estimate of where)."""
-    nq, ng = model.nq, model.ng
-    if nq == 0:
-        return None
-    f = _extended(model)
-    rows, cols = (np.arange(ng), np.arange(nq)) if group is None else blocks(model)[group]
-    J, _ = scaled_jacobians(model, q, u, p, L)
-    cq, _ = _scales(model, L)
-    v = np.zeros(nq)
-    v[cols] = np.linalg.svd(J[np.ix_(rows, cols)])[2][-1] * cq[cols]  # null direction, unscaled
-    v0 = v / (v @ v)
-    d = np.asarray(direction, float)
-    sel = np.r_[np.arange(ng), ng + rows, 2 * ng]  # g, the group's rows of g_q v, v0.v - 1
-    q, u0, s = np.array(q, float), np.array(u, float), 0.0
-
-    def residual(F):
-        return np.abs(F[:ng]).max() / L, np.abs(F[ng + rows]).max(initial=0.0) + abs(F[-1])
-
-    for _ in range(max_iter):
-        F, JF = (np.asarray(a) for a in f(q, u0 + s * d, p, v, v0))
-        F = F.ravel()
-        rg, rv = residual(F)
-        if rg < 1e-14 and rv < 1e-13:
-            break
-        A = np.hstack([JF[:, :nq], JF[:, nq:-nq] @ d[:, None], JF[:, -nq:][:, cols]])[sel]
-        try:  # Gauss-Newton where g_q is tall (redundant joints: a consistent system)
-            step = np.linalg.solve(A, -F[sel]) if A.shape[0] == A.shape[1] else np.linalg.lstsq(A, -F[sel], rcond=None)[0]
-        except np.linalg.LinAlgError:
-            return None
-        if not np.all(np.isfinite(step)):
-            return None
-        q, s = q + step[:nq], s + step[nq]
-        v[cols] += step[nq + 1:]
-    if probe:
-        return s
-    F = np.asarray(f(q, u0 + s * d, p, v, v0)[0]).ravel()
-    rg, rv = residual(F)
-    if rg > 1e-11 or rv > 1e-8:
-        return None
-    return q, u0 + s * d, s
 
 
 # --- range of motion by pseudo-arclength continuation ---

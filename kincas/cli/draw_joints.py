@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.drawing import joint_bodies, joint_values
 from ..model import spline
 from ..model.joints import Circle
 from ..model.mechanism import GROUND
@@ -42,50 +43,13 @@ class JointGeometry:
     numbers: dict
 
 
-def _bodies(m) -> list[str]:
-    out = []
-    for g in m.gears:
-        out += [*g.links]
-    for r in m.racks:
-        out += [r.pinion, m.slide(r.slide).along]
-    for c in m.cams:
-        out += [c.body] + ([c.flat] if c.flat else [])
-    return list(dict.fromkeys(out))
-
-
-def _function(model):
-    """(q, u, p) -> the bodies' frames and the cams' contacts; p -> the joints' numbers;
-    built once per model (`Model.memo`)."""
-    return model.memo("draw_joints.functions", lambda: _build_functions(model))
-
-
-def _build_functions(model):
-    import casadi as ca
-    sym, m = model.sym, model.sym.mech
-    out = [c for b in _bodies(m) for c in sym.frames[b]]
-    out += [c for cam in m.cams for c in sym.cams[cam.name]["contact"]]
-    nums = []
-    for g in m.gears:
-        nums += [sym.val(r) for r in g.radii]
-    for r in m.racks:
-        nums.append(sym.val(r.radius))
-    for c in m.cams:
-        nums.append(sym.val(c.roller_radius) if c.roller else ca.SX(0))
-        nums += ([*(sym.val(v) for v in c.profile.center), sym.val(c.profile.radius)]
-                 if isinstance(c.profile, Circle) else [sym.val(v) for v in c.profile.radii])
-    return (ca.Function("joints_pose", [sym.q, sym.u, sym.p], [ca.vertcat(*out)]),
-            ca.Function("joints_numbers", [sym.p], [ca.vertcat(*nums)]))
-
-
 def joint_geometry(model, Q, U, p, ok) -> JointGeometry | None:
     """Frames and contact points at every pose (Q, U: N rows; p: parameter values)."""
     m = model.sym.mech
     if not (m.gears or m.racks or m.cams):
         return None
-    f, fn = _function(model)
-    n = Q.shape[0]
-    raw = np.asarray(f.map(n)(Q.T, U.T, np.repeat(np.reshape(p, (-1, 1)), n, axis=1))).T.reshape(n, -1)
-    bodies = _bodies(m)
+    raw, nums = joint_values(model, Q, U, p)
+    bodies = joint_bodies(m)
     frames = {}
     for k, b in enumerate(bodies):
         fr = raw[:, 3 * k:3 * k + 3].copy()
@@ -98,7 +62,7 @@ def joint_geometry(model, Q, U, p, ok) -> JointGeometry | None:
         xy = raw[:, c0 + 2 * k:c0 + 2 * k + 2].copy()
         xy[~ok] = np.nan
         contact[c.name] = xy
-    nums, numbers, k = np.asarray(fn(p)).ravel(), {}, 0
+    numbers, k = {}, 0
     for i, g in enumerate(m.gears):
         numbers[("gear", i)], k = nums[k:k + 2], k + 2
     for i, r in enumerate(m.racks):

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.drawing import pose_values
 from ..model.mechanism import GROUND, Mechanism
 from ..results import Sweep
 
@@ -40,7 +41,7 @@ def require_matplotlib(what: str = "kincas.plot") -> None:
         raise ModuleNotFoundError(f"{what} needs matplotlib: {PLOT_EXTRA}", name="matplotlib") from None
 
 
-# --- geometry of every pose (the one place casadi is used here) ---
+# --- geometry of every pose ---
 
 
 @dataclass
@@ -70,27 +71,6 @@ class Geometry:
         return self.xy[:, self.names.index(name)]
 
 
-def _pose_function(model):
-    """(q, u, p) -> ground points, moving points, and for each slide its line's point
-    `through` and direction angle, all in world coordinates (a body's frame is origin
-    (ox, oy) and angle th: a local vector v maps to origin + R(th) v). Built once per model
-    (`Model.memo`: threads drawing at once build it once)."""
-    return model.memo("plot.pose", lambda: _build_pose_function(model))
-
-
-def _build_pose_function(model):
-    import casadi as ca
-    sym, m = model.sym, model.sym.mech
-    out = [c for g in m.ground_points for c in sym.points[g]]
-    out += [c for p in m.moving_points for c in sym.points[p]]
-    for sl in m.slides:
-        ox, oy, th = sym.frames[sl.along]
-        tx, ty = (sym.val(v) for v in sl.through)
-        out += [ox + ca.cos(th) * tx - ca.sin(th) * ty, oy + ca.sin(th) * tx + ca.cos(th) * ty,
-                th + sym.val(sl.angle)]
-    return ca.Function("pose", [sym.q, sym.u, sym.p], [ca.vertcat(*out)])
-
-
 def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
     """Positions of all points and the lines of all slides at every pose of `sweep`."""
     from ..core.numeric import compile
@@ -102,10 +82,9 @@ def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
     n, ok = len(sweep), sweep.ok
     names = list(m.ground_points) + list(m.moving_points)
     U = np.stack([np.asarray(sweep.inputs[k], float) for k in keys], axis=1).reshape(n, len(keys))
-    p = np.array([v for _, v in m.parameters], float).reshape(-1, 1)
+    p = np.array([v for _, v in m.parameters], float)
     Q = np.where(ok[:, None], sweep.q, 0.0)  # what depends on q is masked below
-    f = _pose_function(model).map(n)
-    raw = np.asarray(f(Q.T, U.T, np.repeat(p, n, axis=1))).T.reshape(n, -1)
+    raw = pose_values(model, Q, U, p)
     ng = len(m.ground_points)
     xy = raw[:, :2 * len(names)].reshape(n, len(names), 2).copy()
     xy[~ok, ng:] = np.nan  # ground points are known at every pose, moving ones when solved

@@ -177,13 +177,7 @@ def constrain(prob, lo, hi, periodic, direction):
 
 def objective(prob, curve: Curve):
     """sum_i |P(q_i, u_i) - T_i|^2 as an SX of the NLP's variables."""
-    ca = prob.ca
-    F = prob.model.quantity_function((f"{curve.point}.x", f"{curve.point}.y"))
-    f = 0
-    for k in range(prob.K):
-        d = F(prob.Q[:, k], prob.u_at(k), prob.P, prob.Ud[k], prob.Udd[k]) - ca.DM(curve.targets[k])
-        f = f + ca.sumsqr(d)
-    return f
+    return prob.squared_distances(curve.point, curve.targets)
 
 
 def distances(sw, curve: Curve, at) -> np.ndarray:

@@ -2,8 +2,9 @@
 
 An expression is parsed by Python's `ast` module and only these nodes are accepted: numbers,
 names, `+ - * /`, powers (`**` or `^`), unary minus, and calls of the functions below. Nothing
-is ever evaluated by Python itself; the tree is turned into a CasADi expression, so that its
-derivatives through the kinematics are exact.
+is ever evaluated by Python itself; the tree is turned into a CasADi expression (with the
+operations of kincas/core/expressions_sym.py), so that its derivatives through the
+kinematics are exact.
 
 Names:
   * a quantity `P.x`, `L.angle`, `S.s`, `P.vx`, ... (see docs/scene-format.md): its value at a
@@ -32,13 +33,24 @@ import ast
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
+from ..core.expressions_sym import CONST, SAMPLE, TOTAL  # noqa: F401  (the kinds, shared)
 from ..errors import ModelError
 
 UNARY = {"sin", "cos", "tan", "asin", "acos", "atan", "sqrt", "exp", "log", "abs"}
 BINARY = {"atan2", "hypot"}
 AGGREGATE = {"sum", "mean", "max", "min"}
 FORCES = {"effort", "reaction"}  # quantity names written as calls (kincas/core/dynamics.py)
-CONST, SAMPLE, TOTAL = "constant", "per sample", "total"
+
+
+class NUMERIC:
+    """numpy's arithmetic for `Evaluator` (the default): an expression's value on numbers."""
+
+    const = float
+    sqrt, exp, log, abs = np.sqrt, np.exp, np.log, np.abs
+    sin, cos, tan, asin, acos, atan = np.sin, np.cos, np.tan, np.arcsin, np.arccos, np.arctan
+    atan2 = np.arctan2
 
 
 @dataclass
@@ -142,12 +154,14 @@ def quantity_name(node) -> str | None:
     return None
 
 
-# --- evaluation into CasADi ---
+# --- evaluation ---
 
 
 class Evaluator:
-    """Turns a tree into (kind, value). The caller supplies how leaves and aggregates become
-    CasADi expressions:
+    """Turns a tree into (kind, value), with the arithmetic of the caller's values: `ops`
+    has `const(x)` and the functions sqrt exp log abs sin cos tan asin acos atan atan2 of
+    those values (CasADi's symbolic ones: `kincas.core.expressions_sym.SYMBOLIC`; numpy's
+    work as well). The caller supplies how leaves and aggregates become values:
 
       leaf(kind, name) -> (CONST | SAMPLE, SX)  for quantities ("quantity"), parameters
                                                  ("parameter") and data ("data");
@@ -158,22 +172,22 @@ class Evaluator:
     `angle` is the caller's angle unit in radians (pi/180 for degrees): trigonometric
     functions convert their arguments from it and their results to it."""
 
-    def __init__(self, leaf, aggregate, total, angle: float = 1.0):
+    def __init__(self, leaf, aggregate, total, angle: float = 1.0, ops=None):
         self.leaf, self.aggregate, self.total, self.angle = leaf, aggregate, total, angle
+        self.ops = ops or NUMERIC
 
     def __call__(self, e: Expr):
         return self.eval(e.tree, e)
 
     def eval(self, node, e: Expr):
-        import casadi as ca
-
+        ops = self.ops
         if isinstance(node, ast.Constant):
-            return CONST, ca.SX(float(node.value))
+            return CONST, ops.const(float(node.value))
         if isinstance(node, ast.Attribute):
             return self.leaf("quantity", quantity_name(node))
         if isinstance(node, ast.Name):
             if node.id == "pi":
-                return CONST, ca.SX(math.pi)
+                return CONST, ops.const(math.pi)
             return self.leaf("data" if node.id in e.data else "parameter", node.id)
         if isinstance(node, ast.UnaryOp):
             k, v = self.eval(node.operand, e)
@@ -202,14 +216,14 @@ class Evaluator:
         if len(args) == 2:
             k, a, b = self._join(*args[0], *args[1], e, ast.unparse(node))
             if f == "hypot":
-                return k, ca.sqrt(a * a + b * b)
-            return k, ca.atan2(a, b) / self.angle
+                return k, ops.sqrt(a * a + b * b)
+            return k, ops.atan2(a, b) / self.angle
         k, a = args[0]
-        if f in ("sin", "cos", "tan"):
-            return k, getattr(ca, f)(a * self.angle)
+        if f in ("sin", "cos", "tan"):  # angles in the caller's unit
+            return k, getattr(ops, f)(a * self.angle)
         if f in ("asin", "acos", "atan"):
-            return k, getattr(ca, f)(a) / self.angle
-        return k, {"sqrt": ca.sqrt, "exp": ca.exp, "log": ca.log, "abs": ca.fabs}[f](a)
+            return k, getattr(ops, f)(a) / self.angle
+        return k, getattr(ops, f)(a)
 
     def _join(self, ka, a, kb, b, e: Expr, text: str):
         """The kind of a combination; constants follow totals into the totals' variables."""
