@@ -29,6 +29,7 @@ from .continuation import careful_pose
 from .events import null_derivatives
 from ..core.joints import check_first_pose
 from .inputs import input_table as _input_table
+from .prepared import prepared
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
 
@@ -67,10 +68,14 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     n = U.shape[0]
     Ud = np.broadcast_to(_input_table(m, rates, "rates", 1.0), U.shape)
     Udd = np.broadcast_to(_input_table(m, accelerations, "accelerations", 0.0), U.shape)
-    p = np.array([v for _, v in m.parameters], dtype=float)
-    L = m.size()
-    g = {k: (m.value(x), m.value(y)) for k, (x, y) in {**dict(m.guess), **dict(guess or {})}.items()}
+    pm = prepared(model, m)  # parameter values, size, guess: once per mechanism
+    p, L = pm.p, pm.size
+    g = pm.guess if not guess else {**pm.guess, **{k: (m.value(x), m.value(y)) for k, (x, y) in dict(guess).items()}}
     events = []
+
+    def first(k):
+        """Where the careful path would start Newton for pose k, no pose solved yet."""
+        return pm.placement(model, U[k], g)
 
     def careful(k, j, run):
         """Pose k, which the fast pass did not accept, from the last solved pose j."""
@@ -81,7 +86,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     # (a tall system, with redundant joints, has no compiled pass: its g_q is not square)
     fast = sweeper_for(model, tuple(report), compile) if method == "fast" and model.square else None
     if fast is not None and (compile is False or fast.worth_it(n)):
-        run = fast.sweep(U, p, L, careful, Ud=Ud, Udd=Udd, progress=progress)
+        run = fast.sweep(U, p, L, careful, Ud=Ud, Udd=Udd, progress=progress, first=first)
     elif method in ("fast", "careful"):  # "fast" for a kernel too large to pay for itself
         run = _careful_only(model, report, U, Ud, Udd, p, L, careful, progress)
     else:

@@ -229,12 +229,18 @@ class FastSweeper:
             a[:start], a[k + 1:] = np.nan, np.nan
         return r
 
-    def sweep(self, U, p, L, careful, Ud=None, Udd=None, progress=None) -> FastRun:
+    def sweep(self, U, p, L, careful, Ud=None, Udd=None, progress=None, first=None) -> FastRun:
         """Every pose of U: the fast pass wherever it is accepted, else `careful(k, j, run)`
         -> a solution with q, residual, iterations, ok, where j is the last solved pose (None
         while none is; its unknowns are run.Q[j]); the fast pass restarts after each. Between
         two consecutive fast poses det g_q keeps its sign (see the module's text). With no
-        unknowns or no inputs, every pose goes to `careful`."""
+        unknowns or no inputs, every pose goes to `careful`.
+
+        `first(k)`, if given, places pose k while no pose is solved yet: (q0, qs), the
+        unknowns the careful path would start Newton from (the guessed points) and each
+        unknown's scale in its own group, or None. The kernel then solves pose k from q0
+        (`_from_guess`), and the careful path only where the kernel's answer is not
+        certainly the careful path's."""
         r = FastRun(self, U, p, L, Ud, Udd)
         k, last, going = 0, None, False  # going: the last block ended with no rejection
 
@@ -252,6 +258,14 @@ class FastSweeper:
                 k = bad
                 if going or k == r.n:
                     continue
+            if last is None and first is not None and self.nq and self.nu:
+                stop = r.n if progress is None else k + BLOCK
+                bad = self._from_guess(r, k, first(k), stop)
+                if bad > k:  # the kernel solved pose k from the placed guess, and went on
+                    last, going = bad - 1, bad == min(stop, r.n)
+                    tick(k, bad)
+                    k = bad
+                    continue
             sol = careful(k, last, r)
             r.record(k, sol)
             if sol.ok and last is None and self.nq and self.nu and self._again(r, k):
@@ -266,6 +280,37 @@ class FastSweeper:
         if progress is not None:
             progress(r.n, r.n)
         return r
+
+    def _from_guess(self, r: FastRun, k: int, placed, stop: int) -> int:
+        """Pose k (no pose solved before it) by the kernel's Newton from the placed guess
+        q0, and the poses after it from there; returns where that pass stopped (k: pose k is
+        left to the careful path, with nothing of this attempt kept).
+
+        Pose k is accepted when it passes every test of any pose (residual, converged,
+        Jacobian change against g_q at q0 below JAC_CHANGE per group, correction) and, per
+        Assur group, (a) its block's determinant has the same sign, not zero, at q0 and at
+        the solution, and (b) the correction |q - q0| (each unknown over its scale in its
+        own group, `Model.scales`) sums to at most CORRECTION. Then Newton stayed within
+        one group mode's neighbourhood of q0 with every block invertible on the way (the
+        Jacobian test), where the careful path's damped Newton from q0 converges to the
+        same root: the guess chooses the branch, as it does on the careful path."""
+        if placed is None:
+            return k
+        q0, qs = placed
+        s = self.state(q0, r.U[k], r.p)
+        before = _diagonal_signs(s[self.nq:self.nq + self.nj], self.blocks)
+        r._s = s
+        bad = r.advance(k, None, None, stop)
+        if bad > k:
+            after = r.measures[:len(self.blocks), k]
+            dq = np.abs(r.Q[k] - q0) / qs
+            moved = [float(dq[b.cols].sum()) for b in self.blocks]
+            if np.all(before != 0) and np.array_equal(before, after) and max(moved, default=0.0) <= CORRECTION:
+                return bad
+        r._s = None  # nothing of this attempt is kept: the careful path starts afresh
+        r.Q[k:bad + 1] = r.values[:, k:bad + 1] = r.measures[:, k:bad + 1] = np.nan
+        r.accepted[k:bad + 1] = r.solved[k:bad + 1] = False
+        return k
 
     def _again(self, r: FastRun, k: int) -> bool:
         """Re-solve the first carefully solved pose k in the kernel (predicted where it is,
@@ -350,6 +395,19 @@ class _Buffered:
         for a, b in zip(keep[self.n_in:], arrays[self.n_in:]):
             if a is not b:
                 b[...] = a
+
+
+def _diagonal_signs(d: np.ndarray, blocks) -> np.ndarray:
+    """The signs of the determinants of g_q's diagonal blocks, given as the state keeps them
+    (`diagonal_blocks`: each block's entries column-major, one block after another)."""
+    out, at = np.empty(len(blocks)), 0
+    for i, b in enumerate(blocks):
+        n = len(b.cols)
+        A = d[at:at + n * n]
+        at += n * n
+        det = A[0] if n == 1 else A[0] * A[3] - A[1] * A[2] if n == 2 else np.linalg.det(A.reshape(n, n))
+        out[i] = np.sign(det)
+    return out
 
 
 def _take(table, idx):

@@ -1,0 +1,116 @@
+"""What a sweep needs of one mechanism, worked out once per mechanism and kept by its model.
+
+A `Mechanism` is an immutable value, so its parameter values, its size and its guessed
+points never change, and neither does the first pose's *placement*: the unknowns that
+`Model.initial_q` builds from the guessed points at given inputs (or, without a guess, the
+pose assembled group by group in the default modes). Repeated sweeps of one mechanism (the
+usual case: a user, a benchmark or an optimiser calling `kincas.sweep` again) read them here
+instead of recomputing them. The table belongs to the structure's `Model` (`Model.memo`),
+holds the RECENT mechanisms used last (each kept by a reference, so its `id` stays its own)
+and is guarded by a lock: nothing here is global, and threads share only immutable arrays.
+
+>>> import numpy as np, kincas
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+...            kincas.Link.bar("rocker", "D", "C", 3)],
+...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+>>> model = kincas.compile(m)
+>>> pm = prepared(model, m)
+>>> pm is prepared(model, m), pm.size, pm.keys
+(True, 4.0, ('crank.angle',))
+>>> q0, qs = pm.placement(model, np.array([0.0]), pm.guess)
+>>> bool(np.allclose(q0, model.initial_q(np.array([0.0]), pm.p, pm.guess, 4.0)))
+True
+"""
+from __future__ import annotations
+
+import threading
+from collections import OrderedDict
+
+import numpy as np
+
+from ..core.assembly import ambiguous, assemble
+from ..model.mechanism import Mechanism
+
+RECENT = 32  # mechanisms kept per structure
+PLACEMENTS = 8  # first-pose placements kept per mechanism (inputs and guesses of its sweeps)
+
+
+# --- one mechanism's fixed data ---
+
+
+class Prepared:
+    """A mechanism's parameter values `p` (read-only), `size`, input `keys`, guessed points
+    `guess` (name -> (x, y), numbers) and its first-pose placements (`placement`)."""
+
+    def __init__(self, m: Mechanism):
+        self.m = m
+        self.p = np.array([v for _, v in m.parameters], dtype=float)
+        self.p.flags.writeable = False
+        self.size = m.size()
+        self.keys = tuple(i.key for i in m.inputs)
+        self.guess = {k: (m.value(x), m.value(y)) for k, (x, y) in dict(m.guess).items()}
+        # gears and racks wrap their angles at the first pose (core/joints.settle_first):
+        # that pose stays on the careful path
+        self.plain = not (m.gears or m.racks)
+        self._places: OrderedDict = OrderedDict()
+        self._lock = threading.Lock()
+
+    def placement(self, model, u: np.ndarray, guess: dict):
+        """(q0, qs): the first pose's unknowns placed at inputs u from `guess` (the guessed
+        points, as the careful path places them), and each unknown's scale within its own
+        group (`Model.scales`); None where the careful path must decide alone (gears, no
+        assembly found group by group). Computed once per inputs and guess."""
+        if not self.plain or model.nq == 0:
+            return None
+        key = (np.asarray(u, float).tobytes(), tuple(sorted(guess.items())))
+        with self._lock:
+            if key in self._places:
+                self._places.move_to_end(key)
+                return self._places[key]
+        u = np.array(u, float)
+        if guess:
+            q0 = model.initial_q(u, self.p, guess, self.size)
+        elif not ambiguous(model):  # no guess: the careful path assembles group by group
+            sol = assemble(model, u, self.p, self.size)
+            q0 = None if sol is None else sol.q
+        else:
+            q0 = None
+        out = None
+        if q0 is not None and np.all(np.isfinite(q0)):
+            qs = model.scales(u, self.p)[1]
+            q0.flags.writeable = qs.flags.writeable = False
+            out = (q0, qs)
+        with self._lock:
+            self._places[key] = out
+            while len(self._places) > PLACEMENTS:
+                self._places.popitem(last=False)
+        return out
+
+
+class _Recent:
+    """The RECENT mechanisms last prepared, by identity (each entry keeps its mechanism, so
+    an id is never reused while it is here)."""
+
+    def __init__(self):
+        self._d: OrderedDict = OrderedDict()
+        self._lock = threading.Lock()
+
+    def get(self, m: Mechanism) -> Prepared:
+        with self._lock:
+            hit = self._d.get(id(m))
+            if hit is not None and hit.m is m:
+                self._d.move_to_end(id(m))
+                return hit
+        made = Prepared(m)
+        with self._lock:
+            self._d[id(m)] = made
+            self._d.move_to_end(id(m))
+            while len(self._d) > RECENT:
+                self._d.popitem(last=False)
+        return made
+
+
+def prepared(model, m: Mechanism) -> Prepared:
+    """The `Prepared` data of mechanism m, whose structure's model is `model`."""
+    return model.memo("sweep.prepared", _Recent).get(m)
