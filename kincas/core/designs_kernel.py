@@ -78,7 +78,7 @@ static int kincas_first_pose(const casadi_real* u0, const casadi_real* p0, const
                              const casadi_real* c, casadi_real* q) {
   const casadi_real* arg[SZ_ARG]; casadi_real* res[SZ_RES]; casadi_int iw[SZ_IW]; casadi_real w[SZ_W];
   casadi_real pc[NP > 0 ? NP : 1], pt[NP > 0 ? NP : 1], dp[NP > 0 ? NP : 1], dq[NQ], rs[2], v[1 + NG];
-  casadi_real big = 0;
+  casadi_real Lb[NG > 0 ? NG : 1], big = 0;
   casadi_int i, j, it, k, steps;
   for (j = 0; j < NP; ++j) if (fabs(p[j] - p0[j]) > big) big = fabs(p[j] - p0[j]);
   big = ceil(big / (c[0] * L));
@@ -93,8 +93,10 @@ static int kincas_first_pose(const casadi_real* u0, const casadi_real* p0, const
     arg[0] = q; arg[1] = u0; arg[2] = pc; arg[3] = dp; res[0] = dq;  /* along the tangent */
     if (kC(arg, res, iw, w, 0)) return 0;
     for (i = 0; i < NQ; ++i) q[i] -= dq[i];
+    arg[0] = u0; arg[1] = pt; res[0] = Lb;  /* each group's length at p(t), for kN's tests */
+    if (kL(arg, res, iw, w, 0)) return 0;
     for (k = 0; k < (casadi_int) c[2]; ++k) {  /* Newton at p(t) */
-      arg[0] = q; arg[1] = u0; arg[2] = pt; arg[3] = &L; res[0] = dq; res[1] = rs;
+      arg[0] = q; arg[1] = u0; arg[2] = pt; arg[3] = Lb; res[0] = dq; res[1] = rs;
       if (kN(arg, res, iw, w, 0)) return 0;
       for (i = 0; i < NQ; ++i) q[i] -= dq[i];
       if (rs[1] <= c[4]) break;
