@@ -170,7 +170,8 @@ def _lock(model) -> threading.Lock:
 
 def sweep_designs(m: Mechanism, params, inputs=None, *, names=None, rates=None,
                   accelerations=None, report=None, guess=None, workers: int | None = None,
-                  gaps: str = "stop", compile: bool | None = None, progress=None) -> DesignSweep:
+                  gaps: str = "stop", compile: bool | None = None, progress=None,
+                  backend: str = "casadi") -> DesignSweep:
     """Sweep the structure of `m` for many parameter sets, each on the branch of the guess.
 
     Parameters
@@ -190,6 +191,10 @@ def sweep_designs(m: Mechanism, params, inputs=None, *, names=None, rates=None,
         As for `kincas.sweep` (None: compile when cached or at least 50,000 poses in all).
     progress : callable, optional
         Called as progress(designs done, designs).
+    backend : {"casadi", "jax"}
+        The fast pass over the poses: casadi's compiled kernel (default), or JAX
+        (`pip install "kincas[gpu]"`; a GPU if JAX has one), its rejected poses continued here
+        (kincas/analysis/designs_jax.py).
 
     Returns
     -------
@@ -202,6 +207,8 @@ def sweep_designs(m: Mechanism, params, inputs=None, *, names=None, rates=None,
     """
     if gaps not in ("stop", "resume"):
         raise ModelError(f"gaps: {gaps!r} is neither \"stop\" nor \"resume\"")
+    if backend not in ("casadi", "jax"):
+        raise ModelError(f"backend: {backend!r} is neither \"casadi\" nor \"jax\"")
     model = compile_model(m)
     report = list(default_report(m) if report is None else report)
     model.quantity_function(tuple(report))  # unknown names fail here
@@ -218,6 +225,7 @@ def sweep_designs(m: Mechanism, params, inputs=None, *, names=None, rates=None,
     Ls = np.ascontiguousarray(_sizes(m, P, pnames))
     g = {k: (m.value(x), m.value(y)) for k, (x, y) in {**dict(m.guess), **dict(guess or {})}.items()}
     job = _Job(model, m, report, U, Ud, Udd, P, Ls, g, compile)
+    job.backend = backend
     with _lock(model):
         job.first_poses(p0, m.size())
     job.sweep_all(workers or os.cpu_count() or 1, progress)
@@ -328,9 +336,15 @@ class _Job:
         batched = lib is None and self.kernel is not None and n > 1
         if batched:  # no compiled kernel: all designs advance together, pose by pose
             blocks = [todo]
+        jax_stops = None
+        if getattr(self, "backend", "casadi") == "jax" and self.kernel is not None and n > 1:
+            from .designs_jax import jax_pass  # the fast pass in JAX, then as after the kernel's
+            jax_stops = dict(zip(todo.tolist(), jax_pass(self, todo, _thresholds())))
 
         def run(block):
-            if lib is not None:
+            if jax_stops is not None:
+                stops = [jax_stops[int(d)] for d in block]
+            elif lib is not None:
                 stops = self._kernel_block(lib, block)
             elif batched:
                 stops = self._batched_pass(block)

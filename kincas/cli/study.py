@@ -5,7 +5,8 @@ Reads the scene's `[study]` section (docs/scene-format.md): `vary` (parameter ->
 (expressions in the `[optimize]` language). Writes one row per design: a column per varied
 parameter, `status`, a column per report expression named exactly as written (NetCDF: the
 same as variables along a dimension `design`). Angles in the scene's unit. Runs on every
-local core, or on the Dask cluster at `--scheduler ADDRESS`.
+local core, or on the Dask cluster at `--scheduler ADDRESS`; `--backend jax` sweeps the designs
+in JAX (kincas/core/jax_backend.py).
 
 Exit status: 0 when every design was solved at every pose, 3 when some were not, 2 when the
 scene, the `[study]` section or an option is wrong (one line naming it).
@@ -101,6 +102,9 @@ def cli_arguments(parser) -> None:
     parser.add_argument("--scheduler", metavar="ADDRESS", help="run on the Dask cluster at this scheduler address")
     parser.add_argument("--workers", type=int, metavar="N", help="local threads (default: every core)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--backend", choices=("casadi", "jax"), default="casadi",
+                        help="the designs' fast pass: casadi's compiled kernel (default) or JAX "
+                             "(pip install 'kincas[gpu]'; a GPU where JAX has one)")
 
 
 def cli_run(args) -> int:
@@ -119,6 +123,8 @@ def cli_run(args) -> int:
         check_plot(args.plot, kw["vary"])
     if args.workers is not None and args.workers < 1:
         raise OutputError(f"--workers: expected a whole number >= 1, got {args.workers}")
+    if args.backend == "jax" and not (_has("jax") and _has("jaxadi")):
+        raise OutputError("--backend jax: needs jax and jaxadi (pip install 'kincas[gpu]')")
     client = _client(args.scheduler) if args.scheduler else None
     st = sc.study
     sc.refuse_jerks(kw["report"], "[study] report")
@@ -126,7 +132,7 @@ def cli_run(args) -> int:
         r = study(sc.mechanism, kw["vary"], st.inputs, kw["report"], grid=kw["grid"],
                   samples=kw["samples"], seed=kw["seed"], rates=st.rates,
                   accelerations=st.accelerations, degrees=st.deg, client=client,
-                  workers=args.workers, progress=progress_for(args))
+                  workers=args.workers, progress=progress_for(args), backend=args.backend)
     finally:
         if client is not None:
             client.close()

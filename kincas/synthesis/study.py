@@ -214,6 +214,7 @@ class _Chunk:
     report: list[str]
     angle: float
     compile: bool | None
+    backend: str = "casadi"
 
     def __call__(self, part):
         """(design indices, failure code and pose per design, values (n, len(report)))."""
@@ -225,7 +226,7 @@ class _Chunk:
         wanted = list(dict.fromkeys(q for e in exprs for q in e.quantities))
         r = sweep_designs(self.m, X, self.inputs, names=self.names, rates=self.rates,
                           accelerations=self.accelerations, report=wanted, workers=1,
-                          compile=self.compile)
+                          compile=self.compile, backend=self.backend)
         ok = r.design_ok
         code, pose = np.zeros(len(idx), dtype=int), np.full(len(idx), -1)
         for d in np.flatnonzero(~ok):
@@ -245,7 +246,7 @@ class _Chunk:
 def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, seed=0,
           rates=None, accelerations=None, degrees: bool = False, client=None,
           workers: int | None = None, chunk: int | None = None, compile: bool | None = None,
-          progress=None) -> StudyResult:
+          progress=None, backend: str = "casadi") -> StudyResult:
     """Sweep many designs of `m` and evaluate `report` over each (see the module's text).
 
     Parameters
@@ -265,7 +266,10 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, 
     client : dask.distributed.Client, optional
         Run the chunks on its cluster; else on `workers` local threads (default: all cores).
     chunk : int, optional
-        Designs per chunk (default: about four chunks per worker, at most 512 designs).
+        Designs per chunk (default: about four chunks per worker, at most 512 designs; with
+        the JAX backend, up to 4096 designs a chunk).
+    backend : {"casadi", "jax"}
+        The designs' fast pass, as for `kincas.sweep_designs`.
 
     Returns
     -------
@@ -293,9 +297,11 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, 
     nd = len(X)
     w = default_workers() if workers is None else workers
     size = chunk or max(1, min(512, math.ceil(nd / (4 * w))))
+    if backend == "jax" and not chunk:  # one vmapped call does many designs: few large chunks
+        size = max(1, min(4096, math.ceil(nd / w)))
     parts = [(np.arange(a, min(a + size, nd)), X[a:a + size]) for a in range(0, nd, size)]
     job = _Chunk(m, names, inputs, rates, accelerations, list(report),
-                 math.pi / 180 if degrees else 1.0, compile)
+                 math.pi / 180 if degrees else 1.0, compile, backend)
     out = run_chunks(job, parts, client=client, workers=w, progress=progress)
     idx = np.concatenate([o[0] for o in out]) if out else np.zeros(0, int)
     if not np.array_equal(idx, np.arange(nd)):  # every design exactly once, in order
