@@ -182,8 +182,8 @@ class Mechanism:
 
         Examples
         --------
-    >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-    ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
         >>> m.redundant
         0
         """
@@ -199,8 +199,8 @@ class Mechanism:
 
         Examples
         --------
-    >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-    ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
         >>> m.param_values
         {'r': 2.0}
         """
@@ -219,8 +219,8 @@ class Mechanism:
 
         Examples
         --------
-    >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-    ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
         >>> m.parameter("r")
         2.0
         """
@@ -239,8 +239,8 @@ class Mechanism:
 
         Examples
         --------
-    >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-    ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
         >>> m.link("crank").point_names
         ('O', 'A')
         """
@@ -273,8 +273,8 @@ class Mechanism:
 
         Examples
         --------
-    >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-    ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
         >>> m.ground_points
         ('O',)
         """
@@ -286,8 +286,8 @@ class Mechanism:
 
         Examples
         --------
-    >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-    ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
         >>> m.moving_points
         ('A',)
         """
@@ -300,8 +300,8 @@ class Mechanism:
 
         Examples
         --------
-    >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-    ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
         >>> m.mobility
         1
         """
@@ -320,8 +320,8 @@ class Mechanism:
 
         Examples
         --------
-    >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-    ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
         >>> m.value("r"), m.value(Param("r", 0.5)), m.value(3)
         (2.0, 1.0, 3.0)
         """
@@ -338,8 +338,8 @@ class Mechanism:
 
         Examples
         --------
-    >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-    ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
         >>> m.size()
         2.0
         """
@@ -377,8 +377,8 @@ class Mechanism:
 
         Examples
         --------
-    >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-    ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
         >>> m.with_parameters(r=3).size(), m.size()
         (3.0, 2.0)
         """
@@ -401,8 +401,8 @@ class Mechanism:
 
         Examples
         --------
-    >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-    ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
         >>> m.with_guess(A=(0, 2)).guess
         (('A', (0, 2)),)
         """
