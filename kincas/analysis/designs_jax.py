@@ -31,10 +31,11 @@ def jax_pass(job, todo, thresholds) -> np.ndarray:
     and returns each design's first rejected pose (n if none was)."""
     todo = np.asarray(todo, dtype=int)
     jd = jax_designs(job.model, tuple(job.report))
-    Q, vals, info, stops = jd.run(job.S[todo], job.U, job.P[todo], job.Ls[todo], job.Ud, job.Udd,
-                                  thresholds)
-    for j, d in enumerate(todo):
-        k = stops[j]  # poses 1..k-1 accepted; k rejected (if < n)
-        job.Q[d, 1:k], job.vals[d, :, 1:k], job.info[d, :, 1:k] = Q[j, 1:k], vals[j, :, 1:k], info[j, :, 1:k]
-        job.code[d, 1:k], job.fast[d, 1:k] = 0, True  # 0: "ok"
+    # poses 1.. of each design written straight into the job's rows (NaN where not accepted)
+    stops = jd.run(job.S[todo], job.U, job.P[todo], job.Ls[todo], job.Ud, job.Udd, thresholds,
+                   out=(job.Q, job.vals, job.info), rows=todo)[3]
+    k = np.arange(job.U.shape[0])
+    acc = (k >= 1) & (k < stops[:, None])  # poses 1..stop-1 accepted; the stop rejected
+    job.code[todo] = np.where(acc, 0, job.code[todo])  # 0: "ok"
+    job.fast[todo] |= acc
     return stops
