@@ -51,6 +51,7 @@ class Case:
     kind: str = "dyads"
     guess: dict = field(default_factory=dict)  # moving point -> (x, y) at the first pose
     orient: dict = field(default_factory=dict)  # triangle name -> +1/-1 (R left of P->Q)
+    guessless: bool = False  # no tool gets `guess`: kincas assembles its documented default mode
 
     @property
     def size(self) -> float:
@@ -181,16 +182,130 @@ def stiff_cases(n: int = 360) -> list[Case]:
                   start=0.0)]
 
 
-def alternatives(case: Case) -> list[tuple]:
-    """Every assembly of a one-dyad case as `steps` (both sides of its dyad)."""
-    (step,) = case.steps
-    if step[0] == "translate":  # the parallelogram: its assemblies are the two circle points
-        _, p, a, _, _ = step
-        coupler = next(ls[0] for _, pts, ls in case.links if set(pts) == {a, p})
-        g, rocker = next((q, ls[0]) for _, pts, ls in case.links for q in pts
-                         if p in pts and q in case.ground)
-        return [(("rrr", p, a, g, coupler, rocker, s),) for s in (1, -1)]
-    return [(step[:-1] + (s,),) for s in (1, -1)]
+def alternatives(case: Case, most: int = 64) -> list[tuple]:
+    """Other assemblies of a dyad chain as `steps`: every combination of sides of its circle
+    intersections (a parallelogram's or antiparallelogram's point as the two intersections of
+    its coupler's and rocker's circles); beyond `most` combinations, the case's own steps with
+    one point at a time on either side (a jump of one loop among many)."""
+    options = []
+    for step in case.steps:
+        kind, p = step[0], step[1]
+        if kind in ("translate", "cross"):  # a four-bar's point: both circle points
+            a = step[2]
+            coupler = next(ls[0] for _, pts, ls in case.links if len(pts) == 2 and set(pts) == {a, p})
+            g, rocker = next((q, ls[0]) for _, pts, ls in case.links if len(pts) == 2 and p in pts
+                             for q in pts if q != p and q != a)
+            options.append([("rrr", p, a, g, coupler, rocker, s) for s in (1, -1)])
+        elif kind in ("rrr", "rrp"):
+            options.append([step[:-1] + (s,) for s in (1, -1)])
+        else:  # a rigid triangle's vertex: one place only
+            options.append([step])
+    if math.prod(len(o) for o in options) <= most:
+        import itertools
+        return [tuple(c) for c in itertools.product(*options)]
+    return [case.steps[:k] + (alt,) + case.steps[k + 1:] for k, o in enumerate(options) if len(o) > 1
+            for alt in o]
+
+
+# --- the cases of issue [9]: branches, singular positions, gaps ---
+
+
+def _every(step_deg: float, turn_deg: float = 720.0, start_deg: float = 0.0) -> np.ndarray:
+    """Input angles from `start_deg` in steps of `step_deg` up to `start_deg + turn_deg`."""
+    return np.radians(start_deg + step_deg * np.arange(int(turn_deg // step_deg) + 1))
+
+
+def _slider_1e7(step: float) -> Case:
+    rod = 1.0 + 1e-7
+    return finish(Case(
+        f"slider_rod_1e-7_{step:g}deg", f"slider-crank, rod 1e-7 longer than crank, {step:g} deg steps",
+        {"O": (0.0, 0.0), "T": (-5.0, 0.0)}, ("O", "A", 1.0), (("rod", ("A", "B"), (rod,)),),
+        slides=(("B", "T", 0.0),), steps=(("rrp", "B", "A", rod, "T", 0.0, 1),),
+        theta=_every(step, 720.0, 3.0), outputs=("A", "B")))
+
+
+def _nfourbar(N: int) -> Case:
+    """IFToMM benchmark A02: N four-bars in a row, each one's rocker the next one's crank
+    through a shared coupler point: every link 1 long, pivots 1 apart, so all N loops fold
+    at once (change points at 180 and 360 deg, poses exactly on them)."""
+    ground = {f"G{i}": (float(i), 0.0) for i in range(N + 1)}
+    links = tuple((f"rocker{i}", (f"G{i}", f"B{i}"), (1.0,)) for i in range(1, N + 1))
+    links += tuple((f"coupler{i}", (f"B{i - 1}", f"B{i}"), (1.0,)) for i in range(1, N + 1))
+    steps = tuple(("translate", f"B{i}", f"B{i - 1}", 1.0, 0.0) for i in range(1, N + 1))
+    return finish(Case(f"a02_n{N}", f"IFToMM A02, {N} four-bars folding at once, poses on 180 and 360 deg",
+                       ground, ("G0", "B0", 1.0), links, steps=steps, theta=_every(10.0, 350.0, 10.0),
+                       outputs=("B1", f"B{N}")))
+
+
+def _six_bar(kind: str, s2: int) -> Case:
+    """A Watt II (two four-bars in series through a ternary rocker) or a Stephenson III (a
+    four-bar's coupler point driving a dyad) whose last dyad loses its assembly for part of
+    each turn: two turns in 7 deg steps, through gaps and back."""
+    if kind == "watt2":
+        ground = {"A": (0.0, 0.0), "D": (4.0, 0.0), "G": (4.6, 3.0)}
+        ce, de = math.hypot(1.5, 1.0), math.hypot(1.5, 1.0)
+        links = (("coupler", ("B", "C"), (3.5,)), ("rocker", ("D", "C", "E"), (3.0, ce, de)),
+                 ("rod", ("E", "F"), (2.0,)), ("arm", ("G", "F"), (1.2,)))
+        steps = (("rrr", "C", "B", "D", 3.5, 3.0, 1), ("tri", "E", "C", "D", ce, de, -1),
+                 ("rrr", "F", "E", "G", 2.0, 1.2, s2))
+        title = "Watt II six-bar through gaps (7 deg steps, two turns)"
+    else:
+        ground = {"A": (0.0, 0.0), "D": (4.0, 0.0), "G": (1.0, 4.2)}
+        be, ce = math.hypot(1.5, 1.5), math.hypot(2.0, 1.5)
+        links = (("coupler", ("B", "C", "E"), (3.5, ce, be)), ("rocker", ("D", "C"), (3.0,)),
+                 ("rod", ("E", "F"), (1.5,)), ("arm", ("G", "F"), (1.0,)))
+        steps = (("rrr", "C", "B", "D", 3.5, 3.0, 1), ("tri", "E", "B", "C", be, ce, 1),
+                 ("rrr", "F", "E", "G", 1.5, 1.0, s2))
+        title = "Stephenson III six-bar through gaps (7 deg steps, two turns)"
+    return finish(Case(f"{kind}_gaps", title, ground, ("A", "B", 1.0), links, steps=steps,
+                       theta=_every(7.0, 714.0), outputs=("C", "F")))
+
+
+def _guessless_fourbar() -> Case:
+    """The README's crank-rocker from 0 deg with no guess. The reference is kincas's documented
+    default mode, the one whose block of g_q has a positive determinant: with g = B + b e(phi)
+    - D - c e(psi) and kincas's unknowns (rocker angle psi, coupler angle phi), in that order,
+    det = b c sin(psi - phi) > 0."""
+    a, b, c, d = 1.0, 3.5, 3.0, 4.0
+    B, D = np.array([a, 0.0]), np.array([d, 0.0])
+    side = None
+    for s in (1, -1):  # the circle point C on side s of B -> D, and its det sign
+        e = (D - B) / np.linalg.norm(D - B)
+        x = (b * b - c * c + (d - a) ** 2) / (2 * (d - a))
+        C = B + x * e + s * math.sqrt(b * b - x * x) * np.array([-e[1], e[0]])
+        phi, psi = math.atan2(*(C - B)[::-1]), math.atan2(*(C - D)[::-1])
+        if math.sin(psi - phi) > 0:
+            side = s
+    case = _bar4("guessless_0deg", "four-bar 1 : 3.5 : 3 : 4 from 0 deg without a guess (reference: "
+                 "kincas's default mode; another tool's own default counts as a branch jump)",
+                 a, b, c, d, 36, start=0.0, turn=360.0, side=side)
+    return replace(case, guessless=True)
+
+
+def branch_cases() -> list[Case]:
+    """The cases of issue [9], each with an independent closed form (`steps`)."""
+    a, d = 2.0, 4.0
+    anti = finish(Case(
+        "antiparallelogram_30deg", "antiparallelogram 2 : 4 : 2 : 4 in 30 deg steps across 180 and 360 deg",
+        {"O": (0.0, 0.0), "D": (d, 0.0)}, ("O", "A", a),
+        (("coupler", ("A", "C"), (d,)), ("rocker", ("D", "C"), (a,))),
+        steps=(("cross", "C", "A", "D", d, 0.0),), theta=_every(30.0, 720.0, 5.0), outputs=("A", "C")))
+    s = 1e-6  # a deltoid (crank = ground 1, coupler = rocker 2) 1e-6 m in size, five poses
+    kite = _bar4("kite_1e-6", "kite (deltoid) 1 : 2 : 2 : 1 at 1e-6 m, five poses 70 deg apart",
+                 1 * s, 2 * s, 2 * s, 1 * s, 5, start=20.0, turn=350.0, side=1)
+    limit = _bar4("limit_1e-6", "triple rocker at 1e-6 m swept 100-169 deg through its limit (151.2 deg)",
+                  1 * s, 1.9 * s, 3 * s, 4 * s, 24, start=100.0, turn=72.0)
+    para = finish(Case(
+        "parallelogram_at_180", "parallelogram 1 : 4 : 1 : 4, a pose exactly at 180 deg",
+        {"O": (0.0, 0.0), "D": (4.0, 0.0)}, ("O", "A", 1.0),
+        (("coupler", ("A", "B"), (4.0,)), ("rocker", ("D", "B"), (1.0,))),
+        steps=(("translate", "B", "A", 4.0, 0.0),), theta=np.radians([150.0, 165.0, 180.0, 195.0, 210.0]),
+        outputs=("A", "B")))
+    gap = _bar4("triple_rocker_gap", "triple rocker 140-220 deg: 57 of 81 poses with no assembly "
+                "(the time per pose is mostly deciding 'no assembly')", 1.0, 1.9, 3.0, 4.0, 81,
+                start=140.0, turn=81.0)
+    return [_slider_1e7(16.0), _slider_1e7(30.0), anti, kite, limit, _nfourbar(2), _nfourbar(40),
+            _six_bar("watt2", -1), _six_bar("stephenson3", 1), para, _guessless_fourbar(), gap]
 
 
 # --- growth: N parallelogram four-bars chained through shared links ---
@@ -232,7 +347,7 @@ def to_kincas(case: Case):
     slides = [Slide(p, "ground", through=case.ground[t], angle=ang, name=f"slide_{p}")
               for p, t, ang in case.slides]
     return kincas.Mechanism(ground=case.ground, links=links, slides=slides,
-                            inputs=[Input.angle("crank")], guess=case.guess)
+                            inputs=[Input.angle("crank")], guess={} if case.guessless else case.guess)
 
 
 def kincas_report(case: Case) -> list[str]:

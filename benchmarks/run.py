@@ -2,6 +2,7 @@
 
     python benchmarks/run.py            # the full run (under 10 minutes on 2 cores)
     python benchmarks/run.py --quick    # a smoke run (well under a minute once peers are installed)
+    python benchmarks/run.py --only stability   # one section alone, its tables printed
 
 Installs the peers of benchmarks/requirements.txt with pip first (`--no-install` skips that; a
 peer that fails to install or import is reported, not dropped), runs the four studies of
@@ -123,15 +124,18 @@ def stability_tools():
 
 
 def study_stability(cfg, log) -> dict:
-    """Section 3: the stiff and extreme cases through each tool."""
+    """Section 3: the stiff and extreme cases of issue [2] and the branch, singular-position
+    and gap cases of issue [9] through each tool, each against its closed form (mpmath, 30
+    digits) and scored against every other assembly of the chain (a branch jump)."""
     import cases
-    from peers.closed_form import reference
+    from peers.closed_form import reference, solve_numpy
     from peers.measure import classify, time_tool
 
     out = {}
-    for case in cases.stiff_cases(cfg["n_stiff"]):
+    for case in cases.stiff_cases(cfg["n_stiff"]) + cases.branch_cases():
         P, _ = reference(case)
-        others = [reference(case, steps=alt)[0] for alt in cases.alternatives(case)]
+        # the other assemblies in float64: a pose matches one within 1e-6 L or not at all
+        others = [solve_numpy(case, steps=alt)[0] for alt in cases.alternatives(case)]
         res = out[case.name] = {"case": case}
         for lb, prep, mod in stability_tools():
             why = mod and (mod.available() or mod.supports(case))
@@ -228,8 +232,12 @@ def main(argv=None) -> int:
     ap.add_argument("--no-install", action="store_true", help="do not pip-install missing peers")
     ap.add_argument("--out", default=str(HERE), help="folder for RESULTS.md and the PNGs")
     ap.add_argument("--no-others", action="store_true", help="skip the other bench_*.py scripts")
+    ap.add_argument("--only", choices=("stability", "growth"),
+                    help="run this section alone and print its tables (RESULTS.md is not written)")
     args = ap.parse_args(argv)
     cfg = CONFIG["quick" if args.quick else "full"]
+    if args.only:
+        return run_only(args, cfg)
     # fresh compiled-code cache: setup times then include compiling, not loading old builds
     os.environ["KINCAS_CACHE"] = tempfile.mkdtemp(prefix="kincas-bench-")
     os.environ.setdefault("MPLBACKEND", "Agg")
@@ -253,6 +261,22 @@ def main(argv=None) -> int:
     write_report(out, quick=args.quick, cfg=cfg, installs=installs, machine=machine(), api=api, main=main_res,
                  stability=stab, growth=growth, others=others, seconds=time.perf_counter() - t_start)
     log(f"wrote {out / 'RESULTS.md'} in {time.perf_counter() - t_start:.0f} s")
+    return 0
+
+
+def run_only(args, cfg) -> int:
+    """One section, its tables printed as markdown (the peers installed as for a full run)."""
+    os.environ["KINCAS_CACHE"] = tempfile.mkdtemp(prefix="kincas-bench-")
+    log = lambda s: print(s, file=sys.stderr, flush=True)
+    t0 = time.perf_counter()
+    install_requirements(args.no_install)
+    from peers import report
+    if args.only == "stability":
+        lines = report.stability_tables(study_stability(cfg, log))
+    else:
+        lines = report.growth_table(study_growth(cfg, log))
+    print("\n".join(lines))
+    log(f"{args.only}: {time.perf_counter() - t0:.0f} s")
     return 0
 
 

@@ -128,3 +128,52 @@ def test_doctests_of_the_harness(module):
         pytest.skip(f"{module}: its peer is not installed")
     result = doctest.testmod(mod)
     assert result.failed == 0 and result.attempted > 0
+
+
+# --- the cases of issue [9] (stability section) ---
+
+BRANCH = {c.name: c for c in cases.branch_cases()}
+
+
+@pytest.mark.parametrize("name", sorted(BRANCH))
+def test_issue9_cases_keep_every_length_where_they_assemble(name):
+    case = BRANCH[name]
+    P, _ = reference(case)
+    ok = np.all([np.isfinite(P[p]).all(axis=1) for p in case.moving], axis=0)
+    assert ok.sum() >= 5
+    assert constraint_violation(case, {k: v[ok] for k, v in P.items()}) < 1e-14
+    # every alternative assembly keeps them too (where it assembles)
+    for steps in cases.alternatives(case)[:8]:
+        Q, _ = solve_numpy(case, steps=steps)
+        fine = np.all([np.isfinite(Q[p]).all(axis=1) for p in case.moving], axis=0)
+        if fine.any():
+            assert constraint_violation(case, {k: v[fine] for k, v in Q.items()}) < 1e-12
+
+
+@pytest.mark.parametrize("name", ["antiparallelogram_30deg", "watt2_gaps", "stephenson3_gaps"])
+def test_issue9_velocities_match_central_differences(name):
+    case, h = BRANCH[name], 1e-6
+    Pp, _ = reference(case.with_theta(case.theta + h))
+    Pm, _ = reference(case.with_theta(case.theta - h))
+    _, V = reference(case)
+    for p in case.moving:
+        fd = (Pp[p] - Pm[p]) / (2 * h) * case.omega
+        fine = np.isfinite(fd).all(axis=1) & np.isfinite(V[p]).all(axis=1)
+        assert fine.sum() >= 5
+        assert np.abs(fd[fine] - V[p][fine]).max() < 1e-6 * case.size * case.omega
+
+
+def test_antiparallelogram_is_the_crossed_coupler():
+    # the parallelogram point B + (d, 0) reflected across the line B -> D, written here again
+    case = BRANCH["antiparallelogram_30deg"]
+    P, _ = reference(case)
+    B, D = P["A"], np.array([4.0, 0.0])
+    e = (D - B) / np.linalg.norm(D - B, axis=1)[:, None]
+    w = np.array([4.0, 0.0])
+    C = B + 2 * (w * e).sum(1)[:, None] * e - w
+    assert np.abs(P["C"] - C).max() < 1e-14 * case.size
+    assert np.abs(P["C"] - (B + w)).max() > 1.0  # not the parallelogram
+    # one of the two alternatives is the parallelogram at each pose
+    alts = [solve_numpy(case, steps=s)[0]["C"] for s in cases.alternatives(case)]
+    near = np.min([np.linalg.norm(a - (B + w), axis=1) for a in alts], axis=0)
+    assert near.max() < 1e-12 * case.size

@@ -8,7 +8,10 @@ points already placed:
   distance equations (P - A1).(V - V1) = 0, (P - A2).(V - V2) = 0 by Cramer's rule;
 - "rrp" (P, A, r, T, angle, side): P = T + s u on a ground line with |P - A| = r, the larger s
   for side +1; s' = (P - A).V_A / ((P - A).u);
-- "translate" (P, A, dx, dy): P = A + (dx, dy), V = V_A (a parallelogram's coupler).
+- "translate" (P, A, dx, dy): P = A + (dx, dy), V = V_A (a parallelogram's coupler);
+- "cross" (P, A1, A2, dx, dy): A1 + (dx, dy) reflected across the line A1 -> A2 (an
+  antiparallelogram's crossed coupler, whose side of A1 -> A2 changes at every change point);
+  its velocity by Cramer's rule as for "rrr" (both distances are kept by the reflection).
 Where a point cannot be placed (no real intersection) its values are NaN.
 
 The same code runs on numpy arrays (all poses at once) and on mpmath numbers (one pose at a
@@ -55,16 +58,22 @@ def chain(case, theta, omega, M):
     V[a] = (-omega * r * s, omega * r * c)
     for step in case.steps:
         kind, p = step[0], step[1]
-        if kind in ("rrr", "tri"):
-            _, _, a1, a2, r1, r2, side = step
-            (x1, y1), (x2, y2) = P[a1], P[a2]
+        if kind in ("rrr", "tri", "cross"):
+            (x1, y1), (x2, y2) = P[step[2]], P[step[3]]
+            a1, a2 = step[2], step[3]
             dx, dy = x2 - x1, y2 - y1
             d2 = dx * dx + dy * dy
             d = M.sqrt(d2)
-            along = (d2 + r1 * r1 - r2 * r2) / (2 * d)
-            h = M.sqrt(r1 * r1 - along * along)
             ex, ey = dx / d, dy / d
-            px, py = x1 + along * ex - side * h * ey, y1 + along * ey + side * h * ex
+            if kind == "cross":  # w = (wx, wy) reflected across e: 2 (w.e) e - w
+                wx, wy = step[4], step[5]
+                wd = wx * ex + wy * ey
+                px, py = x1 + 2 * wd * ex - wx, y1 + 2 * wd * ey - wy
+            else:
+                _, _, _, _, r1, r2, side = step
+                along = (d2 + r1 * r1 - r2 * r2) / (2 * d)
+                h = M.sqrt(r1 * r1 - along * along)
+                px, py = x1 + along * ex - side * h * ey, y1 + along * ey + side * h * ex
             ax, ay, bx, by = px - x1, py - y1, px - x2, py - y2
             ra = ax * V[a1][0] + ay * V[a1][1]
             rb = bx * V[a2][0] + by * V[a2][1]

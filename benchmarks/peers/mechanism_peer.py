@@ -35,6 +35,8 @@ def available():
 
 def supports(case):
     o = case.crank[0]
+    if case.guessless:
+        return "needs a starting angle for every vector (the case gives none)"
     return None if tuple(case.ground[o]) == (0.0, 0.0) else "the origin must be the crank's pivot"
 
 

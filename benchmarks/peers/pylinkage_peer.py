@@ -68,8 +68,8 @@ def build(case):
     anchor = lambda p: comp[p]
     for st in case.steps:
         kind, p = st[0], st[1]
-        hint = case.guess[p]
-        if kind == "translate":  # a parallelogram's point: a circle-circle dyad like any other
+        hint = (None, None) if case.guessless else case.guess[p]
+        if kind in ("translate", "cross"):  # a four-bar's point: a circle-circle dyad like any other
             a = st[2]
             g = next(q for _, pts, _ in case.links if p in pts for q in pts if q != p and q != a)
             st = ("rrr", p, a, g, _distance(case, a, p), _distance(case, g, p), 0)

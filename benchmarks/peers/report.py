@@ -176,17 +176,18 @@ def stability_tables(stab: dict) -> list[str]:
     for name, res in stab.items():
         case = res["case"]
         out += [f"### {case.title} ({name}: {len(case.theta)} poses)", "",
-                "| tool | solved / assemblable | correct | branch jumps | wrong | missed | false | worst error / L (correct poses) |",
-                "|---|---|---|---|---|---|---|---|"]
+                "| tool | solved / assemblable | correct | branch jumps | wrong | missed | false | "
+                "worst error / L (correct poses) | µs/pose |",
+                "|---|---|---|---|---|---|---|---|---|"]
         for lb, r in res.items():
             if lb == "case":
                 continue
             if "why" in r or r["c"] is None:
-                out.append(f"| {lb} | not run: {r.get('why') or r['t'].error} | | | | | | |")
+                out.append(f"| {lb} | not run: {r.get('why') or r['t'].error} | | | | | | | |")
                 continue
             c = r["c"]
             out.append(f"| {lb} | {c['claimed']} / {c['assemble']} | {c['correct']} | {c['jumps']} | {c['wrong']} "
-                       f"| {c['missed']} | {c['false']} | {fmt_e(c['worst'])} |")
+                       f"| {c['missed']} | {c['false']} | {fmt_e(c['worst'])} | {fmt_t(r['t'].median)} |")
         out.append("")
     return out
 

@@ -7,7 +7,8 @@ term from how the tangent changed since the pose before, then corrected by Newto
 q <- q - g_q^-1 g, until the next step would be negligible (on a dense sweep the prediction
 usually is already). A pose is *accepted* only when it is verified in the same pass:
 
-- residual: max |g| / L <= RESIDUAL (the careful path's acceptance);
+- residual: max |g| / L <= RESIDUAL (the careful path's acceptance), each equation against
+  its own Assur group's length L (`Structure.block_lengths`), as on the careful path;
 - converged: the Newton step that would follow, |g_q^-1 g| (radians, lengths / L) <= STEP;
 - same branch: M = J_prev^-1 J with J = g_q. If ||D^-1 (M - I) D|| < 1 (D scales lengths by
   L), every matrix on the segment from I to M is invertible, so det M > 0: det g_q kept its
@@ -91,7 +92,7 @@ class FastRun:
         self.thr = np.array([RESIDUAL, STEP, JAC_CHANGE, CORRECTION, NEAR])
         self.first_bad, self._s = 0, None
 
-    residual = property(lambda self: self.info[0], doc="max |g| / L at each pose")
+    residual = property(lambda self: self.info[0], doc="max |g| / L at each pose (L: each group's)")
     step = property(lambda self: self.info[1], doc="the last Newton step (negligible, applied)")
     jac_change = property(lambda self: self.info[2], doc="max per group of sum |D^-1 (A_prev^-1 A - I) D|")
     correction = property(lambda self: self.info[3], doc="||D^-1 (q - q_pred)||_1")
@@ -178,7 +179,8 @@ class FastSweeper:
         if self._functions is None:
             with self._lock:
                 if self._functions is None:
-                    self._functions = kernel_functions(self.sym, self.blocks, self.report)
+                    self._functions = kernel_functions(self.sym, self.blocks, self.report,
+                                                       self.model.structure)
         return self._functions
 
     def _library(self) -> Library:
@@ -333,9 +335,10 @@ class FastSweeper:
                 x = [ca.MX.sym(f"x{i}", *kS.size_in(i)) for i in range(6)]
                 U, Ud, Udd = (ca.MX.sym(c, nu, CHUNK) for c in ("U", "Ud", "Udd"))
                 p, L, t = ca.MX.sym("p", kS.size1_in(7)), ca.MX.sym("L"), ca.MX.sym("t", 5)
+                Lb = self.functions[3](U[:, 0], p)  # the groups' lengths, as the C loop takes them
                 rep = lambda a: ca.repmat(a, 1, CHUNK)
                 self._vmF = ca.Function("chunk", [*x, U, p, L, t, Ud, Udd],
-                                        acc(*x, U, rep(p), rep(L), rep(t), Ud, Udd))
+                                        acc(*x, U, rep(p), rep(L), rep(t), Ud, Udd, rep(Lb)))
         return self._vmF
 
     def _vm_buffers(self):

@@ -190,24 +190,26 @@ class JaxDesigns:
     def _build(self):
         jax, _ = _jax()
         jnp, lax = jax.numpy, jax.lax
-        kP, kN, kF = (to_jax(f) for f in self.sweeper.functions)
+        kP, kN, kF, kL = (to_jax(f) for f in self.sweeper.functions)
         nq, nu, nj, max_evals = self.nq, self.nu, self.nj, self.sweeper.max_evals
         cuts = np.cumsum([nq, nj, nq * nu, nu, nq * nu]).tolist()
 
         def design(s0, p, L, signs0, U, Ud, Udd, thr):
+            (Lb,) = kL(U[0], p)  # each group's length, at the first pose as the C loop has it
+
             def pose(carry, x):
                 s, alive = carry
                 u, ud, udd = x
 
                 def newton(c):  # Newton until the step just applied makes the next negligible
                     q, it, _ = c
-                    dq, rs = kN(q, u, p, L)
+                    dq, rs = kN(q, u, p, Lb)
                     return q - dq, it + 1, rs[1] <= thr[4]
                 q0, J0, T0, u0, T1, u1 = jnp.split(s, cuts)
                 (qp,) = kP(q0, T0, u0, u, T1, u1)
                 q, it, _ = lax.while_loop(lambda c: ~c[2] & (c[1] < max_evals), newton,
                                           (qp, jnp.int64(0), jnp.bool_(False)))
-                J, T, rf, mc, meas, y, dq = kF(q, u, p, L, ud, udd, J0, qp)
+                J, T, rf, mc, meas, y, dq = kF(q, u, p, L, ud, udd, J0, qp, Lb)
                 conv = (rf[0] <= thr[0]) & (rf[1] <= thr[1])  # the next step negligible: applied
                 q = jnp.where(conv, q - dq, q)
                 ok = (alive & conv & (mc[0] <= thr[2]) & (mc[1] <= thr[3])

@@ -5,11 +5,14 @@ so their size grows with the number of groups, not with nq^3:
 
 - kP: the prediction from the last solved pose (tangent, second-order term);
 - kN: at q, the Newton step g_q^-1 g and the measures that stop Newton (max |g| / L and the
-  step's size in radians or lengths / L): nothing else is evaluated at a Newton iterate;
+  step's size in radians or lengths / L, each equation and unknown against its own Assur
+  group's length L, as on the careful path): nothing else is evaluated at a Newton iterate;
 - kF: once per pose, at the final q: g_q, the tangent dq/du, the residual, the branch test
   against the last pose (Jacobian change per group, size of the correction), the singular
   measures (the sign of each group's det and a lower bound of its smallest singular value,
-  columns scaled to O(1)) and the reported quantities, sharing one set of sines and cosines.
+  columns scaled to O(1)) and the reported quantities, sharing one set of sines and cosines;
+- kL: each group's length (`Structure.length_function`), once per call of the C loop, so a
+  far point elsewhere in the drawing loosens no group's tests.
 
 One stopping rule: a pose is converged when the Newton step that would follow is below STEP
 (radians, or lengths / L) and the residual below RESIDUAL; that last step is applied, so a
@@ -23,6 +26,7 @@ from __future__ import annotations
 
 import casadi as ca
 
+from .structure import Structure
 from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size
 from .tolerances import ACCEPT, TOL
 
@@ -39,8 +43,10 @@ NEAR = 1e-8  # kN's step below which the next is negligible where convergence is
 # --- the casadi functions ---
 
 
-def kernel_functions(sym, blocks, report=()) -> list[ca.Function]:
-    """[kP, kN, kF] (see the module text), outputs dense so that C can index them.
+def kernel_functions(sym, blocks, report=(), structure=None) -> list[ca.Function]:
+    """[kP, kN, kF, kL] (see the module text), outputs dense so that C can index them.
+    `structure` (the `Structure` whose blocks these are, built from `sym` if not given)
+    gives the groups' lengths.
 
     The prediction is of second order: with the tangents T0 at the last pose (input u0) and
     T1 at the one before (u1), dT = T0 - T1 ~ H[u0 - u1, .] for the second derivative H of
@@ -55,12 +61,14 @@ def kernel_functions(sym, blocks, report=()) -> list[ca.Function]:
     lam = ca.if_else(ca.dot(dup, dup) > 0, ca.dot(du, dup) / ca.dot(dup, dup), 0)
     pred = q + ca.mtimes(T0, du) + 0.5 * lam * ca.mtimes(T0 - T1, du)
     p, L, ud, udd = ca.SX.sym("p", sym.np), ca.SX.sym("L"), ca.SX.sym("ud", nu), ca.SX.sym("udd", nu)
+    Lb = ca.SX.sym("Lb", len(blocks))  # each group's length
     is_length = ca.DM(sym.is_length.astype(float))
-    D = ca.if_else(is_length, L, 1)  # the scale of each unknown
+    Lq, Lg = _group_scales(Lb, blocks, sym.nq, sym.ng)
+    D = ca.if_else(is_length, Lq, 1)  # the scale of each unknown: its group's length or 1
     cs = ca.if_else(is_length, 1, 1 / L)  # g_q's columns to O(1): 1 (lengths), 1/L (angles)
     g, Jq, Ju = ca.Function("G", [sym.q, sym.u, sym.p], [sym.g, sym.Jq, sym.Ju])(q, u, p)
     step = solve(Jq, g)
-    rs = ca.vertcat(_max_abs(g) / L, _max_abs(step / D))
+    rs = ca.vertcat(_max_abs(g / Lg), _max_abs(step / D))
     T = -solve(Jq, Ju)
     change = block_change(J0, Jq, D, blocks)
     signs, sigma = block_measures(Jq, cs, blocks)
@@ -70,11 +78,24 @@ def kernel_functions(sym, blocks, report=()) -> list[ca.Function]:
     else:
         y = ca.SX(0, 1)
     d, o = ca.densify, {"cse": True}  # cse: one sin and cos per angle, shared by everything
+    kL = (structure or Structure(sym)).length_function()
     return [ca.Function("kP", [q, T0, u0, u, T1, u1], [d(pred)], o),
-            ca.Function("kN", [q, u, p, L], [d(step), rs], o),
-            ca.Function("kF", [q, u, p, L, ud, udd, J0, qp],
+            ca.Function("kN", [q, u, p, Lb], [d(step), rs], o),
+            ca.Function("kF", [q, u, p, L, ud, udd, J0, qp, Lb],
                         [diagonal_blocks(Jq, blocks), d(T), rs, ca.vertcat(change, ca.norm_1((q - qp) / D)),
-                         ca.vertcat(signs, sigma), y, d(step)], o)]
+                         ca.vertcat(signs, sigma), y, d(step)], o),
+            kL]
+
+
+def _group_scales(Lb, blocks, nq, ng):
+    """(per unknown, per equation) the length of the group it belongs to."""
+    Lq, Lg = [ca.SX(1)] * nq, [ca.SX(1)] * ng
+    for i, b in enumerate(blocks):
+        for j in b.cols:
+            Lq[int(j)] = Lb[i]
+        for r in b.rows:
+            Lg[int(r)] = Lb[i]
+    return ca.vertcat(*Lq) if nq else ca.SX(0, 1), ca.vertcat(*Lg) if ng else ca.SX(0, 1)
 
 
 def _max_abs(v):
@@ -91,30 +112,33 @@ def state_function(sym, blocks) -> ca.Function:
                        {"cse": True})
 
 
-def vm_step(kP, kN, kF, nq, nu, max_evals) -> ca.Function:
+def vm_step(kP, kN, kF, kL, nq, nu, max_evals) -> ca.Function:
     """One pose for the virtual machine, the compiled loop's arithmetic with a fixed number
     of kN evaluations: once a step is below NEAR, q stays put, so it ends where the loop stops.
-    info = (residual, next step, Jacobian change, correction, kN steps, converged)."""
+    info = (residual, next step, Jacobian change, correction, kN steps, converged). The
+    groups' lengths Lb are an input, computed once per sweep as the compiled loop does."""
     q0, J0, T0, u0 = ca.SX.sym("q0", nq), ca.SX.sym("J0", kF.size1_in(6)), ca.SX.sym("T0", nq, nu), ca.SX.sym("u0", nu)
     u, p, L, thr = ca.SX.sym("u", nu), ca.SX.sym("p", kN.size1_in(2)), ca.SX.sym("L"), ca.SX.sym("t", 5)
+    Lb = ca.SX.sym("Lb", kL.size1_out(0))
     ud, udd, T1, u1 = ca.SX.sym("ud", nu), ca.SX.sym("udd", nu), ca.SX.sym("T1", nq, nu), ca.SX.sym("u1", nu)
     q = qp = kP(q0, T0, u0, u, T1, u1)
     done, evals = ca.SX(0), ca.SX(0)
     for _ in range(max_evals):
-        dq, rs = kN(q, u, p, L)
+        dq, rs = kN(q, u, p, Lb)
         evals += 1 - done
         q = ca.if_else(done, q, q - dq)
         done = ca.logic_or(done, rs[1] <= thr[4])
-    J, T, rs, mc, meas, y, dq = kF(q, u, p, L, ud, udd, J0, qp)
+    J, T, rs, mc, meas, y, dq = kF(q, u, p, L, ud, udd, J0, qp, Lb)
     conv = ca.logic_and(rs[0] <= thr[0], rs[1] <= thr[1])
     q = ca.if_else(conv, q - dq, q)
     info = ca.vertcat(rs, mc, evals, conv)
-    return ca.Function("kS", [q0, J0, T0, u0, T1, u1, u, p, L, thr, ud, udd],
+    return ca.Function("kS", [q0, J0, T0, u0, T1, u1, u, p, L, thr, ud, udd, Lb],
                        [q, J, T, u, T0, u0, info, y, meas])
 
 
-# --- the C loop around them (NQ, NU, NO, NM, NJ: sizes; state s = q, g_q's diagonal blocks,
-# T = dq/du, u at the last pose, then T and u at the one before; matrices column-major) ---
+# --- the C loop around them (NQ, NU, NO, NM, NJ: sizes, NM - 1 groups; state s = q, g_q's
+# diagonal blocks, T = dq/du, u at the last pose, then T and u at the one before; matrices
+# column-major; L the whole mechanism's length, for the singular measures' column scale) ---
 
 SWEEP_C = """
 int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const casadi_real* L,
@@ -123,7 +147,12 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
                  const casadi_real* Udd, casadi_int sudd, casadi_real* vals, casadi_real* meas) {
   const casadi_real* arg[SZ_ARG]; casadi_real* res[SZ_RES]; casadi_int iw[SZ_IW]; casadi_real w[SZ_W];
   casadi_real qp[NQ], q[NQ], dq[NQ], J[NJ > 0 ? NJ : 1], T[NQ*NU], rs[2], rf[2], mc[2], ms[NM], y[NO > 0 ? NO : 1];
+  casadi_real Lb[NM > 1 ? NM - 1 : 1];  /* each group's length, from the parameters */
   casadi_int k, i, it;
+  if (n > 0) {
+    arg[0] = U; arg[1] = p; res[0] = Lb;
+    if (kL(arg, res, iw, w, 0)) return 0;
+  }
   for (k = 0; k < n; ++k) {
     const casadi_real* u = U + k*NU;
     int conv = 0;
@@ -132,13 +161,13 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     if (kP(arg, res, iw, w, 0)) break;
     for (i = 0; i < NQ; ++i) q[i] = qp[i];
     for (it = 1; ; ++it) {  /* Newton until the step just applied makes the next negligible */
-      arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = L; res[0] = dq; res[1] = rs;
+      arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = Lb; res[0] = dq; res[1] = rs;
       if (kN(arg, res, iw, w, 0)) break;
       for (i = 0; i < NQ; ++i) q[i] -= dq[i];
       if (rs[1] <= thr[4] || it >= max_evals) break;
     }
     arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = L; arg[4] = Ud + k*sud; arg[5] = Udd + k*sudd;
-    arg[6] = s + NQ; arg[7] = qp;
+    arg[6] = s + NQ; arg[7] = qp; arg[8] = Lb;
     res[0] = J; res[1] = T; res[2] = rf; res[3] = mc; res[4] = ms; res[5] = y; res[6] = dq;
     if (kF(arg, res, iw, w, 0)) break;
     conv = rf[0] <= thr[0] && rf[1] <= thr[1];  /* the next step is negligible: apply it */

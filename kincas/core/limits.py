@@ -27,6 +27,8 @@ import casadi as ca
 import numpy as np
 
 from .assembly import blocks
+from .newton import newton
+from .tolerances import MAX_ITER
 
 
 # --- scaled Jacobians ---
@@ -75,52 +77,75 @@ def _extended(model):
     return model.memo("singular.extended", build)
 
 
-def locate_singular(model, q, u, p, L, direction, max_iter: int = 40, group: int | None = None,
+def locate_singular(model, q, u, p, L, direction, max_iter: int = MAX_ITER, group: int | None = None,
                     probe: bool = False):
     """Newton on the extended system from a pose near a singular position, moving the
     inputs along u + s * direction. Returns (q*, u*, s*) there, or None.
 
-    `group` (an index into the Assur groups, kincas/core/assembly.py) locates where that
-    group alone is singular: g = 0, g_q[rows, cols] v = 0 with v nonzero only on the group's
-    unknowns. The residual is measured scale-free: g over the size, g_q v as the pure number
-    it is (v is the null direction of the column-scaled block, in unscaled unknowns).
-    `probe`: return s after max_iter steps, converged or not (a cheap estimate of where)."""
+    The one Newton of kincas (kincas/core/newton.py) with its stopping rule and thresholds
+    (kincas/core/tolerances.py), in the unknowns (q, s, v): q scaled per group as every
+    solve scales it (angles as they are, lengths over their group's length), s in the
+    input's unit (radians, or lengths over L), v as the null direction of the
+    column-scaled g_q it is. Residuals: g over its group's length, g_q v and v0 . v - 1 as
+    the pure numbers they are.
+
+    Parameters
+    ----------
+    model : kincas.core.numeric.Model
+    q, u, p : numpy.ndarray
+        A solved pose near the singular position, and the parameter values.
+    L : float
+        The mechanism's size (the scale of the column-scaled Jacobians).
+    direction : array_like
+        The inputs move along u + s * direction.
+    max_iter : int
+        Newton iterations at most.
+    group : int, optional
+        An index into the Assur groups (kincas/core/assembly.py): locate where that group
+        alone is singular (g = 0, g_q[rows, cols] v = 0 with v nonzero only on the group's
+        unknowns).
+    probe : bool
+        Return s after `max_iter` iterations, converged or not (a cheap estimate of where).
+
+    Returns
+    -------
+    tuple or float or None
+        (q*, u*, s*); s with `probe`; None where Newton does not converge.
+
+    Examples
+    --------
+    See the module's example: the rocker limit of a crank-rocker, to rounding.
+    """
     nq, ng = model.nq, model.ng
     if nq == 0:
         return None
     f = _extended(model)
     rows, cols = (np.arange(ng), np.arange(nq)) if group is None else blocks(model)[group]
     J, _ = scaled_jacobians(model, q, u, p, L)
-    cq, _ = _scales(model, L)
+    cq, cu = _scales(model, L)
     v = np.zeros(nq)
     v[cols] = np.linalg.svd(J[np.ix_(rows, cols)])[2][-1] * cq[cols]  # null direction, unscaled
     v0 = v / (v @ v)
     d = np.asarray(direction, float)
     sel = np.r_[np.arange(ng), ng + rows, 2 * ng]  # g, the group's rows of g_q v, v0.v - 1
-    q, u0, s = np.array(q, float), np.array(u, float), 0.0
+    u0 = np.array(u, float)
+    eq, qs = model.scales(u0, p)
+    # s moves the inputs by s d: its unit is the step that moves them by one radian, or by L
+    s_unit = 1.0 / max(np.abs(d * cu * L).max(initial=0.0), 1e-300)
+    step_scale = np.r_[qs, s_unit, cq[cols]]
+    res_scale = np.r_[eq, np.ones(len(rows) + 1)]
 
-    def residual(F):
-        return np.abs(F[:ng]).max() / L, np.abs(F[ng + rows]).max(initial=0.0) + abs(F[-1])
+    def F(x):
+        vv = v.copy()
+        vv[cols] = x[nq + 1:]
+        Fx, JF = f(x[:nq], u0 + x[nq] * d, p, vv, v0)
+        A = np.hstack([JF[:, :nq], JF[:, nq:-nq] @ d[:, None], JF[:, -nq:][:, cols]])
+        return Fx.ravel()[sel], A[sel]
 
-    for _ in range(max_iter):
-        F, JF = (np.asarray(a) for a in f(q, u0 + s * d, p, v, v0))
-        F = F.ravel()
-        rg, rv = residual(F)
-        if rg < 1e-14 and rv < 1e-13:
-            break
-        A = np.hstack([JF[:, :nq], JF[:, nq:-nq] @ d[:, None], JF[:, -nq:][:, cols]])[sel]
-        try:  # Gauss-Newton where g_q is tall (redundant joints: a consistent system)
-            step = np.linalg.solve(A, -F[sel]) if A.shape[0] == A.shape[1] else np.linalg.lstsq(A, -F[sel], rcond=None)[0]
-        except np.linalg.LinAlgError:
-            return None
-        if not np.all(np.isfinite(step)):
-            return None
-        q, s = q + step[:nq], s + step[nq]
-        v[cols] += step[nq + 1:]
+    res = newton(F, np.r_[np.asarray(q, float), 0.0, v[cols]], step_scale, res_scale, max_iter=max_iter)
+    qx, s = res.x[:nq], float(res.x[nq])
     if probe:
-        return s
-    F = np.asarray(f(q, u0 + s * d, p, v, v0)[0]).ravel()
-    rg, rv = residual(F)
-    if rg > 1e-11 or rv > 1e-8:
+        return s if np.isfinite(s) else None
+    if not res.ok or not np.all(np.isfinite(res.x)):
         return None
-    return q, u0 + s * d, s
+    return qx, u0 + s * d, s

@@ -6,9 +6,13 @@ converges quadratically where the residual at the solution is zero and J has ful
 rank) or wide (an assembly with free inputs: the minimum-norm step). Steps are computed in
 scaled unknowns z = x / step_scale (angles as they are, lengths over their group's length),
 limited to `MAX_STEP` per coordinate (a trust region that keeps a step on its branch) and
-backtracked until the residual max |F / res_scale| decreases. It stops at `TOL`, or when no
-step makes progress (a non-solution, or rounding level), and a result counts as solved
-below `ACCEPT` (kincas/core/tolerances.py).
+backtracked until the residual max |F / res_scale| decreases. It stops by the compiled
+kernel's rule (kincas/core/kernel.py): converged when the residual is below `ACCEPT` and
+the next step below `TOL` (scaled), and that negligible step is applied, so the careful and
+the fast paths both end at rounding. It also stops when the residual is below `TOL` but the
+step is not negligible (g_q nearly singular: the step would be magnified rounding), or when
+no step makes progress (a non-solution); a result counts as solved below `ACCEPT`
+(kincas/core/tolerances.py).
 
 >>> import numpy as np
 >>> F = lambda x: (np.array([x[0] ** 2 - 2.0]), np.array([[2 * x[0]]]))
@@ -66,6 +70,12 @@ def newton(F, x, step_scale, res_scale, *, tol: float = TOL, accept: float = ACC
         Per unknown, the unit of a step (1 for an angle, a length for a length).
     res_scale : numpy.ndarray
         Per equation, the length its residual is measured against.
+    tol : float
+        A next step (scaled) below this, at a residual below `accept`, is the last.
+    accept : float
+        The largest residual of a solved result.
+    max_iter, max_step : int, float
+        Iterations at most; the largest step per scaled coordinate.
 
     Returns
     -------
@@ -86,11 +96,18 @@ def newton(F, x, step_scale, res_scale, *, tol: float = TOL, accept: float = ACC
     g, J = F(x)
     r = _size(g, res_scale)
     for it in range(max_iter):
-        if r <= tol:
-            return NewtonResult(x, r, it, True, g, J)
-        dz = lsolve(J * step_scale, -g)
+        dz = lsolve(J * step_scale, -g) if r > 0 else np.zeros_like(x)
         if not np.all(np.isfinite(dz)):
             break
+        if r <= accept and np.abs(dz).max(initial=0.0) <= tol:
+            # the compiled kernel's rule (kincas/core/kernel.py): converged when the next
+            # step is negligible; apply it, so a solve ends where quadratic convergence puts
+            # it (rounding), not at the residual that passed the test
+            return NewtonResult(x + dz * step_scale, r, it + 1, True, g, J)
+        if r <= tol:
+            # the residual is at its target but the step is not negligible: g_q is (nearly)
+            # singular, so the step is rounding magnified; stay where the residual is
+            return NewtonResult(x, r, it, True, g, J)
         dx = dz * (step_scale / max(1.0, np.abs(dz).max() / max_step))  # the trust region
         t = 1.0
         while True:  # backtrack until the residual decreases

@@ -3,8 +3,9 @@
 `model_of(m)` (also `kincas.compile`, its first name) gives the `Model` of m's structure, built once and cached (parameter values are
 numeric inputs, so changing them does not rebuild it). Every CasADi call on a hot path goes
 through zero-copy numpy buffers (one set per thread). Newton solves the Assur groups of the
-structure one after another (kincas/core/structure.py), each aiming at a residual of `TOL`
-times its own group's length; a pose counts as solved below `ACCEPT`. Tolerances relative
+structure one after another (kincas/core/structure.py), each until its next step is below
+`TOL` (radians, or lengths over its own group's length), which it then applies, as the
+compiled kernel does; a pose counts as solved below `ACCEPT` times each group's length. Tolerances relative
 to each group make a mechanism of 1e-6 m and one of 1e6 m, or a small group beside a far
 point, reach the same relative accuracy.
 

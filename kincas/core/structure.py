@@ -124,6 +124,42 @@ class Structure:
             out[out == 0] = max(max(ext, default=0.0), math.hypot(*box)) or 1.0
         return out
 
+    def length_function(self):
+        """kL(u, p) -> each block's length, the same definition as `block_lengths` written
+        in casadi, so that a compiled kernel measures each group against its own length
+        without a call back to Python (it agrees with `block_lengths` to rounding)."""
+        import casadi as ca  # casadi is only needed by the kernels that ask for this
+
+        sym, m = self.sym, self.sym.mech
+        fmax = lambda xs, d=0.0: _reduce(ca.fmax, xs, d)
+        dist = lambda a, b: ca.sqrt((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2)
+        ext = []
+        for lk in m.links:
+            pts = [(sym.val(x), sym.val(y)) for _, (x, y) in lk.points]
+            ext.append(fmax([dist(a, b) for i, a in enumerate(pts) for b in pts[i + 1:]]))
+        gxy = [sym.points[g] for g, _ in m.ground]
+        out = []
+        for near, gidx in self._extent_links:
+            span = [dist(gxy[a], gxy[b]) for i, a in enumerate(gidx) for b in gidx[i + 1:]]
+            out.append(fmax(span + [ext[j] for j in near]))
+        if gxy:
+            box = [fmax([g[c] for g in gxy], -ca.inf) - _reduce(ca.fmin, [g[c] for g in gxy], ca.inf)
+                   for c in (0, 1)]
+            whole = fmax([fmax(ext), ca.sqrt(box[0] ** 2 + box[1] ** 2)])
+        else:
+            whole = fmax(ext)
+        whole = ca.if_else(whole == 0, 1.0, whole)
+        out = [ca.if_else(b == 0, whole, b) for b in out]
+        return ca.Function("kL", [sym.u, sym.p], [ca.densify(ca.vertcat(*out)) if out else ca.SX(0, 1)])
+
+
+def _reduce(f, xs, start):
+    """f(...f(f(start, x0), x1)..., xn): casadi's fmax / fmin over a list."""
+    out = start
+    for x in xs:
+        out = f(out, x)
+    return out
+
 
 def _solve_order(blocks, sp):
     """Blocks sorted so that each comes after every block whose unknowns its equations use

@@ -9,7 +9,7 @@ far point, reach the same relative accuracy.
 True
 """
 
-TOL = 1e-13  # Newton's target: max |g| of a group over that group's length
+TOL = 1e-13  # Newton stops when its next step (radians, lengths over the group's length) is below this
 ACCEPT = 1e-10  # a pose whose relative residual is above this is not solved
 MAX_STEP = 0.5  # largest Newton step per iteration: radians, or this times the group's length
 MAX_ITER = 40  # Newton iterations per group before giving up
