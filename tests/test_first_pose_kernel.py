@@ -100,7 +100,7 @@ def test_placement_is_kept_per_mechanism_and_inputs():
     assert pm.placement(model, np.array([0.3]), pm.guess) is not a
     other = fourbar((3.6, -2.9))  # another mechanism of the same structure: its own guess
     assert prepared(model, other) is not pm
-    q_other = prepared(model, other).placement(model, np.array([0.2]), prepared(model, other).guess)[0]
-    assert not np.allclose(q_other, a[0])
+    q_other = prepared(model, other).placement(model, np.array([0.2]), prepared(model, other).guess)
+    assert not np.allclose(q_other.q0, a.q0)
     with pytest.raises(ValueError):
-        a[0][0] = 1.0  # read-only: shared by threads
+        a.q0[0] = 1.0  # read-only: shared by threads

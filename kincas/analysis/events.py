@@ -73,8 +73,10 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma):
     events: list[dict] = []
     if model.nq == 0 or not m.inputs or n == 0:
         return events, at
-    signs = np.nan_to_num(np.asarray(signs, float)).astype(int)
     sigma = np.asarray(sigma, float)
+    if _nothing_met(ok, signs, sigma):
+        return events, at
+    signs = np.nan_to_num(np.asarray(signs, float)).astype(int)
     names = group_links(model)
     keys = [i.key for i in m.inputs]
     exact: dict = {}
@@ -146,6 +148,16 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma):
                 if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
                     event(kind_at(found[0], found[1]), k, found[1], int(i))
     return _distinct(events), at
+
+
+def _nothing_met(ok, signs, sigma) -> bool:
+    """Whether the sweep met no singular position and no gap: every pose solved, every
+    group well conditioned at every pose (none near NEAR or FLAG_SIGMA) and in one mode
+    throughout. The usual sweep: then none of the searches below has anything to look at."""
+    if not ok.all() or not (sigma > max(NEAR, 1e3 * FLAG_SIGMA)).all():
+        return False
+    signs = np.asarray(signs)
+    return bool((signs == signs[:1]).all())
 
 
 def _distinct(events):

@@ -18,9 +18,17 @@ from ..errors import ModelError
 from ..model.mechanism import Mechanism
 
 
-def input_table(m: Mechanism, inputs, what: str, default: float | None) -> np.ndarray:
-    """(N x nu) array of one value per input and pose from a mapping key -> scalar or array."""
-    keys = [i.key for i in m.inputs]
+def input_table(m: Mechanism, inputs, what: str, default: float | None, keys=None) -> np.ndarray:
+    """(N x nu) array of one value per input and pose from a mapping key -> scalar or array
+    (`keys`: the mechanism's input keys, if already at hand). Where every input has one
+    value, the table has one row (N = 1), whatever the number of poses."""
+    keys = [i.key for i in m.inputs] if keys is None else list(keys)
+    if inputs is None and default is not None:  # every input at its default: one row
+        return np.full((1, len(keys)), float(default))
+    if len(keys) == 1 and isinstance(inputs, Mapping) and len(inputs) == 1 and keys[0] in inputs:
+        c = np.asarray(inputs[keys[0]], dtype=float)  # the common case, one input: no copy
+        if c.ndim <= 1 and c.size and np.isfinite(c).all():
+            return c.reshape(-1, 1)
     if inputs is None:
         if default is None and keys:
             raise ModelError(f"{what}: give a value for each of {keys}")

@@ -18,7 +18,7 @@ and is guarded by a lock: nothing here is global, and threads share only immutab
 >>> pm = prepared(model, m)
 >>> pm is prepared(model, m), pm.size, pm.keys
 (True, 4.0, ('crank.angle',))
->>> q0, qs = pm.placement(model, np.array([0.0]), pm.guess)
+>>> q0 = pm.placement(model, np.array([0.0]), pm.guess).q0
 >>> bool(np.allclose(q0, model.initial_q(np.array([0.0]), pm.p, pm.guess, 4.0)))
 True
 """
@@ -29,7 +29,7 @@ from collections import OrderedDict
 
 import numpy as np
 
-from ..core.assembly import ambiguous, assemble
+from ..core.assembly import Placement, ambiguous, assemble
 from ..model.mechanism import Mechanism
 
 RECENT = 32  # mechanisms kept per structure
@@ -57,9 +57,9 @@ class Prepared:
         self._lock = threading.Lock()
 
     def placement(self, model, u: np.ndarray, guess: dict):
-        """(q0, qs): the first pose's unknowns placed at inputs u from `guess` (the guessed
-        points, as the careful path places them), and each unknown's scale within its own
-        group (`Model.scales`); None where the careful path must decide alone (gears, no
+        """A `Placement` (q0, qs): the first pose's unknowns placed at inputs u from `guess`
+        (the guessed points, as the careful path places them), and each unknown's scale within
+        its own group (`Model.scales`); None where the careful path must decide alone (gears, no
         assembly found group by group). Computed once per inputs and guess."""
         if not self.plain or model.nq == 0:
             return None
@@ -78,9 +78,7 @@ class Prepared:
             q0 = None
         out = None
         if q0 is not None and np.all(np.isfinite(q0)):
-            qs = model.scales(u, self.p)[1]
-            q0.flags.writeable = qs.flags.writeable = False
-            out = (q0, qs)
+            out = Placement(q0, model.scales(u, self.p)[1])
         with self._lock:
             self._places[key] = out
             while len(self._places) > PLACEMENTS:

@@ -64,11 +64,11 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     model = _model_of(m)
     report = list(default_report(m) if report is None else report)
     model.quantity_function(tuple(report))  # unknown names fail here, before any solving
-    U = _input_table(m, inputs, "inputs", None)
+    pm = prepared(model, m)  # parameter values, size, guess, input keys: once per mechanism
+    U = _input_table(m, inputs, "inputs", None, pm.keys)
     n = U.shape[0]
-    Ud = np.broadcast_to(_input_table(m, rates, "rates", 1.0), U.shape)
-    Udd = np.broadcast_to(_input_table(m, accelerations, "accelerations", 0.0), U.shape)
-    pm = prepared(model, m)  # parameter values, size, guess: once per mechanism
+    Ud = np.broadcast_to(_input_table(m, rates, "rates", 1.0, pm.keys), U.shape)
+    Udd = np.broadcast_to(_input_table(m, accelerations, "accelerations", 0.0, pm.keys), U.shape)
     p, L = pm.p, pm.size
     g = pm.guess if not guess else {**pm.guess, **{k: (m.value(x), m.value(y)) for k, (x, y) in dict(guess).items()}}
     events = []
@@ -94,7 +94,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
     if ok.any():  # gear centre distances at the first solved pose
         check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
-    status = ["ok"] * n if ok.all() else ["ok" if s else NO_ASSEMBLY for s in ok]
+    status = np.full(n, "ok", dtype=object) if ok.all() else ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
     found, at = _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma)
     events += found
@@ -109,7 +109,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
             values = np.array(values, dtype=float)
             values[np.ix_(third, np.flatnonzero(ok))] = got
     null_derivatives(model, report, values, Q, U, p, at)  # no wrong number at a singular pose
-    keys = [i.key for i in m.inputs]
+    keys = pm.keys
     events.sort(key=lambda e: e["pose"])
     for e in events:
         e.setdefault("inputs", {kk: float(U[e["pose"], j]) for j, kk in enumerate(keys)})

@@ -382,6 +382,19 @@ def polish_singular(model, q, u, p, L, groups, max_iter: int = 30):
 # --- the first pose: from the guess, or group by group ---
 
 
+class Placement:
+    """Where the careful path starts Newton for a sweep's first pose: `q0` (the unknowns
+    placed from the guessed points, or assembled group by group without a guess) and `qs`,
+    each unknown's scale in its own group (`Model.scales`), both read-only; `kernel` is
+    left to the fast kernel to keep its state at q0 in (it depends on q0 alone)."""
+
+    __slots__ = ("q0", "qs", "kernel")
+
+    def __init__(self, q0, qs):
+        self.q0, self.qs, self.kernel = q0, qs, None
+        q0.flags.writeable = qs.flags.writeable = False
+
+
 def no_assembly(model, q) -> Solution:
     return Solution(np.array(q, float), np.inf, 0, False, None)
 

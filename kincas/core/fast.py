@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import ctypes
 import threading
+from itertools import accumulate
 
 import casadi as ca
 import numpy as np
@@ -81,23 +82,28 @@ class FastRun:
         self.sweeper, nq, nu = sweeper, sweeper.nq, sweeper.nu
         self.U = np.ascontiguousarray(table(U, nu))
         self.n = n = self.U.shape[0]
-        self.Ud = rows(np.ones(nu) if Ud is None else Ud, n, nu)
-        self.Udd = rows(np.zeros(nu) if Udd is None else Udd, n, nu)
+        self.Ud = _rows(np.ones(nu) if Ud is None else Ud, n, nu)
+        self.Udd = _rows(np.zeros(nu) if Udd is None else Udd, n, nu)
         self.p = np.ascontiguousarray(np.asarray(p, dtype=float).ravel())
-        self.L = np.array([float(L)])
-        self.Q, self.info = np.empty((n, nq)), np.empty((5, n))
-        self.values = np.empty((len(sweeper.report), n))
-        self.measures = np.empty((len(sweeper.blocks) + 1, n))
+        # everything the kernel reads or writes of this run, inputs aside, in one block of
+        # memory: L and the thresholds, the state, Q, info, values, measures (its address
+        # is taken once, not per array and per call)
+        no, nm = len(sweeper.report), len(sweeper.blocks) + 1
+        o = self._off = list(accumulate([0, 6, sweeper.state_size, n * nq, 5 * n, no * n, nm * n]))
+        block = self._block = np.empty(o[-1])
+        block[:6] = float(L), RESIDUAL, STEP, JAC_CHANGE, CORRECTION, NEAR
+        self.L, self.thr, self._state = block[0:1], block[1:6], block[o[1]:o[2]]
+        self.Q, self.info = block[o[2]:o[3]].reshape(n, nq), block[o[3]:o[4]].reshape(5, n)
+        self.values, self.measures = block[o[4]:o[5]].reshape(no, n), block[o[5]:o[6]].reshape(nm, n)
         self.accepted, self.solved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
-        self.thr = np.array([RESIDUAL, STEP, JAC_CHANGE, CORRECTION, NEAR])
-        self.first_bad, self._s = 0, None
+        self.first_bad, self._s, self._addr = 0, None, None
 
     residual = property(lambda self: self.info[0], doc="max |g| / L at each pose (L: each group's)")
     step = property(lambda self: self.info[1], doc="the last Newton step (negligible, applied)")
     jac_change = property(lambda self: self.info[2], doc="max per group of sum |D^-1 (A_prev^-1 A - I) D|")
     correction = property(lambda self: self.info[3], doc="||D^-1 (q - q_pred)||_1")
-    iterations = property(lambda self: np.nan_to_num(self.info[4], nan=0.0).astype(int),
-                          doc="Newton steps taken at each pose")
+    iterations = property(lambda self: np.where(np.isnan(self.info[4]), 0.0, self.info[4]).astype(int),
+                          doc="Newton steps taken at each pose (0 where none was attempted)")
     signs = property(lambda self: self.measures[:-1].T, doc="(N, groups) signs of det per group")
     sigma = property(lambda self: self.measures[-1], doc="smallest relative singular value bound")
 
@@ -110,16 +116,18 @@ class FastRun:
         if start >= stop or not (sw.nq and sw.nu):  # nothing to predict: all careful
             return min(start, stop)
         if q_last is not None or self._s is None:
-            self._s = sw.state(q_last, u_last, self.p)
+            self._s = sw.state(q_last, u_last, self.p, out=self._state)
         s = self._s  # the C loop leaves the last accepted pose's state in it
         lib = sw.backend.compiled(self.n)
         if lib is not None:
-            (Ud, sud), (Udd, sudd) = self.Ud, self.Udd
+            if self._addr is None:  # addresses of the run's block and of its inputs
+                self._addr = (ptr(self._block), ptr(self.U), ptr(self.p), ptr(self.Ud[0]), ptr(self.Udd[0]))
+            a, aU, ap, aUd, aUdd = self._addr
+            o, sud, sudd, nq = self._off, self.Ud[1], self.Udd[1], sw.nq
             k = start + lib.kincas_sweep(
-                stop - start, ptr(self.U, start * sw.nu), ptr(self.p), ptr(self.L), ptr(self.thr),
-                sw.max_evals, ptr(s), ptr(self.Q, start * sw.nq), ptr(self.info, start), self.n,
-                ptr(Ud, start * sud), sud, ptr(Udd, start * sudd), sudd, ptr(self.values, start),
-                ptr(self.measures, start))
+                stop - start, aU + 8 * start * sw.nu, ap, a, a + 8, sw.max_evals, a + 8 * o[1],
+                a + 8 * (o[2] + start * nq), a + 8 * (o[3] + start), self.n, aUd + 8 * start * sud, sud,
+                aUdd + 8 * start * sudd, sudd, a + 8 * (o[4] + start), a + 8 * (o[5] + start))
         else:
             k = sw._vm_advance(self, start, stop, s)
         self.accepted[start:k] = self.solved[start:k] = True
@@ -155,7 +163,7 @@ class FastSweeper:
         self.blocks = _model_blocks(model)
         self.nj = diagonal_size(self.blocks)  # g_q's diagonal blocks, all the state keeps of it
         self.state_size = self.nq + self.nj + 2 * (self.nq * self.nu + self.nu)
-        self._functions = None
+        self._functions, self._size = None, None
         self._lock = threading.RLock()
         self._local = threading.local()  # the virtual machine's buffers, one set per thread
         self.backend = Backend(compile, self._library, "fast sweep kernel")
@@ -163,7 +171,9 @@ class FastSweeper:
     @property
     def size(self) -> int:
         """The kernel's size in casadi instructions (what compiling and running cost)."""
-        return sum(fn.n_instructions() for fn in self.functions)
+        if self._size is None:
+            self._size = sum(fn.n_instructions() for fn in self.functions)
+        return self._size
 
     def worth_it(self, n: int) -> bool:
         """Whether the fast pass pays for n poses: compiled (when its size allows: a larger
@@ -189,12 +199,13 @@ class FastSweeper:
                         "NJ": self.nj},
                        {"kincas_sweep": [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V, _V]})
 
-    def state(self, q, u, p) -> np.ndarray:
+    def state(self, q, u, p, out=None) -> np.ndarray:
         """(q, J, T = dq/du, u, T, u) at a solved pose, matrices column-major as in casadi
-        (the second T, u stand for the pose before: the first prediction is linear). At a
-        singular start T is not finite, and the next pose fails the branch test."""
+        (the second T, u stand for the pose before: the first prediction is linear), in
+        `out` if given. At a singular start T is not finite, and the next pose fails the
+        branch test."""
         nq, nu, nj = self.nq, self.nu, self.nj
-        s = np.empty(self.state_size)
+        s = np.empty(self.state_size) if out is None else out
         s[:nq], s[nq + nj + nq * nu:][:nu] = np.ravel(q), np.ravel(u)
         f = self._state_call()
         f(s[:nq], s[nq + nj + nq * nu:][:nu], np.ravel(p), s[nq:nq + nj], s[nq + nj:][:nq * nu])
@@ -238,9 +249,9 @@ class FastSweeper:
         two consecutive fast poses det g_q keeps its sign (see the module's text). With no
         unknowns or no inputs, every pose goes to `careful`.
 
-        `first(k)`, if given, places pose k while no pose is solved yet: (q0, qs), the
-        unknowns the careful path would start Newton from (the guessed points) and each
-        unknown's scale in its own group, or None. The kernel then solves pose k from q0
+        `first(k)`, if given, places pose k while no pose is solved yet: a `Placement`
+        (kincas/core/assembly.py) of the unknowns the careful path would start Newton from
+        (the guessed points) and each unknown's scale in its own group, or None. The kernel then solves pose k from q0
         (`_from_guess`), and the careful path only where the kernel's answer is not
         certainly the careful path's."""
         r = FastRun(self, U, p, L, Ud, Udd)
@@ -298,16 +309,20 @@ class FastSweeper:
         same root: the guess chooses the branch, as it does on the careful path."""
         if placed is None:
             return k
-        q0, qs = placed
-        s = self.state(q0, r.U[k], r.p)
-        before = _diagonal_signs(s[self.nq:self.nq + self.nj], self.blocks)
-        r._s = s
+        q0, qs = placed.q0, placed.qs
+        if placed.kernel is None:  # the state at q0 and its groups' signs, once per placement
+            s = self.state(q0, r.U[k], r.p)
+            s.flags.writeable = False
+            placed.kernel = s, _diagonal_signs(s[self.nq:self.nq + self.nj], self.blocks)
+        s, before = placed.kernel
+        r._state[:] = s
+        r._s = r._state
         bad = r.advance(k, None, None, stop)
         if bad > k:
             after = r.measures[:len(self.blocks), k]
             dq = np.abs(r.Q[k] - q0) / qs
             moved = [float(dq[b.cols].sum()) for b in self.blocks]
-            if np.all(before != 0) and np.array_equal(before, after) and max(moved, default=0.0) <= CORRECTION:
+            if (before != 0).all() and (before == after).all() and max(moved, default=0.0) <= CORRECTION:
                 return bad
         r._s = None  # nothing of this attempt is kept: the careful path starts afresh
         r.Q[k:bad + 1] = r.values[:, k:bad + 1] = r.measures[:, k:bad + 1] = np.nan
@@ -411,6 +426,20 @@ def _diagonal_signs(d: np.ndarray, blocks) -> np.ndarray:
         det = A[0] if n == 1 else A[0] * A[3] - A[1] * A[2] if n == 2 else np.linalg.det(A.reshape(n, n))
         out[i] = np.sign(det)
     return out
+
+
+def _rows(a, n: int, width: int) -> tuple[np.ndarray, int]:
+    """`rows` (kincas/core/compiled.py) with its usual cases first: a C-contiguous (n, width)
+    table as it is, one row (or a table broadcast from one) as that row with stride 0."""
+    a = np.asarray(a, dtype=float)
+    if a.ndim == 2 and a.shape == (n, width) and width:
+        if a.strides[0] == 0:
+            return np.ascontiguousarray(a[0]), 0
+        if a.flags.c_contiguous:
+            return a, width
+    if a.size == width and width:
+        return np.ascontiguousarray(a.reshape(width)), 0
+    return rows(a, n, width)
 
 
 def _take(table, idx):
