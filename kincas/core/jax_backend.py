@@ -170,7 +170,7 @@ class JaxDesigns:
     values (nd, len(report), n), info (nd, 5, n), stops (nd,)): poses 1..stops[d]-1 of design
     d accepted, the rest NaN (`info`: the measures of INFO in kincas/core/fast.py). With
     `out=(Q, values, info)` and `rows`, design d's poses 1.. are written into rows[d] of those
-    arrays instead. Safe from several threads (jitted functions are).
+    arrays instead (info None: not kept). Safe from several threads (jitted functions are).
     """
 
     def __init__(self, model, report=()):
@@ -264,7 +264,8 @@ class JaxDesigns:
                 w, r = b - a, rows[a:b]
                 Q[r, 1:] = np.asarray(q)[:w]
                 vals[r, :, 1:] = np.asarray(y)[:w].transpose(0, 2, 1)
-                info[r, :, 1:] = np.asarray(inf)[:w].transpose(0, 2, 1)
+                if info is not None:
+                    info[r, :, 1:] = np.asarray(inf)[:w].transpose(0, 2, 1)
                 stops[a:b] = 1 + np.asarray(ok)[:w].sum(axis=1)
         starts = range(0, nd, chunk)
         if workers > 1 and len(starts) > 1:
