@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.assembly import NEAR, assemble, blocks, group_links, modes, polish_singular
+from ..core.assembly import NEAR, assemble, modes, polish_singular
 # the first pose of a sweep (its home is the core: `kincas modes` and `range` start there too)
 from ..core.assembly import ambiguous as _ambiguous, first_pose as _first, no_assembly as _no_assembly  # noqa: F401
 from ..core.numeric import Model, Solution
 from ..model.mechanism import Mechanism
+from .resume import carry_groups, larger_groups, resume_label
 
 
 WATCH = 0.5  # a group conditioned below this at either end of a step is checked for a crossing
@@ -37,8 +38,17 @@ def careful_pose(model: Model, m: Mechanism, U, p, L, guess, k: int, j: int | No
     fresh = j == k - 1
     if not fresh and not _ambiguous(model):  # in or after a gap: decided group by group
         return _resume(model, U, p, L, k, j, run, events)
-    prev = (run.Q[j - 1], U[j - 1]) if fresh and j >= 1 and run.solved[j - 1] else None
-    sol = _continue(model, run.Q[j], U[j], u, p, L, depth=8 if fresh else 0, prev=prev)
+    big = larger_groups(model)
+    memo = run.__dict__.setdefault("carried", {})  # how far each gap was carried, per sweep
+    carried = carry_groups(model, U, p, L, j, run.Q[j], k, big, memo) if big and not fresh else {}
+    sol = None
+    for q in (q for q in carried.values() if q is not None):  # a group carried through the
+        sol = assemble(model, u, p, L, want=modes(model, model.jac(run.Q[j], U[j], p), L)[0], near=q)
+        break  # gap is in the mode it left: first that, the later groups in theirs
+    if sol is None:
+        prev = (run.Q[j - 1], U[j - 1]) if fresh and j >= 1 and run.solved[j - 1] else None
+        sol = _continue(model, run.Q[j], U[j], u, p, L, depth=8 if fresh else 0, prev=prev)
+    recovered = sol is None
     if sol is None:
         sol = _recover(model, m, (run.Q[j], U[j]), u, p, L)
     if sol.ok and not fresh:  # back in range: in the modes it left where they assemble
@@ -51,10 +61,13 @@ def careful_pose(model: Model, m: Mechanism, U, p, L, guess, k: int, j: int | No
                 got = modes(model, alt.J, L)[0]
                 moved = np.flatnonzero((before != got) & (before != 0) & (got != 0))
                 if moved.size < changed.size:
-                    sol, changed = alt, moved
-        names = group_links(model)
-        events.append({"kind": "resume", "pose": int(k), "branch": "other" if changed.size else "same"}
-                      | ({"groups": [names[i] for i in changed]} if changed.size else {}))
+                    sol = alt
+        events.append({"kind": "resume", "pose": int(k)}
+                      | resume_label(model, U, p, L, j, run.Q[j], k, sol.q, carried or None))
+    elif sol.ok and recovered and big:  # the mode followed ended: another took over, if any
+        label = resume_label(model, U, p, L, j, run.Q[j], k, sol.q)
+        if label["branch"] != "same":
+            events.append({"kind": "resume", "pose": int(k)} | label)
     return sol
 
 
@@ -67,11 +80,7 @@ def _resume(model: Model, U, p, L, k, j, run, events) -> Solution:
     sol = assemble(model, U[k], p, L, want=before, near=run.Q[j])
     if sol is None:
         return _no_assembly(model, run.Q[j])
-    after = modes(model, sol.J, L)[0]
-    changed = np.flatnonzero((before != after) & (before != 0) & (after != 0))
-    names = group_links(model)
-    events.append({"kind": "resume", "pose": int(k), "branch": "other" if changed.size else "same"}
-                  | ({"groups": [names[i] for i in changed]} if changed.size else {}))
+    events.append({"kind": "resume", "pose": int(k)} | resume_label(model, U, p, L, j, run.Q[j], k, sol.q))
     return sol
 
 

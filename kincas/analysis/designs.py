@@ -5,16 +5,19 @@ design: values of some of its parameters, the others as declared) at every pose 
 every design on the branch of m's guess:
 
 1. the nominal design's first pose is assembled from the guess (as `kincas.sweep` does);
-2. each design's first pose is continued from it in the parameters, all designs together:
-   along p(t) = p0 + t (p_d - p0), a predictor dq = -g_q^-1 g_p dp, then Newton, in a few
-   steps of t; a step is kept only when its residual is accepted and det(g_q) kept the
-   nominal's sign (the assembly branch). A design that fails is assembled from the guess
-   instead and kept if det(g_q) has the nominal's sign;
-3. each design is swept over the poses by the compiled fast pass of `kincas.sweep` (the same
-   kernel and checks), blocks of designs in one C call each, the blocks on several threads
-   (the C loop releases the GIL and shares no buffers); a pose the fast pass rejects is
+2. with a compiler, each design is then solved whole in C (kincas/core/designs_kernel.py):
+   its first pose continued from the nominal's in the parameters, along p(t) = p0 + t (p_d -
+   p0) (a predictor dq = -g_q^-1 g_p dp, then Newton, in steps of t; a step is kept only
+   when its residual is accepted and every Assur group's det g_q kept the nominal's sign:
+   the assembly branch), then its poses by the fast pass of `kincas.sweep` (the same kernel
+   and checks). Blocks of designs go in one C call each, the blocks on several threads (the
+   C loop releases the GIL and shares no buffers);
+3. what that loop leaves (rare) is done as before it existed: a pose the fast pass rejects is
    continued carefully (step halving, as `kincas.sweep`'s careful path) and the fast pass goes
-   on after it.
+   on after it; a first pose it could not continue is continued again with numpy, all such
+   designs together, else assembled from the guess and kept if every group has the
+   nominal's mode, then swept. Without a compiler, all designs take this path (and advance
+   pose by pose together).
 
 Where a design cannot be continued to a pose, `gaps="stop"` (the default) ends it there:
 that pose gets "no assembly" (or "branch lost" when Newton finds an assembly there that the
@@ -45,20 +48,22 @@ from typing import Mapping
 import numpy as np
 
 from ..errors import ModelError
-from ..core.batch import BatchEvaluator, DesignKernel
+from ..core.batch import BatchEvaluator
 from ..core.compiled import ptr, rows
+from ..core.designs_kernel import MAX_STEPS, NEWTON, STEP, designs_loop_for
 from ..core.fast import FastRun
 from ..core.numeric import ACCEPT, compile as compile_model
 from ..core.symbolic import default_report
 from ..model.mechanism import Mechanism, as_param
-from .continuation import _continue, _det_sign, _first
+from ..core.assembly import modes
+from ..core.blocks import numeric_signs
+from .continuation import _continue, _first
 from .sweeps import _input_table
 
 OK, NO_ASSEMBLY, NOT_SOLVED, BRANCH_LOST, NO_MESH = 0, 1, 2, 3, 4
 STATUS = ("ok", "no assembly", "not solved", "branch lost", "gears do not mesh")
-BLOCK = 32  # designs per C call (a thread's unit of work)
-STEP = 0.05  # largest parameter change per continuation step, relative to the size
-NEWTON = 8  # Newton iterations per continuation step at most
+BLOCK = 32  # designs per C call (a thread's unit of work) on the careful designs' path
+FULL_BLOCK = 256  # designs per call of the whole-designs loop at most
 
 
 # --- the result ---
@@ -214,7 +219,7 @@ def sweep_designs(m: Mechanism, params, inputs=None, *, names=None, rates=None,
     model.quantity_function(tuple(report))  # unknown names fail here
     names, X = design_table(m, params, names)
     U = _input_table(m, inputs, "inputs", None)
-    n, nd = U.shape[0], X.shape[0]
+    nd = X.shape[0]
     Ud = np.ascontiguousarray(np.broadcast_to(_input_table(m, rates, "rates", 1.0), U.shape))
     Udd = np.ascontiguousarray(np.broadcast_to(_input_table(m, accelerations, "accelerations", 0.0), U.shape))
     pnames = [k for k, _ in m.parameters]
@@ -224,11 +229,16 @@ def sweep_designs(m: Mechanism, params, inputs=None, *, names=None, rates=None,
     P = np.ascontiguousarray(P)
     Ls = np.ascontiguousarray(_sizes(m, P, pnames))
     g = {k: (m.value(x), m.value(y)) for k, (x, y) in {**dict(m.guess), **dict(guess or {})}.items()}
-    job = _Job(model, m, report, U, Ud, Udd, P, Ls, g, compile)
+    job = _Job(model, m, report, U, Ud, Udd, P, Ls, g, compile, progress)
     job.backend = backend
+    workers = workers or os.cpu_count() or 1
     with _lock(model):
-        job.first_poses(p0, m.size())
-    job.sweep_all(workers or os.cpu_count() or 1, progress)
+        nominal = _first(model, U[0], p0, m.size(), g) if nd else None
+    job._news(0)
+    rest = job.whole_designs(nominal, p0, m.size(), workers)
+    with _lock(model):
+        job.first_poses(nominal, p0, m.size(), rest)
+    job.sweep_all(workers, rest)
     if gaps == "resume":
         job.resume_gaps(names)
     job.fill_values()
@@ -241,17 +251,62 @@ def sweep_designs(m: Mechanism, params, inputs=None, *, names=None, rates=None,
 class _Job:
     """The arrays of one call of `sweep_designs` and its three stages."""
 
-    def __init__(self, model, m, report, U, Ud, Udd, P, Ls, guess, compile):
+    def __init__(self, model, m, report, U, Ud, Udd, P, Ls, guess, compile, progress=None):
         self.model, self.m, self.report, self.guess = model, m, report, guess
         self.U, self.Ud, self.Udd, self.P, self.Ls = U, Ud, Udd, P, Ls
         nd, n, nq = P.shape[0], U.shape[0], model.nq
-        self.Q = np.full((nd, n, nq), np.nan)
-        self.vals = np.full((nd, len(report), n), np.nan)
-        self.info = np.full((nd, 5, n), np.nan)
+        self.Q = np.empty((nd, n, nq))  # meaningful where code is OK
+        self.vals = np.empty((nd, len(report), n))  # NaN where not OK: see fill_values
         self.code = np.full((nd, n), NOT_SOLVED, dtype=np.int8)
         self.fast = np.zeros((nd, n), dtype=bool)  # values computed by the kernel
-        self.kernel = DesignKernel(model, report, compile) if model.square and model.nq and model.nu else None
+        self.kernel = (designs_loop_for(model, tuple(report), compile)
+                       if model.square and model.nq and model.nu else None)
         self.S = np.full((nd, self.kernel.sweeper.state_size if self.kernel else 0), np.nan)  # kernel states
+        self.progress, self.done, self._tick = progress, 0, threading.Lock()
+        self.backend = "casadi"  # or "jax": the poses' fast pass (kincas/analysis/designs_jax.py)
+
+    def _news(self, k: int):
+        """k more designs are finished."""
+        if self.progress is not None:
+            with self._tick:
+                self.done += k
+                self.progress(self.done, self.P.shape[0])
+
+    # --- 0. whole designs in one compiled call each block, on threads ---
+    def whole_designs(self, nominal, p0, L0, workers) -> np.ndarray:
+        """Every design in the compiled loop (kincas/core/designs_kernel.py): its first pose
+        continued from the nominal's, then its poses, without the GIL. Designs it leaves
+        before the end are finished here (careful pose, then the kernel again); returns the
+        designs whose first pose it could not continue (for `first_poses`)."""
+        nd, n = self.P.shape[0], self.U.shape[0]
+        todo = np.arange(nd)
+        whole = self.kernel is not None and nominal is not None and self.backend == "casadi"
+        lib = self.kernel.lib(nd * n) if whole else None
+        if lib is None or not nominal.ok or nd == 0:
+            return todo
+        thr, q0 = _thresholds(), np.ascontiguousarray(nominal.q)
+        size = max(1, min(FULL_BLOCK, math.ceil(nd / (4 * workers))))
+        parts = [(a, min(a + size, nd)) for a in range(0, nd, size)]
+        stops = np.full(nd, -1)
+
+        def run(part):
+            a, b = part
+            stops[a:b] = self.kernel.full(lib, self.U, self.P[a:b], self.Ls[a:b], q0, p0, L0,
+                                          self.Q[a:b], self.vals[a:b], self.Ud, self.Udd, thr)
+            for d in range(a, b):  # what the loop left (rare): on the careful path
+                if 0 < stops[d] < n:
+                    self.code[d, :stops[d]], self.fast[d, :stops[d]] = OK, True
+                    self._finish(lib, d, int(stops[d]))
+            self._news(int(np.sum(stops[a:b] > 0)))
+        if workers > 1 and len(parts) > 1:
+            with ThreadPoolExecutor(workers) as ex:
+                list(ex.map(run, parts))
+        else:
+            for part in parts:
+                run(part)
+        whole = stops == n
+        self.code[whole], self.fast[whole] = OK, True
+        return np.flatnonzero(stops <= 0)
 
     def check_gears(self):
         """A design whose gear centres are not r1 + r2 (or |r2 - r1|) apart at its first
@@ -267,27 +322,28 @@ class _Job:
                 self.code[d], self.vals[d] = NO_MESH, np.nan
 
     # --- 1. first poses: continuation in the parameters from the nominal design ---
-    def first_poses(self, p0, L0):
-        model, nd, u0 = self.model, self.P.shape[0], self.U[0]
-        if nd == 0:
+    def first_poses(self, nominal, p0, L0, idx):
+        """First poses of the designs `idx`, all together (numpy), from the nominal's."""
+        model, u0 = self.model, self.U[0]
+        if not len(idx):
             return
-        nominal = _first(model, u0, p0, L0, self.guess)
-        sign0 = _det_sign(model, nominal, L0) if nominal.ok else 0
-        ok = np.zeros(nd, dtype=bool)
+        sign0 = _modes(model, nominal.J, L0) if nominal.ok else None
+        ok = np.zeros(len(idx), dtype=bool)
         if nominal.ok and model.nq:
-            ok = self._continue_in_parameters(nominal.q, p0, sign0)
+            ok = self._continue_in_parameters(idx, nominal.q, p0, sign0)
         elif nominal.ok:  # nothing to solve for: every design assembles as the nominal
             ok[:] = True
-        for d in np.flatnonzero(~ok):  # Newton from the guess, on the nominal's branch
+        for j in np.flatnonzero(~ok):  # Newton from the guess, on the nominal's branch
+            d = idx[j]
             q = model.initial_q(u0, self.P[d], self.guess, self.Ls[d])
             sol = model.newton(q, u0, self.P[d], self.Ls[d])
-            if sol.ok and (sign0 == 0 or _det_sign(model, sol, self.Ls[d]) in (0, sign0)):
-                self.Q[d, 0], ok[d] = sol.q, True
+            if sol.ok and _same_modes(sign0, _modes(model, sol.J, self.Ls[d])):
+                self.Q[d, 0], ok[j] = sol.q, True
             else:
                 self.code[d, 0] = BRANCH_LOST if sol.ok else NO_ASSEMBLY
-        self.code[ok, 0] = OK
-        if self.kernel is not None and ok.any():  # the fast pass's starting states, batched
-            idx = np.flatnonzero(ok)
+        idx = idx[ok]
+        self.code[idx, 0] = OK
+        if self.kernel is not None and len(idx):  # the fast pass's starting states, batched
             u = np.repeat(self.U[:1], len(idx), axis=0)
             _, J, Ju, _ = BatchEvaluator(model).derivatives(self.Q[idx, 0], u, self.P[idx])
             T = -_solve(J, Ju)
@@ -295,15 +351,15 @@ class _Job:
             Jd = self.kernel.sweeper.diagonal(J)  # g_q's diagonal blocks, as the kernel keeps them
             self.S[idx] = np.concatenate([self.Q[idx, 0], Jd, cm(T), u, cm(T), u], axis=1)
 
-    def _continue_in_parameters(self, q0, p0, sign0) -> np.ndarray:
-        model, P, Ls = self.model, self.P, self.Ls
+    def _continue_in_parameters(self, idx, q0, p0, sign0) -> np.ndarray:
+        model, P, Ls = self.model, self.P[idx], self.Ls[idx]
         nd, u = P.shape[0], np.repeat(self.U[:1], P.shape[0], axis=0)
         ev = BatchEvaluator(model)
         scale = np.where(model.sym.is_length[None, :], 1.0, 1.0 / Ls[:, None])
         dP = P - p0
         # Steps of at most STEP * size in every parameter, counted per design, so that a
         # design's numbers do not depend on the others computed with it (chunks on a cluster).
-        steps = np.clip(np.ceil(np.abs(dP).max(axis=1, initial=0.0) / (STEP * Ls)), 1, 64).astype(int)
+        steps = np.clip(np.ceil(np.abs(dP).max(axis=1, initial=0.0) / (STEP * Ls)), 1, MAX_STEPS).astype(int)
         q, pc = np.repeat(q0[None, :], nd, axis=0), np.repeat(p0[None, :], nd, axis=0)
         ok = np.ones(nd, dtype=bool)
         for i in range(1, int(steps.max(initial=1)) + 1):
@@ -318,26 +374,26 @@ class _Job:
             gv, J, _, _ = ev.derivatives(qa, ua, pt)
             r = np.abs(gv).max(axis=1) / La
             with np.errstate(all="ignore"):
-                s = np.sign(np.linalg.det(J * scale[a][:, None, :]))
-            ok[a] &= (r <= ACCEPT) & np.isfinite(qa).all(axis=1) & ((s == sign0) | (sign0 == 0))
+                s = numeric_signs(J * scale[a][:, None, :], self.kernel.sweeper.blocks if self.kernel
+                                  else list(model.blocks))
+            ok[a] &= (r <= ACCEPT) & np.isfinite(qa).all(axis=1) & _same_modes(sign0, s)
             q[a], pc[a] = qa, pt
-        self.Q[ok, 0] = q[ok]
+        self.Q[idx[ok], 0] = q[ok]
         return ok
 
     # --- 2. the poses: compiled blocks of designs on threads, careful where rejected ---
-    def sweep_all(self, workers, progress):
-        nd, n = self.P.shape[0], self.U.shape[0]
-        todo = np.flatnonzero(self.code[:, 0] == OK)
+    def sweep_all(self, workers, rest):
+        """The designs `rest` (first poses from `first_poses`) over the poses."""
+        n = self.U.shape[0]
+        todo = rest[self.code[rest, 0] == OK]
+        self._news(len(rest) - len(todo))
         lib = self.kernel.lib(len(todo) * n) if self.kernel is not None and n > 1 else None
         blocks = [todo[i:i + BLOCK] for i in range(0, len(todo), BLOCK)]
-        done = [nd - len(todo)]
-        tick = threading.Lock()
-
         batched = lib is None and self.kernel is not None and n > 1
         if batched:  # no compiled kernel: all designs advance together, pose by pose
             blocks = [todo]
         jax_stops = None
-        if getattr(self, "backend", "casadi") == "jax" and self.kernel is not None and n > 1:
+        if self.backend == "jax" and self.kernel is not None and n > 1:
             from .designs_jax import jax_pass  # the fast pass in JAX, then as after the kernel's
             jax_stops = dict(zip(todo.tolist(), jax_pass(self, todo, _thresholds())))
 
@@ -352,20 +408,13 @@ class _Job:
                 stops = np.ones(len(block), dtype=int)
             for d, k in zip(block, stops):
                 self._finish(lib, int(d), int(k))
-            if progress is not None:
-                with tick:
-                    done[0] += len(block)
-                    progress(done[0], nd)
-        if progress is not None:
-            progress(done[0], nd)
+            self._news(len(block))
         if workers > 1 and len(blocks) > 1 and lib is not None:
             with ThreadPoolExecutor(workers) as ex:
                 list(ex.map(run, blocks))
         else:
             for b in blocks:
                 run(b)
-        if progress is not None:
-            progress(nd, nd)
 
     def _batched_pass(self, todo) -> np.ndarray:
         """The fast pass without a compiler: every design of `todo` advanced pose by pose
@@ -415,7 +464,7 @@ class _Job:
         nb = len(block)
         S = np.ascontiguousarray(self.S[block])
         P, Ls = np.ascontiguousarray(self.P[block]), np.ascontiguousarray(self.Ls[block])
-        Q, info = np.empty((nb, n, nq)), np.empty((nb, 5, n))
+        Q, info = np.empty((nb, n, nq)), np.empty((nb, 5, n))  # info: the kernel's, unused
         vals, stops = np.empty((nb, len(self.report), n)), np.empty(nb)
         (Ud, sud), (Udd, sudd) = rows(self.Ud, n, nu), rows(self.Udd, n, nu)
         thr = _thresholds()  # referenced until the call returns: C reads it by address
@@ -425,7 +474,7 @@ class _Job:
         stops = stops.astype(int)
         for j, d in enumerate(block):
             k = stops[j]  # poses 1..k-1 accepted; k rejected (if < n)
-            self.Q[d, 1:k], self.vals[d, :, 1:k], self.info[d, :, 1:k] = Q[j, 1:k], vals[j, :, 1:k], info[j, :, 1:k]
+            self.Q[d, 1:k], self.vals[d, :, 1:k] = Q[j, 1:k], vals[j, :, 1:k]
             self.code[d, 1:k], self.fast[d, 1:k] = OK, True
         return stops
 
@@ -500,14 +549,32 @@ class _Job:
             self.fast[d] = True  # values filled
 
     def fill_values(self):
-        need = (self.code == OK) & ~self.fast
-        d, k = np.nonzero(need)
+        """Quantities at the poses solved on the careful path; NaN (and unknowns NaN) where
+        a pose is not solved."""
+        bad = self.code != OK
+        self.vals.transpose(0, 2, 1)[bad] = np.nan
+        self.Q[bad] = np.nan
+        d, k = np.nonzero(~bad & ~self.fast)
         if not len(d) or not self.report:
             return
         ev = BatchEvaluator(self.model)
         with _lock(self.model):
             self.vals[d, :, k] = ev.quantities(self.report, self.Q[d, k], self.U[k], self.P[d],
                                                self.Ud[k], self.Udd[k]).T
+
+
+def _modes(model, J, L) -> np.ndarray:
+    """Each Assur group's mode (sign of its block's det, 0 near singular) at one pose."""
+    return modes(model, J, L)[0] if model.square else np.zeros(0)
+
+
+def _same_modes(sign0, s) -> np.ndarray:
+    """Whether the modes s (one row per design, or one) are the nominal's sign0 in every
+    group where both are defined (sign0 None: no nominal mode to keep)."""
+    s = np.asarray(s)
+    if sign0 is None or s.shape[-1] != len(sign0):
+        return np.ones(s.shape[:-1], dtype=bool)
+    return np.all((s == sign0) | (sign0 == 0) | (s == 0), axis=-1)
 
 
 def _thresholds() -> np.ndarray:

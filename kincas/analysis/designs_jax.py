@@ -35,6 +35,6 @@ def jax_pass(job, todo, thresholds) -> np.ndarray:
                                   thresholds)
     for j, d in enumerate(todo):
         k = stops[j]  # poses 1..k-1 accepted; k rejected (if < n)
-        job.Q[d, 1:k], job.vals[d, :, 1:k], job.info[d, :, 1:k] = Q[j, 1:k], vals[j, :, 1:k], info[j, :, 1:k]
+        job.Q[d, 1:k], job.vals[d, :, 1:k] = Q[j, 1:k], vals[j, :, 1:k]
         job.code[d, 1:k], job.fast[d, 1:k] = 0, True  # 0: "ok"
     return stops

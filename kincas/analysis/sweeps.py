@@ -26,6 +26,7 @@ from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
 from ..core.symbolic import default_report, needs_jerk
 from .continuation import careful_pose
+from .resume import unlabelled_resumes
 from .events import null_derivatives
 from ..core.joints import check_first_pose
 from .inputs import input_table as _input_table
@@ -96,6 +97,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
     status = np.full(n, "ok", dtype=object) if ok.all() else ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
+    events += unlabelled_resumes(model, U, p, L, Q, ok, events)  # after gaps the fast pass crossed
     found, at = _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma)
     events += found
     values = run.values

@@ -11,7 +11,10 @@ independent normal variables with the given standard deviations sigma_j. Two ans
   continued from the nominal's first pose in the parameters, keeping the sign of det(g_q)
   (the nominal's assembly branch), then swept by the compiled fast pass with its checks. A
   sample that cannot be continued to a pose is counted as failed there and left out, never
-  used, and taken up again at the next pose from the nominal's pose there.
+  used, and taken up again at the next pose from the nominal's pose there. The samples run
+  in chunks on the executor of `kincas study` (threads; the compiled loop releases the GIL),
+  each chunk reduced to per-pose counts, means and squared deviations, so that 100,000
+  samples x 360 poses need no more memory than one chunk.
 
 The two agree when the outputs are close to linear over the tolerance band; their ratio is
 reported beside the Monte-Carlo sampling error, 1 / sqrt(2 (N - 1)) relative.
@@ -38,6 +41,7 @@ from ..core.numeric import model_of
 from ..model.mechanism import Mechanism
 
 FEW_POSES = 16  # up to this many poses, each is solved from the nominal's (not swept to)
+CHUNK = 2048  # samples per task of the executor
 
 
 
@@ -109,9 +113,11 @@ class ToleranceResult:
 
 def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | None = None, *,
             samples: int = 2000, seed: int | None = 0, rates=None, accelerations=None,
-            progress=None) -> ToleranceResult:
+            progress=None, workers: int | None = None) -> ToleranceResult:
     """Spread of the `report` quantities over `inputs` from independent normal parameter
-    errors with standard deviations `std` (parameter name -> sigma, in its own unit)."""
+    errors with standard deviations `std` (parameter name -> sigma, in its own unit). The
+    samples run in chunks on `workers` threads (default: every core); the numbers do not
+    depend on how many. See the module's text for an example."""
     from .sensitivity import sensitivities
     from ..core.symbolic import default_report, parse_quantity
 
@@ -131,7 +137,7 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
     fo = np.sqrt(np.einsum("ijk,k->ij", sens.matrix ** 2, sig ** 2))  # poses x outputs
     rng = np.random.default_rng(seed)
     dp = rng.standard_normal((samples, len(to))) * sig  # one row per manufactured mechanism
-    mc, shift, failed, retried = _monte_carlo(m, sw, report, to, dp)
+    mc, shift, failed, retried = _monte_carlo(m, sw, report, to, dp, workers)
     nominal = {n: sw[n] for n in report}
     return ToleranceResult(
         names=report, std={p: float(std[p]) for p in to}, samples=samples, seed=seed,
@@ -157,67 +163,118 @@ def _check_std(m: Mechanism, std, where: str) -> list[str]:
     return out
 
 
-def _monte_carlo(m: Mechanism, sw, report, to, dp):
+def _monte_carlo(m: Mechanism, sw, report, to, dp, workers=None):
     """Monte-Carlo std and mean shift (poses x outputs), failures per pose, restarts.
 
-    Each drawn mechanism is a design of `kincas.sweep_designs`, swept over every run of poses
-    the nominal solved (with FEW_POSES poses or fewer, each pose on its own), from the nominal's first pose of the run (continued in the
-    parameters, keeping det g_q's sign: the nominal's branch). A sample that cannot be
-    continued to a pose counts as failed there, and is taken up again at the next pose,
-    continued in the parameters from the nominal's pose there."""
-    from ..core.numeric import compile
-    from .designs import sweep_designs
+    The samples are cut into chunks of CHUNK (a fixed size, so that the numbers do not depend
+    on the number of workers), run on the executor of `kincas study`
+    (kincas/analysis/executor.py: local threads; the compiled loop releases the GIL). Each
+    chunk gives, per pose, the count, mean and sum of squared deviations of its good samples
+    (nothing larger is kept: 100,000 samples x 360 poses fit in memory), merged in the
+    chunks' order by the pairwise update of Chan et al."""
+    from .executor import run_chunks
 
-    model = compile(m)
     n_s, n_pose = dp.shape[0], len(sw)
     pv = dict(m.parameters)
-    p0 = np.array(list(pv.values()), dtype=float)
     X = np.array([pv[p] for p in to], dtype=float) + dp
-    keys = list(sw.inputs)
-    U = np.stack([sw.inputs[k] for k in keys], axis=1)
-    Ud = np.stack([sw.rates[k] for k in keys], axis=1)
-    Udd = np.stack([sw.accelerations[k] for k in keys], axis=1)
-    mc = np.full((n_pose, len(report)), np.nan)
-    shift = np.full((n_pose, len(report)), np.nan)
-    failed = np.zeros(n_pose, dtype=int)
-    ok = np.asarray(sw.ok, dtype=bool)
-    Qv = np.full((len(report), n_s, n_pose), np.nan)
-    good = np.zeros((n_s, n_pose), dtype=bool)
-    if n_pose <= FEW_POSES:  # far apart, as a rule: each from the nominal's pose there
-        todo = [(a, a + 1, np.arange(n_s)) for a in np.flatnonzero(ok)]
-    else:  # swept along each run of poses the nominal solved
-        edges = np.flatnonzero(np.diff(np.r_[0, ok.astype(int), 0]))
-        todo = [(a, b, np.arange(n_s)) for a, b in zip(edges[::2], edges[1::2])]
+    job = _Samples(m, sw, list(report), list(to))
+    parts = [X[a:a + CHUNK] for a in range(0, n_s, CHUNK)]
+    out = run_chunks(job, parts, workers=workers)
+    count = np.zeros((n_pose, 1))
+    mean, m2 = np.zeros((n_pose, len(report))), np.zeros((n_pose, len(report)))
     restarts = 0
-    while todo:
-        a, b, idx = todo.pop()
-        pts = model.points(sw.q[a], U[a], p0)
-        guess = {nm: tuple(pts[:, j]) for j, nm in enumerate(m.moving_points)}
-        cut = lambda T: {k: T[a:b, j] for j, k in enumerate(keys)}
-        r = sweep_designs(m, X[idx], cut(U), names=to, rates=cut(Ud), accelerations=cut(Udd),
-                          report=list(report), guess=guess)
-        for i, nm in enumerate(report):
-            Qv[i, idx, a:b] = r.values[nm]
-        good[idx, a:b] = r.ok
-        stopped = ~r.ok.all(axis=1)
-        first = np.argmin(r.ok, axis=1)
-        for f in np.unique(first[stopped]):
-            if a + f + 1 < b:
-                again = idx[stopped & (first == f)]
-                todo.append((a + f + 1, b, again))
-                restarts += len(again)
-    angular = np.array([n.endswith(".angle") for n in report], dtype=bool)
-    for k in np.flatnonzero(ok):
-        g = good[:, k]
-        failed[k] = int(n_s - g.sum())
-        if g.sum() < 2:
-            continue
-        nom = np.array([sw[n][k] for n in report])
-        d = Qv[:, g, k] - nom[:, None]
-        d[angular] = np.angle(np.exp(1j * d[angular]))  # deviations of angles across +-pi
-        mc[k] = d.std(axis=1, ddof=1)
-        shift[k] = d.mean(axis=1)
+    for c, mu, s2, again in out:
+        tot = count + c
+        with np.errstate(invalid="ignore", divide="ignore"):
+            delta = mu - mean
+            mean = np.where(tot > 0, mean + delta * (c / tot), 0.0)
+            m2 = m2 + s2 + delta ** 2 * np.where(tot > 0, count * c / tot, 0.0)
+        count, restarts = tot, restarts + again
+    ok = np.asarray(sw.ok, dtype=bool)
+    enough = ok & (count[:, 0] >= 2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mc = np.where(enough[:, None], np.sqrt(m2 / (count - 1)), np.nan)
+    shift = np.where(enough[:, None], mean, np.nan)
+    failed = np.where(ok, n_s - count[:, 0], 0).astype(int)
     return mc, shift, failed, restarts
+
+
+@dataclass
+class _Samples:
+    """One chunk of drawn mechanisms: each a design of `kincas.sweep_designs`, swept over
+    every run of poses the nominal solved (with FEW_POSES poses or fewer, each pose on its
+    own), from the nominal's first pose of the run (continued in the parameters, keeping
+    each Assur group's mode: the nominal's branch). A sample that cannot be continued to a
+    pose counts as failed there, and is taken up again at the next pose, continued in the
+    parameters from the nominal's pose there. Returns per pose the count of good samples,
+    the mean and the sum of squared deviations of each output from the nominal (angles
+    across +-pi), and the number of restarts."""
+
+    m: Mechanism
+    sw: object
+    report: list
+    to: list
+
+    def __call__(self, X):
+        from ..core.numeric import compile
+        from .designs import sweep_designs
+
+        m, sw, report = self.m, self.sw, self.report
+        model = compile(m)
+        n_s, n_pose = X.shape[0], len(sw)
+        p0 = np.array([v for _, v in m.parameters], dtype=float)
+        keys = list(sw.inputs)
+        U = np.stack([sw.inputs[k] for k in keys], axis=1)
+        Ud = np.stack([sw.rates[k] for k in keys], axis=1)
+        Udd = np.stack([sw.accelerations[k] for k in keys], axis=1)
+        Qv = None  # per output (samples, poses), read only where good
+        good = np.zeros((n_s, n_pose), dtype=bool)
+        ok = np.asarray(sw.ok, dtype=bool)
+        if n_pose <= FEW_POSES:  # far apart, as a rule: each from the nominal's pose there
+            todo = [(a, a + 1, np.arange(n_s)) for a in np.flatnonzero(ok)]
+        else:  # swept along each run of poses the nominal solved
+            edges = np.flatnonzero(np.diff(np.r_[0, ok.astype(int), 0]))
+            todo = [(a, b, np.arange(n_s)) for a, b in zip(edges[::2], edges[1::2])]
+        restarts = 0
+        while todo:
+            a, b, idx = todo.pop()
+            pts = model.points(sw.q[a], U[a], p0)
+            guess = {nm: tuple(pts[:, j]) for j, nm in enumerate(m.moving_points)}
+            cut = lambda T: {k: T[a:b, j] for j, k in enumerate(keys)}
+            r = sweep_designs(m, X[idx], cut(U), names=self.to, rates=cut(Ud),
+                              accelerations=cut(Udd), report=list(report), guess=guess, workers=1)
+            if Qv is None and (a, b, len(idx)) == (0, n_pose, n_s):  # all of it: no copy
+                Qv = [r.values[nm] for nm in report]
+            else:
+                Qv = Qv or [np.empty((n_s, n_pose)) for _ in report]
+                for i, nm in enumerate(report):
+                    Qv[i][idx, a:b] = r.values[nm]
+            good[idx, a:b] = r.ok
+            stopped = ~r.ok.all(axis=1)
+            first = np.argmin(r.ok, axis=1)
+            for f in np.unique(first[stopped]):
+                if a + f + 1 < b:
+                    again = idx[stopped & (first == f)]
+                    todo.append((a + f + 1, b, again))
+                    restarts += len(again)
+        good &= ok
+        bad = ~good
+        Qv = Qv or [np.zeros((n_s, n_pose)) for _ in report]
+        c = good.sum(axis=0).astype(float)  # (poses,)
+        mu, s2 = np.zeros((n_pose, len(report))), np.zeros((n_pose, len(report)))
+        for i, nm in enumerate(report):  # in place: a few passes over (samples, poses)
+            d = Qv[i]
+            d -= np.where(ok, sw[nm], 0.0)
+            d[bad] = 0.0
+            wrap = np.abs(d) > np.pi if nm.endswith(".angle") else None  # across +-pi
+            if wrap is not None and wrap.any():
+                d[wrap] -= 2 * np.pi * np.round(d[wrap] / (2 * np.pi))
+            with np.errstate(invalid="ignore", divide="ignore"):
+                mu[:, i] = np.where(c > 0, d.sum(axis=0) / c, 0.0)
+            d -= mu[:, i]
+            d[bad] = 0.0
+            s2[:, i] = np.einsum("ij,ij->j", d, d)
+        return c[:, None], mu, s2, restarts
 
 
 # --- scenes: the [tolerance] section ---

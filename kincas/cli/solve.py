@@ -13,6 +13,7 @@ import numpy as np
 
 from .common import EXIT_OK, EXIT_UNSOLVED, _list, _unit, progress_for
 from .scene import load
+from ..analysis.resume import label_text
 
 
 def cli_arguments(parser) -> None:
@@ -112,7 +113,7 @@ def _table(sc, sw, inputs, values):
     for e in sw.events:
         e = _user_event(sc, e)
         at = ", ".join(f"{k} = {v:.12g}" for k, v in e["inputs"].items())
-        what = f"resumed on the {e['branch']} branch" if e["kind"] == "resume" else e["kind"]
+        what = label_text(e) if e["kind"] == "resume" else e["kind"]
         print(f"pose {e['pose']}: {what} at {at}")
     bad = sum(s != "ok" for s in sw.status)
     print(f"{len(sw)} poses, {len(sw) - bad} solved" + (f", {bad} not solved" if bad else ""))

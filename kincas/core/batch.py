@@ -1,16 +1,11 @@
 """Many designs of one structure at once: batched evaluation and one compiled call per block.
 
 A *design* is one set of parameter values for a compiled model (`kincas.compile(m)`: the
-structure is built once, the parameters stay numeric inputs). Two tools live here:
-
-* `BatchEvaluator`: g, g_q, g_u, g_p and the reported quantities at many (q, u, p) columns
-  in one mapped CasADi call each, and damped-free Newton steps for all of them with numpy's
-  batched linear algebra (no symbolic inverse, so it scales with the mechanism);
-* `DesignKernel`: the fast sweep kernel of `kincas.core.fast` (the same casadi functions and
-  the same C loop, `kincas_sweep`) with one more C entry point, `kincas_designs`, that sweeps
-  a block of designs one after the other in a single call. A ctypes call releases the GIL and
-  the loop keeps its work arrays on its own stack, so blocks of designs run on several
-  threads at once when each has its own output rows.
+structure is built once, the parameters stay numeric inputs). `BatchEvaluator` gives g, g_q,
+g_u, g_p and the reported quantities at many (q, u, p) columns in one mapped CasADi call
+each, for damped-free Newton steps on all of them with numpy's batched linear algebra (no
+symbolic inverse, so it scales with the mechanism). The compiled loop over whole designs is
+in kincas/core/designs_kernel.py.
 
 >>> import numpy as np, kincas
 >>> m = kincas.Mechanism(parameters={"a": 1.0}, ground={"A": (0, 0), "D": (4, 0)},
@@ -23,64 +18,8 @@ structure is built once, the parameters stay numeric inputs). Two tools live her
 """
 from __future__ import annotations
 
-import ctypes
-
 import casadi as ca
 import numpy as np
-
-from .compiled import Backend, Library
-from .fast import sweeper_for
-from .kernel import SWEEP_C as _SWEEP_C
-
-_I, _V = ctypes.c_longlong, ctypes.c_void_p
-
-# --- the C loop over designs: design d's poses 1..n-1 from its state row S[d] ---
-
-_DESIGNS_C = """
-int kincas_designs(casadi_int nd, casadi_int n, const casadi_real* U, const casadi_real* P,
-                   casadi_int np_, const casadi_real* Ls, const casadi_real* thr,
-                   casadi_int max_evals, casadi_real* S, casadi_int ns, casadi_real* Q,
-                   casadi_real* info, const casadi_real* Ud, casadi_int sud,
-                   const casadi_real* Udd, casadi_int sudd, casadi_real* vals,
-                   casadi_real* stops) {
-  casadi_int d;
-  for (d = 0; d < nd; ++d) {
-    int k = kincas_sweep(n - 1, U + NU, P + d*np_, Ls + d, thr, max_evals, S + d*ns,
-                         Q + d*n*NQ + NQ, info + d*5*n + 1, n, Ud + sud, sud, Udd + sudd, sudd,
-                         vals + d*(NO > 0 ? NO : 0)*n + 1, 0);
-    stops[d] = (casadi_real) (k + 1);
-  }
-  return (int) nd;
-}
-"""
-_SWEEP_SIG = [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V, _V]
-_DESIGNS_SIG = [_I, _I, _V, _V, _I, _V, _V, _I, _V, _I, _V, _V, _V, _I, _V, _I, _V, _V]
-
-
-class DesignKernel:
-    """The compiled sweep kernel of a model and report, with a loop over designs.
-
-    `lib(n)` is the loaded library for n poses in all (None: no compiler, or not worth it,
-    as `kincas.core.compiled.Backend` decides); `sweeper` is the `FastSweeper` whose
-    functions it compiles (and whose virtual-machine path serves when there is no library).
-    """
-
-    def __init__(self, model, report=(), compile=None):
-        self.sweeper = sweeper_for(model, tuple(report), compile)
-        self.nq, self.nu, self.no = model.nq, model.nu, len(tuple(report))
-        self.backend = Backend(compile, self._library, "design sweep kernel")
-
-    def _library(self) -> Library:
-        return Library("kincas_designs", self.sweeper.functions, _SWEEP_C + _DESIGNS_C,
-                       {"NQ": self.nq, "NU": self.nu, "NO": self.no,
-                        "NM": len(self.sweeper.blocks) + 1, "NJ": self.sweeper.nj},
-                       {"kincas_sweep": _SWEEP_SIG, "kincas_designs": _DESIGNS_SIG})
-
-    def lib(self, n: int):
-        if self.sweeper.size > 40_000:  # as FastSweeper.worth_it: too large to compile
-            return None
-        return self.backend.compiled(n)
-
 
 # --- g and its derivatives at many columns ---
 

@@ -1,0 +1,231 @@
+"""Which mode each Assur group resumes in after a gap: proven the same, proven other, or unknown.
+
+A dyad's mode is the sign of its block's determinant (which of its two circle points it
+takes): an invariant of each pose, so equal signs before and after a gap are the same mode.
+A larger group has more assemblies than signs (a class-III triad up to six), so for it equal
+signs prove nothing. Its mode after a gap is established in one of two ways, else it is
+reported as unknown, with the reason, and never as "same":
+
+- **carried**: where the group and the groups it is built on assemble at every input of the
+  gap (a later group is the one that has no assembly), they alone are continued through the
+  gap's inputs (predictor along the exact tangent, Newton corrector group by group, the step
+  halved where it fails, wanders from the prediction or changes a block's sign). The
+  assembly they arrive at is the mode left; the resumed one is it, or another.
+- **the same limit**: where the mode left ended at a limit of the group and the resumed
+  assembly begins at one, and both are the same point (the inputs came back the way they
+  went), exactly two real branches meet there, and their block signs differ: equal signs,
+  the same branch.
+
+The same rules label a pose where the mode followed ended at a limit while another assembly
+of the same sign goes on (no gap at all): that change is a "resume" event, never silent.
+
+>>> import numpy as np
+>>> label_text({"branch": "unknown", "unknown": [["leg1", "plate"]], "reason": "r"})
+'resumed, mode of group leg1+plate unknown (r)'
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.assembly import _block_newton, blocks, group_links, modes
+from ..core.limits import locate_singular
+from ..core.tolerances import ACCEPT
+
+WIDE = 2  # a group with more unknowns than this has more assemblies than block signs
+SAME = 1e-6  # two assemblies are one when every unknown agrees to this (lengths over L)
+DEPTH = 10  # halvings of one input step while carrying groups through a gap
+BUDGET = 600  # Newton solves spent carrying groups through one gap
+
+REASON = ("its assemblies of one sign are told apart neither by continuation (it has no "
+          "assembly in the gap) nor by a limit it left and came back through")
+
+
+# --- which groups need more than a sign ---
+
+
+def larger_groups(model) -> list[int]:
+    """Indices of the Assur groups whose block sign does not identify their assembly."""
+    if not model.square:
+        return []
+    return [i for i, (_, cols) in enumerate(blocks(model)) if len(cols) > WIDE]
+
+
+# --- the label of a resume ---
+
+
+def resume_label(model, U, p, L, j, qj, k, qk, carried=None) -> dict:
+    """How pose k (unknowns qk) resumed from the last solved pose j (qj) across U[j+1..k-1].
+
+    Parameters
+    ----------
+    model : kincas.core.numeric.Model
+    U : numpy.ndarray
+        The sweep's inputs, (n, nu).
+    p : numpy.ndarray
+        Parameter values.
+    L : float
+        The mechanism's size.
+    j, k : int
+        The last solved pose before the resume, and the resumed pose.
+    qj, qk : numpy.ndarray
+        Their unknowns.
+    carried : dict, optional
+        {group: unknowns at U[k] or None}, from `carry_groups` if already computed.
+
+    Returns
+    -------
+    dict
+        "branch": "same", "other" (some group provably in another mode: "groups" lists
+        their links) or "unknown" (no group changed provably, some could not be
+        established: "unknown" lists them and "reason" says why).
+    """
+    before = modes(model, model.jac(qj, U[j], p), L)[0]
+    after = modes(model, model.jac(qk, U[k], p), L)[0]
+    changed = {int(i) for i in np.flatnonzero((before != after) & (before != 0) & (after != 0))}
+    unknown = []
+    for i in larger_groups(model):
+        if i in changed or before[i] == 0 or after[i] == 0:
+            continue
+        if any(g < i for g in changed):  # built on a group that changed: a new configuration
+            unknown.append(i)
+            continue
+        q = (carried if carried is not None else carry_groups(model, U, p, L, j, qj, k, [i])).get(i)
+        if q is not None:
+            if not _same(model, q, qk, L, i):
+                changed.add(i)
+        elif not _same_limit(model, U, p, L, j, qj, k, qk, i):
+            unknown.append(i)
+    names = group_links(model)
+    out = {"branch": "other" if changed else "unknown" if unknown else "same"}
+    if changed:
+        out["groups"] = [names[i] for i in sorted(changed)]
+    if unknown:
+        out["unknown"] = [names[i] for i in unknown]
+        out["reason"] = REASON
+    return out
+
+
+def label_text(e: dict) -> str:
+    """A resume event in words (for the command line)."""
+    if e["branch"] != "unknown":
+        return f"resumed on the {e['branch']} branch"
+    groups = ", ".join("+".join(g) for g in e["unknown"])
+    return f"resumed, mode of group {groups} unknown ({e['reason']})"
+
+
+# --- carried through the gap ---
+
+
+def carry_groups(model, U, p, L, j, qj, k, groups, memo=None) -> dict:
+    """{group: unknowns at U[k], or None}: each group in `groups` with the groups before it,
+    continued from the solved pose j through the inputs U[j+1], ..., U[k]. `memo` (a dict
+    kept by the caller for one sweep) keeps how far each carry got, so that the poses of one
+    gap, tried one after another, continue it by one step each."""
+    out = {}
+    for i in sorted(groups, reverse=True):  # the longest chain first: it carries the others
+        if i in out:
+            continue
+        q = _carry(model, U, p, L, j, qj, k, i, {} if memo is None else memo)
+        out[i] = q
+        if q is not None:
+            out.update({g: q for g in groups if g < i})
+    return out
+
+
+def _carry(model, U, p, L, j, qj, k, i, memo):
+    start, q = memo.get((j, i), (j, None))
+    if start > k or start == j:  # nothing carried yet (or past k): from pose j
+        start, q = j, np.array(qj, float)
+    if q is None or start == k:  # failed on the way to k, or already there
+        return q
+    bl = blocks(model)
+    R = np.concatenate([bl[b][0] for b in range(i + 1)])
+    C = np.concatenate([bl[b][1] for b in range(i + 1)])
+    scale = np.where(model.sym.is_length, L, 1.0)[C]
+    signs = modes(model, model.jac(qj, U[j], p), L)[0][:i + 1]
+    if np.any(signs == 0):
+        return None
+    spent = [0]
+
+    def solve(q, u):  # groups 0..i, each by its own Newton, the later ones left as they are
+        for b in range(i + 1):
+            q, r = _block_newton(model, q, u, p, L, b, max_iter=12)
+            if not r <= ACCEPT:
+                return None
+        return q
+
+    def step(q, u0, u1, depth):
+        spent[0] += 1
+        if spent[0] > BUDGET:
+            return None
+        _, J, Ju = model._tangent(q, u0, p)
+        with np.errstate(all="ignore"):
+            try:
+                t = np.linalg.solve(J[np.ix_(R, C)], -np.asarray(Ju)[R])
+            except np.linalg.LinAlgError:
+                t = np.zeros((len(C), len(u0)))
+        pred = q.copy()
+        pred[C] = q[C] + (t @ (u1 - u0) if np.all(np.isfinite(t)) else 0.0)
+        x = solve(pred.copy(), u1)
+        if x is not None:
+            moved = np.abs((pred - q)[C] / scale).max(initial=0.0)
+            far = np.abs((x - pred)[C] / scale).max(initial=0.0) > max(0.02, 0.5 * moved)
+            if not far and np.array_equal(modes(model, model.jac(x, u1, p), L)[0][:i + 1], signs):
+                return x
+        if depth == 0:
+            return None
+        um = 0.5 * (u0 + u1)
+        mid = step(q, u0, um, depth - 1)
+        return None if mid is None else step(mid, um, u1, depth - 1)
+
+    for kk in range(start + 1, k + 1):
+        q = step(q, U[kk - 1], U[kk], DEPTH)
+        spent[0] = 0  # a budget per input step
+        memo[(j, i)] = (kk, q)
+        if q is None:
+            return None
+    return q
+
+
+def _same(model, qa, qb, L, i) -> bool:
+    """Whether groups 0..i have the same assembly in qa and qb (angles modulo a turn)."""
+    cols = np.concatenate([blocks(model)[b][1] for b in range(i + 1)])
+    d = (np.asarray(qa) - np.asarray(qb))[cols]
+    is_len = model.sym.is_length[cols]
+    d = np.where(is_len, d / L, np.angle(np.exp(1j * d)))
+    return bool(np.abs(d).max(initial=0.0) <= SAME)
+
+
+# --- the same limit, left and come back through ---
+
+
+def _same_limit(model, U, p, L, j, qj, k, qk, i) -> bool:
+    """Whether the mode left at pose j ends at a limit of group i that is also where the
+    resumed assembly at pose k begins (located from each end toward the gap)."""
+    if j + 1 >= len(U) or k < 1:
+        return False
+    ends = []
+    for q, u, nb in ((qj, U[j], U[j + 1]), (qk, U[k], U[k - 1])):
+        found = locate_singular(model, q, u, p, L, nb - u, group=i)
+        if found is None or not -1e-9 <= found[2] <= 1 + 1e-9:
+            return False
+        ends.append(found)
+    (qa, ua, _), (qb, ub, _) = ends
+    if np.abs(np.asarray(ua) - np.asarray(ub)).max() > 1e-9 * max(1.0, float(np.abs(ua).max())):
+        return False
+    return _same(model, qa, qb, L, i)
+
+
+# --- resumes the fast pass made ---
+
+
+def unlabelled_resumes(model, U, p, L, Q, ok, events) -> list[dict]:
+    """"resume" events for the poses solved after a gap that have none yet (the compiled
+    pass went on from the last solved pose by itself), labelled as `resume_label` does."""
+    idx = np.flatnonzero(ok)
+    have = {e["pose"] for e in events if e["kind"] == "resume"}
+    out = []
+    for j, k in zip(idx[:-1], idx[1:]):
+        if k > j + 1 and int(k) not in have:
+            out.append({"kind": "resume", "pose": int(k)} | resume_label(model, U, p, L, j, Q[j], k, Q[k]))
+    return out
