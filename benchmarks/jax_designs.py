@@ -47,15 +47,18 @@ def fourbar():
 
 
 def timed(fn, repeat):
+    """(result, first call's wall time, median wall time, (min, max), median CPU time of
+    this process: on a shared machine the CPU time says what the work costs)."""
     t0 = time.perf_counter()
     out = fn()
     first = time.perf_counter() - t0
-    times = []
+    times, cpu = [], []
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         fn()
         times.append(time.perf_counter() - t0)
-    return out, first, statistics.median(times), (min(times), max(times))
+        cpu.append(time.process_time() - c0)
+    return out, first, statistics.median(times), (min(times), max(times)), statistics.median(cpu)
 
 
 def main(argv=None):
@@ -64,6 +67,7 @@ def main(argv=None):
     ap.add_argument("--poses", type=int, default=360)
     ap.add_argument("--repeat", type=int, default=3)
     a = ap.parse_args(argv)
+    load = os.getloadavg()[0]
     import jax
 
     from kincas.core.jax_backend import jax_designs
@@ -75,12 +79,10 @@ def main(argv=None):
     U = {"crank.angle": np.linspace(0, 2 * np.pi, n, endpoint=False)}
     m = fourbar()
     rows = []
-    r_c, first_c, med_c, spread_c = timed(lambda: kincas.sweep_designs(m, params, U, report=REPORT,
-                                                                        compile=True), a.repeat)
-    rows.append(("casadi, compiled C loop, %d threads" % os.cpu_count(), first_c, med_c, spread_c))
-    r_j, first_j, med_j, spread_j = timed(lambda: kincas.sweep_designs(m, params, U, report=REPORT,
-                                                                        backend="jax"), a.repeat)
-    rows.append(("jax (CPU backend), whole call", first_j, med_j, spread_j))
+    r_c, *t = timed(lambda: kincas.sweep_designs(m, params, U, report=REPORT, compile=True), a.repeat)
+    rows.append(("casadi, compiled C loop, %d threads" % os.cpu_count(), *t))
+    r_j, *t = timed(lambda: kincas.sweep_designs(m, params, U, report=REPORT, backend="jax"), a.repeat)
+    rows.append(("jax (CPU backend), whole call", *t))
 
     # the JAX pass alone, from the states the call starts from
     from kincas.analysis import designs_jax
@@ -96,8 +98,8 @@ def main(argv=None):
     job, todo, thr = states["job"], states["todo"], states["thr"]
     jd = jax_designs(job.model, tuple(job.report))
     run = lambda: jd.run(job.S[todo], job.U, job.P[todo], job.Ls[todo], job.Ud, job.Udd, thr)
-    (_, _, _, stops), first_p, med_p, spread_p = timed(run, a.repeat)
-    rows.append(("jax (CPU backend), the JAX pass alone", first_p, med_p, spread_p))
+    (_, _, _, stops), *t = timed(run, a.repeat)
+    rows.append(("jax (CPU backend), the JAX pass alone", *t))
 
     diff = max(float(np.nanmax(np.abs(r_c.values[q] - r_j.values[q]))) for q in REPORT)
     same = bool((r_c.code == r_j.code).all())
@@ -105,9 +107,13 @@ def main(argv=None):
              "", f"{nd:,} designs x {n} poses = {nd * n:,} poses of a four-bar; "
              f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores (shared), "
              f"jax {jax.__version__} on {jax.devices()[0].platform}; median of {a.repeat} after a first call.",
-             "", "| path | first call (s) | median (s) | spread (s) | per pose (ns) |", "|---|---|---|---|---|"]
-    for name, first, med, (lo, hi) in rows:
-        lines.append(f"| {name} | {first:.2f} | {med:.2f} | {lo:.2f}-{hi:.2f} | {med / (nd * n) * 1e9:.0f} |")
+             f"Load average before the run: {load:.1f} (other jobs share the cores: the CPU "
+             "time of this process is the steadier measure of the work).",
+             "", "| path | first call (s) | median wall (s) | spread (s) | wall per pose (ns) | CPU per pose (ns) |",
+             "|---|---|---|---|---|---|"]
+    for name, first, med, (lo, hi), cpu in rows:
+        lines.append(f"| {name} | {first:.2f} | {med:.2f} | {lo:.2f}-{hi:.2f} | {med / (nd * n) * 1e9:.0f} "
+                     f"| {cpu / (nd * n) * 1e9:.0f} |")
     lines += ["", f"Designs the JAX pass swept whole: {(stops == n).sum():,} of {len(stops):,}; "
               f"same statuses as the C path: {same}; largest difference of a value: {diff:.2g}."]
     text = "\n".join(lines) + "\n"

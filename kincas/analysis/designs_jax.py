@@ -27,14 +27,14 @@ BACKENDS = ("casadi", "jax")
 
 def jax_pass(job, todo, thresholds) -> np.ndarray:
     """The JAX pass over designs `todo` of a `sweep_designs` job (their first poses solved,
-    their kernel states in job.S): fills the accepted poses' unknowns, values and measures,
-    and returns each design's first rejected pose (n if none was)."""
+    their kernel states in job.S): fills the accepted poses' unknowns and values, and returns each design's first rejected pose (n if none was)."""
     todo = np.asarray(todo, dtype=int)
     jd = jax_designs(job.model, tuple(job.report))
-    Q, vals, info, stops = jd.run(job.S[todo], job.U, job.P[todo], job.Ls[todo], job.Ud, job.Udd,
-                                  thresholds)
-    for j, d in enumerate(todo):
-        k = stops[j]  # poses 1..k-1 accepted; k rejected (if < n)
-        job.Q[d, 1:k], job.vals[d, :, 1:k] = Q[j, 1:k], vals[j, :, 1:k]
-        job.code[d, 1:k], job.fast[d, 1:k] = 0, True  # 0: "ok"
+    # poses 1.. of each design written straight into the job's rows (NaN where not accepted)
+    stops = jd.run(job.S[todo], job.U, job.P[todo], job.Ls[todo], job.Ud, job.Udd, thresholds,
+                   out=(job.Q, job.vals, None), rows=todo)[3]
+    k = np.arange(job.U.shape[0])
+    acc = (k >= 1) & (k < stops[:, None])  # poses 1..stop-1 accepted; the stop rejected
+    job.code[todo] = np.where(acc, 0, job.code[todo])  # 0: "ok"
+    job.fast[todo] |= acc
     return stops

@@ -34,7 +34,9 @@ keeps 8 digits of 1.2345678e-9).
 """
 from __future__ import annotations
 
+import os
 import threading
+from concurrent.futures import ThreadPoolExecutor
 
 import casadi as ca
 import numpy as np
@@ -42,7 +44,8 @@ import numpy as np
 from ..errors import ModelError
 from .fast import sweeper_for
 
-CHUNK = 4096  # designs per jitted call at most (memory: chunk x poses x (nq + report))
+CPU_CHUNK = 1024  # designs per jitted call on a CPU (one chunk per core at a time)
+GPU_BYTES = 1 << 28  # results per jitted call on a GPU, about (designs x poses x (nq + report))
 MIN_CHUNK = 64  # designs are padded to a power of two from here: few shapes, few compiles
 
 
@@ -165,8 +168,9 @@ class JaxDesigns:
     `run(S, U, P, Ls, Ud, Udd, thr)` sweeps each design d from its kernel state S[d] (at pose
     0, laid out as `FastSweeper.state`) over the poses 1.. of U and returns (Q (nd, n, nq),
     values (nd, len(report), n), info (nd, 5, n), stops (nd,)): poses 1..stops[d]-1 of design
-    d accepted, the rest NaN (`info` holds the measures of every pose attempted). Safe from
-    several threads (jitted functions are).
+    d accepted, the rest NaN (`info`: the measures of INFO in kincas/core/fast.py). With
+    `out=(Q, values, info)` and `rows`, design d's poses 1.. are written into rows[d] of those
+    arrays instead (info None: not kept). Safe from several threads (jitted functions are).
     """
 
     def __init__(self, model, report=()):
@@ -213,7 +217,7 @@ class JaxDesigns:
                 s1 = jnp.concatenate([q, J, T, u, T0, u0])
                 keep = lambda a: jnp.where(ok, a, jnp.nan)
                 info = jnp.concatenate([rf, mc, it[None].astype(jnp.float64)])
-                return (jnp.where(ok, s1, s), ok), (keep(q), keep(y), info, ok)
+                return (jnp.where(ok, s1, s), ok), (keep(q), keep(y), keep(info), ok)
             _, out = lax.scan(pose, (s0, jnp.bool_(True)), (U, Ud, Udd))
             return out
 
@@ -229,29 +233,47 @@ class JaxDesigns:
             at += k * k
         return np.stack(out, axis=1) if out else np.zeros((len(S), 0))
 
-    def run(self, S, U, P, Ls, Ud, Udd, thr):
+    def run(self, S, U, P, Ls, Ud, Udd, thr, *, out=None, rows=None, workers: int | None = None):
         nd, n = S.shape[0], U.shape[0]
-        Q, vals = np.full((nd, n, self.nq), np.nan), np.full((nd, self.no, n), np.nan)
-        info, stops = np.full((nd, 5, n), np.nan), np.ones(nd, dtype=int)
+        if out is None:
+            out, rows = (np.full((nd, n, self.nq), np.nan), np.full((nd, self.no, n), np.nan),
+                         np.full((nd, 5, n), np.nan)), np.arange(nd)
+        Q, vals, info = out
+        stops = np.ones(nd, dtype=int)
         if nd == 0 or n < 2:
             return Q, vals, info, stops
         fn, sg = self._compiled(), self.signs(S)
         jax, _ = _jax()
         jnp = jax.numpy
-        with x64():
-            xs = [jnp.asarray(a[1:], dtype=jnp.float64) for a in (U, Ud, Udd)]
-            t = jnp.asarray(thr, dtype=jnp.float64)
-            for a in range(0, nd, CHUNK):
-                b = min(nd, a + CHUNK)
-                size = max(MIN_CHUNK, 1 << (b - a - 1).bit_length())  # padded: few shapes
-                pad = lambda x: np.concatenate([x[a:b], np.repeat(x[a:a + 1], size - (b - a), 0)])
+        cpu = jax.default_backend() == "cpu"
+        # On a CPU, chunks of CPU_CHUNK designs on every core (XLA runs one chunk on one
+        # core); on a GPU, chunks of about GPU_BYTES of results, one after the other.
+        per_design = 8 * n * (self.nq + self.no + 6)
+        chunk = CPU_CHUNK if cpu else max(MIN_CHUNK, GPU_BYTES // per_design)
+        workers = (workers or os.cpu_count() or 1) if cpu else 1
+
+        def part(a):
+            b = min(nd, a + chunk)
+            size = max(MIN_CHUNK, 1 << (b - a - 1).bit_length())  # padded: few shapes
+            pad = lambda x: np.concatenate([x[a:b], np.repeat(x[a:a + 1], size - (b - a), 0)])
+            with x64():  # per thread: the setting is thread-local
+                xs = [jnp.asarray(x[1:], dtype=jnp.float64) for x in (U, Ud, Udd)]
                 q, y, inf, ok = fn(*(jnp.asarray(pad(x), dtype=jnp.float64)
-                                     for x in (S, P, Ls.reshape(-1, 1), sg)), *xs, t)
-                w = b - a
-                Q[a:b, 1:] = np.asarray(q)[:w]
-                vals[a:b, :, 1:] = np.asarray(y)[:w].transpose(0, 2, 1)
-                info[a:b, :, 1:] = np.asarray(inf)[:w].transpose(0, 2, 1)
+                                     for x in (S, P, Ls.reshape(-1, 1), sg)), *xs,
+                                   jnp.asarray(thr, dtype=jnp.float64))
+                w, r = b - a, rows[a:b]
+                Q[r, 1:] = np.asarray(q)[:w]
+                vals[r, :, 1:] = np.asarray(y)[:w].transpose(0, 2, 1)
+                if info is not None:
+                    info[r, :, 1:] = np.asarray(inf)[:w].transpose(0, 2, 1)
                 stops[a:b] = 1 + np.asarray(ok)[:w].sum(axis=1)
+        starts = range(0, nd, chunk)
+        if workers > 1 and len(starts) > 1:
+            with ThreadPoolExecutor(workers) as ex:  # each writes its own rows
+                list(ex.map(part, starts))
+        else:
+            for a in starts:
+                part(a)
         return Q, vals, info, stops
 
 
