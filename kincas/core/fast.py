@@ -45,6 +45,7 @@ import numpy as np
 
 from .blocks import diagonal_size, numeric_signs
 from .compiled import CHUNK, Backend, Library, QuantityEvaluator, ptr, rows, table
+from .group_kernel import kernel_sizes
 from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, NEAR, RESIDUAL, STEP, SWEEP_C,
                      kernel_functions, state_function, vm_step)
 
@@ -170,10 +171,18 @@ class FastSweeper:
 
     @property
     def size(self) -> int:
-        """The kernel's size in casadi instructions (what compiling and running cost)."""
+        """The kernel's C code size in casadi instructions (what compiling costs: a
+        function shared by several Assur groups counts once, kincas/core/group_kernel.py)."""
         if self._size is None:
-            self._size = sum(fn.n_instructions() for fn in self.functions)
+            code, self._work = kernel_sizes(self.functions)
+            self._size = code  # set last: another thread reads _work once it sees _size
         return self._size
+
+    @property
+    def work(self) -> int:
+        """Instructions evaluated per kernel pass (what running it costs)."""
+        self.size
+        return self._work
 
     def worth_it(self, n: int) -> bool:
         """Whether the fast pass pays for n poses: compiled (when its size allows: a larger
@@ -181,7 +190,7 @@ class FastSweeper:
         careful path."""
         if self.backend.compile is not False and self.size > COMPILE_MAX:
             self.backend.compile = False
-        return self.backend.compiled(n) is not None or self.size <= VM_MAX
+        return self.backend.compiled(n) is not None or self.work <= VM_MAX
 
     @property
     def functions(self) -> list[ca.Function]:

@@ -190,7 +190,9 @@ class JaxDesigns:
     def _build(self):
         jax, _ = _jax()
         jnp, lax = jax.numpy, jax.lax
-        kP, kN, kF, kL = (to_jax(f) for f in self.sweeper.functions)
+        # a kernel written group by group (kincas/core/group_kernel.py) calls SX functions
+        # from MX ones: inlined into one SX function each for the translation
+        kP, kN, kF, kL = (to_jax(f.expand() if f.is_a("MXFunction") else f) for f in self.sweeper.functions)
         nq, nu, nj, max_evals = self.nq, self.nu, self.nj, self.sweeper.max_evals
         cuts = np.cumsum([nq, nj, nq * nu, nu, nq * nu]).tolist()
 

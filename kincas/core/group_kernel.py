@@ -1,0 +1,250 @@
+"""The fast kernel's Newton step and final evaluation written group by group, one small
+casadi function per kind of Assur group, so that its C code does not grow with the chain.
+
+`kincas/core/kernel.py` writes kN and kF as one expression over all unknowns: the arithmetic
+grows linearly with the number of groups, but the C compiler's time grows faster than the
+size of one function (gcc -O3 on 40 chained four-bars: 6 s of CPU). Here each group B gets
+the same arithmetic on its own unknowns x_B, given the unknowns z_B of the groups its
+equations hang on (their values, Newton steps dz_B and tangents T_z):
+
+    Newton step  dx_B = A^-1 (g_B - C dz_B)        (A = dg_B/dx_B, C = dg_B/dz_B)
+    tangent      T_B  = -A^-1 (g_B,u + C T_z)
+
+which is the block forward substitution of `kincas.core.blocks.block_solve`, so kN and kF
+compute the same numbers as the flat expressions (to rounding). Groups whose functions are
+the same expression up to the numbering of their inputs (every four-bar of a chain but the
+first) share one casadi function, code-generated once and called for each of them; kN and kF
+are then small MX functions that route vectors between those calls. The reported quantities
+are their own function (flat: a point far down a chain needs the whole chain's velocities).
+
+>>> import kincas
+>>> links = [kincas.Link.bar("crank", "O", "A", 1)]
+>>> for k in range(1, 6):
+...     links += [kincas.Link.bar(f"cp{k}", "A" if k == 1 else f"T{k - 1}", f"T{k}", 4),
+...               kincas.Link.bar(f"rk{k}", f"G{k}", f"T{k}", 1)]
+>>> m = kincas.Mechanism(ground={"O": (0, 0), **{f"G{k}": (4 * k, 0) for k in range(1, 6)}},
+...     links=links, inputs=[kincas.Input.angle("crank")])
+>>> model = kincas.compile(m)
+>>> kinds = GroupFunctions(model.sym, list(model.blocks))
+>>> len(model.blocks), len(kinds.newton_kinds)  # the first four-bars differ from the rest
+(5, 3)
+"""
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+from .blocks import _small_solve, block_measures
+from .structure import Block
+
+OPTS = {"cse": True}  # one sin and cos per angle within a group's function
+
+
+def _max_abs(v):
+    """max |v_i|, NaN if any v_i is (casadi's mmax skips NaNs; a sum keeps them)."""
+    return ca.mmax(ca.fabs(v)) + 0 * ca.sum1(v) if v.numel() else 0 * ca.sum1(v)
+
+
+class _Group:
+    """One group's inputs: own unknowns `cols`, the earlier unknowns `hang` its equations
+    use, the parameters `params` they use; its residual g in local symbols (x, z, u, p)
+    with its numeric constants lifted into one more symbol c (`values` holds them), and
+    `key`: equal for groups that differ only in those constants."""
+
+    def __init__(self, sym, blk: Block):
+        self.cols, rows = [int(j) for j in blk.cols], [int(i) for i in blk.rows]
+        gB = sym.g[rows]
+        own = set(self.cols)
+        used = sorted({int(c) for c in ca.jacobian(gB, sym.q).sparsity().get_col()})
+        self.hang = [j for j in used if j not in own]
+        self.params = sorted({int(c) for c in ca.jacobian(gB, sym.p).sparsity().get_col()})
+        n, m = len(self.cols), len(self.hang)
+        x, z = ca.SX.sym("x", n), ca.SX.sym("z", m)
+        u, p = ca.SX.sym("u", sym.nu), ca.SX.sym("p", len(self.params))
+        qv, pv = [ca.SX(0)] * sym.nq, [ca.SX(0)] * sym.np
+        for k, j in enumerate(self.cols):
+            qv[j] = x[k]
+        for k, j in enumerate(self.hang):
+            qv[j] = z[k]
+        for k, j in enumerate(self.params):
+            pv[j] = p[k]
+        old = [sym.q, sym.u, sym.p]
+        new = [ca.vertcat(*qv) if qv else ca.SX(0, 1), u, ca.vertcat(*pv) if pv else ca.SX(0, 1)]
+        keep = [k for k, v in enumerate(old) if v.numel()]
+        g = ca.substitute([gB], [old[k] for k in keep], [new[k] for k in keep])[0]
+        shape, self.values = _lift_constants(ca.Function("g", [x, z, u, p], [g]))
+        self.is_length = sym.is_length[self.cols]
+        self.key = (shape.serialize(), tuple(self.is_length))
+        self.x, self.z, self.u, self.p, self.c = shape.sx_in()
+        self.g = shape.call(shape.sx_in())[0]
+
+
+class GroupFunctions:
+    """Per group, the casadi functions of its Newton step and final evaluation, one per kind.
+
+    `newton_kinds` / `final_kinds`: the distinct functions; `kind[i]`: group i's index in
+    them. A kind is called with group i's inputs (`groups[i]`) and then its constants
+    (`groups[i].values`)."""
+
+    def __init__(self, sym, blocks):
+        self.sym, self.blocks = sym, blocks
+        self.groups = [_Group(sym, b) for b in blocks]
+        self.newton_kinds, self.final_kinds, self.kind, seen = [], [], [], {}
+        for grp in self.groups:
+            if grp.key not in seen:
+                seen[grp.key] = len(self.newton_kinds)
+                self.newton_kinds.append(self._newton(grp, f"gN{len(self.newton_kinds)}"))
+                self.final_kinds.append(self._final(grp, f"gF{len(self.final_kinds)}"))
+            self.kind.append(seen[grp.key])
+
+    @staticmethod
+    def _newton(grp, name):
+        """(x, z, dz, u, p, Lb, c) -> (dx, [max |g| / Lb, max |dx / D|])."""
+        dz, Lb = ca.SX.sym("dz", grp.z.numel()), ca.SX.sym("Lb")
+        A, C = ca.jacobian(grp.g, grp.x), ca.jacobian(grp.g, grp.z)
+        D = ca.if_else(ca.DM(grp.is_length.astype(float)), Lb, 1)
+        rhs = grp.g - ca.mtimes(C, dz) if grp.z.numel() else grp.g
+        dx = _small_solve(A, rhs)
+        rs = ca.vertcat(_max_abs(grp.g / Lb), _max_abs(dx / D))
+        return ca.Function(name, [grp.x, grp.z, dz, grp.u, grp.p, Lb, grp.c], [ca.densify(dx), rs], OPTS)
+
+    @staticmethod
+    def _final(grp, name):
+        """(x, z, dz, Tz, u, p, Lb, L, A0, xp, c) -> (A, T, rs, [change, correction],
+        [sign, sigma], dx): kF's measures for this group."""
+        n, m, nu = grp.x.numel(), grp.z.numel(), grp.u.numel()
+        dz, Tz, Lb, L = ca.SX.sym("dz", m), ca.SX.sym("Tz", m, nu), ca.SX.sym("Lb"), ca.SX.sym("L")
+        A0, xp = ca.SX.sym("A0", n * n), ca.SX.sym("xp", n)
+        A, C = ca.jacobian(grp.g, grp.x), ca.jacobian(grp.g, grp.z)
+        Gu = ca.jacobian(grp.g, grp.u)
+        isl = ca.DM(grp.is_length.astype(float))
+        D = ca.if_else(isl, Lb, 1)
+        cs = ca.if_else(isl, 1, 1 / L)  # columns to O(1): 1 (lengths), 1/L (angles)
+        dx = _small_solve(A, grp.g - ca.mtimes(C, dz) if m else grp.g)
+        T = -_small_solve(A, Gu + ca.mtimes(C, Tz) if m else Gu)
+        rs = ca.vertcat(_max_abs(grp.g / Lb), _max_abs(dx / D))
+        M = (_small_solve(ca.reshape(A0, n, n), A) - ca.DM.eye(n)) * ca.repmat(D.T, n, 1) / ca.repmat(D, 1, n)
+        change = ca.sum1(ca.sum2(ca.fabs(M)))
+        corr = ca.sum1(ca.fabs((grp.x - xp) / D))
+        sign, sigma = block_measures(A, cs, [Block(np.arange(n), np.arange(n), ())])
+        return ca.Function(name, [grp.x, grp.z, dz, Tz, grp.u, grp.p, Lb, L, A0, xp, grp.c],
+                           [ca.densify(ca.vec(A)), ca.densify(T), rs, ca.vertcat(change, corr),
+                            ca.vertcat(sign, sigma), ca.densify(dx)], OPTS)
+
+    # --- kN and kF: MX functions routing vectors between the groups' calls ---
+    def kernel(self, report_function):
+        """(kN, kF) with the signatures of `kernel_functions`' flat ones."""
+        sym, nq, nu = self.sym, self.sym.nq, self.sym.nu
+        q, u, p, Lb = ca.MX.sym("q", nq), ca.MX.sym("u", nu), ca.MX.sym("p", sym.np), ca.MX.sym("Lb", len(self.blocks))
+        L, ud, udd = ca.MX.sym("L"), ca.MX.sym("ud", nu), ca.MX.sym("udd", nu)
+        nj = sum(len(b.cols) ** 2 for b in self.blocks)
+        J0, qp = ca.MX.sym("J0", nj), ca.MX.sym("qp", nq)
+        pick = lambda v, idx: v[idx] if idx else ca.MX(0, 1)
+        rows = lambda parts, idx: ca.vertcat(*[parts[j] for j in idx]) if idx else ca.MX(0, 1)
+        # kN
+        dxs, r = [None] * nq, []
+        for i, (grp, kd) in enumerate(zip(self.groups, self.kind)):
+            f, c = self.newton_kinds[kd], ca.DM(grp.values)
+            dx, rs = f(pick(q, grp.cols), pick(q, grp.hang), rows(dxs, grp.hang), u, pick(p, grp.params), Lb[i], c)
+            for k, j in enumerate(grp.cols):
+                dxs[j] = dx[k]
+            r.append(rs)
+        step = ca.vertcat(*dxs) if nq else ca.MX(0, 1)
+        rs = _max_rows(r)
+        kN = ca.Function("kN", [q, u, p, Lb], [step, rs])
+        # kF
+        dxs, Ts, r, A, ch, co, sg, sig, at = [None] * nq, [None] * nq, [], [], [], [], [], [], 0
+        for i, (grp, kd) in enumerate(zip(self.groups, self.kind)):
+            f, c = self.final_kinds[kd], ca.DM(grp.values)
+            n = len(grp.cols)
+            Tz = ca.vertcat(*[Ts[j] for j in grp.hang]) if grp.hang else ca.MX(0, nu)
+            a, T, rs, mc, ms, dx = f(pick(q, grp.cols), pick(q, grp.hang), rows(dxs, grp.hang), Tz, u,
+                                     pick(p, grp.params), Lb[i], L, J0[at:at + n * n], pick(qp, grp.cols), c)
+            at += n * n
+            for k, j in enumerate(grp.cols):
+                dxs[j], Ts[j] = dx[k], T[k, :]
+            r.append(rs)
+            A.append(a)
+            ch.append(mc[0])
+            co.append(mc[1])
+            sg.append(ms[0])
+            sig.append(ms[1])
+        y = report_function(q, u, p, ud, udd) if report_function is not None else ca.MX(0, 1)
+        step = ca.vertcat(*dxs) if nq else ca.MX(0, 1)
+        T = ca.vertcat(*Ts) if nq else ca.MX(0, nu)
+        change = ca.mmax(ca.vertcat(0, *ch))
+        corr = ca.sum1(ca.vertcat(*co)) if co else ca.MX(0)
+        sigma = ca.mmin(ca.vertcat(*sig)) if sig else ca.MX(1)
+        kF = ca.Function("kF", [q, u, p, L, ud, udd, J0, qp, Lb],
+                         [ca.vertcat(*A) if A else ca.MX(0, 1), T, _max_rows(r), ca.vertcat(change, corr),
+                          ca.vertcat(*sg, sigma), y, step])
+        return kN, kF
+
+
+def kernel_sizes(functions) -> tuple[int, int]:
+    """(code, work) of casadi functions, in instructions: `code` counts each function once
+    however often it is called (what the C compiler sees), `work` counts every call (what
+    one evaluation costs, and what the virtual machine runs once the calls are inlined).
+
+    >>> import casadi as ca
+    >>> x = ca.MX.sym("x")
+    >>> f = ca.Function("f", [ca.SX.sym("y")], [ca.SX.sym("y") * 0 + 1])
+    >>> kernel_sizes([ca.Function("g", [x], [f(f(x))])])[1] > kernel_sizes([ca.Function("g", [x], [f(f(x))])])[0]
+    True
+    """
+    seen: set = set()
+
+    def count(f):
+        if not f.is_a("MXFunction"):
+            n = f.n_instructions()
+            new = f.name() not in seen
+            seen.add(f.name())
+            return (n if new else 0), n
+        code = work = 0
+        for i in range(f.n_instructions()):
+            if f.instruction_id(i) == ca.OP_CALL:
+                c, w = count(f.instruction_MX(i).which_function())
+                code, work = code + c, work + w
+            else:
+                code, work = code + 1, work + 1
+        return code, work
+    out = [count(f) for f in functions]
+    return sum(c for c, _ in out), sum(w for _, w in out)
+
+
+def _max_rows(parts):
+    """Entry-wise max of the [residual, step] pairs of every group (NaN kept)."""
+    if not parts:
+        return ca.MX.zeros(2)
+    M = ca.horzcat(*parts)
+    return ca.vertcat(ca.mmax(M[0, :]) + 0 * ca.sum2(M[0, :]), ca.mmax(M[1, :]) + 0 * ca.sum2(M[1, :]))
+
+
+def _lift_constants(f: ca.Function):
+    """(g, c): g(*f's inputs, c) == f(*f's inputs), every constant of f's instructions an
+    entry of the new last input c; the same operations in the same order, so g computes
+    f's numbers exactly."""
+    ins = f.sx_in()
+    consts, values, work, outs = [], [], {}, [[None] * f.nnz_out(k) for k in range(f.n_out())]
+    nz = [ca.vertsplit(ca.vec(a), 1) if a.numel() else [] for a in ins]
+    for i in range(f.n_instructions()):
+        op, o, ii = f.instruction_id(i), f.instruction_output(i), f.instruction_input(i)
+        if op == ca.OP_CONST:
+            c = ca.SX.sym(f"c{len(consts)}")
+            consts.append(c)
+            values.append(f.instruction_constant(i))
+            work[o[0]] = c
+        elif op == ca.OP_INPUT:
+            work[o[0]] = nz[ii[0]][ii[1]]
+        elif op == ca.OP_OUTPUT:
+            outs[o[0]][o[1]] = work[ii[0]]
+        elif len(ii) == 1:
+            work[o[0]] = ca.SX.unary(op, work[ii[0]])
+        else:
+            work[o[0]] = ca.SX.binary(op, work[ii[0]], work[ii[1]])
+    res = []
+    for k, col in enumerate(outs):
+        sp = f.sparsity_out(k)
+        res.append(ca.SX(sp, ca.vertcat(*[ca.SX(0) if v is None else v for v in col]) if col else ca.SX(0, 1)))
+    c = ca.vertcat(*consts) if consts else ca.SX(0, 1)
+    return ca.Function("g", [*ins, c], res), np.array(values, dtype=float)
