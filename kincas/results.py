@@ -31,7 +31,32 @@ def wrap_angle(a: np.ndarray) -> np.ndarray:
 
 @dataclass(repr=False)
 class Pose:
-    """One solved (or unsolved) pose: `pose["C.x"]` is a float (NaN when not solved)."""
+    """One solved (or unsolved) pose: `pose["C.x"]` is a float (NaN when not solved).
+
+    A pose is a container of names, as a `Sweep` is (inputs, then reported quantities).
+
+    Parameters
+    ----------
+    inputs : dict
+        The inputs' values (radians for angles).
+    status : str
+        "ok", or why the pose was not solved ("no assembly", ...).
+    flag : str or None
+        "limit", "change point" or "singular" at or near a singular position.
+    values : dict
+        The reported quantities.
+    residual : float
+        The loop-closure residual, relative to each group's size.
+
+    Examples
+    --------
+        >>> import kincas
+    >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
+    ...                      inputs=[kincas.Input.angle("crank")])
+    >>> pose = kincas.solve(m, {"crank.angle": 0.0}, report=["A.x"])
+    >>> pose.status, pose["A.x"], list(pose)
+    ('ok', 2.0, ['crank.angle', 'A.x'])
+    """
 
     inputs: dict[str, float]
     status: str
@@ -41,6 +66,13 @@ class Pose:
 
     @property
     def ok(self) -> bool:
+        """Whether the pose was solved (status "ok").
+
+        Examples
+        --------
+        >>> Pose({"crank.angle": 0.0}, "no assembly", None, {"C.x": float("nan")}, float("inf")).ok
+        False
+        """
         return self.status == "ok"
 
     def __getitem__(self, name: str) -> float:
@@ -69,6 +101,34 @@ class Sweep:
     position ("limit", "change point", "singular", else None). Values are radians for angles,
     whatever the scene's unit (`Scene.user_values` converts). `to_pandas()` and `to_xarray()`
     give the same data as a DataFrame or a Dataset (extra `kincas[data]`).
+
+    Parameters
+    ----------
+    inputs, rates, accelerations : dict
+        Per input, its values (and first and second time derivatives) at every pose.
+    status : sequence of str
+        Per pose, "ok" or why it was not solved.
+    flags : list
+        Per pose, "limit", "change point", "singular" or None.
+    values : dict
+        Per reported quantity, its values.
+    q, residual, iterations : numpy.ndarray
+        Per pose, the unknowns, the relative residual, Newton's iterations.
+    unknowns : list of str
+        The unknowns' names.
+    size : float
+        The mechanism's size.
+    events, info : list, dict
+        Singular positions met and resumptions; details of how the sweep was solved.
+
+    Examples
+    --------
+        >>> import kincas
+    >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
+    ...                      inputs=[kincas.Input.angle("crank")])
+    >>> sw = kincas.sweep(m, {"crank.angle": [0.0, 1.5707963267948966]}, report=["A.x", "A.y"])
+    >>> np.round(sw["A.y"], 12).tolist(), sw.ok.tolist(), list(sw)
+    ([0.0, 2.0], [True, True], ['crank.angle', 'A.x', 'A.y'])
     """
 
     inputs: dict[str, np.ndarray]
@@ -110,7 +170,21 @@ class Sweep:
         return iter([*self.inputs, *self.values])
 
     def keys(self) -> list[str]:
-        """The names: inputs, then reported quantities (so `dict(sweep)` works)."""
+        """The names: inputs, then reported quantities (so `dict(sweep)` works).
+
+        Returns
+        -------
+        list of str
+
+        Examples
+        --------
+        >>> import kincas
+        >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
+        ...                      inputs=[kincas.Input.angle("crank")])
+        >>> sw = kincas.sweep(m, {"crank.angle": [0.0, 1.5707963267948966]}, report=["A.x", "A.y"])
+        >>> sw.keys(), sorted(dict(sw))
+        (['crank.angle', 'A.x', 'A.y'], ['A.x', 'A.y', 'crank.angle'])
+        """
         return list(self)
 
     def __repr__(self) -> str:
@@ -124,7 +198,24 @@ class Sweep:
         return f"{n} pose{'s' if n != 1 else ''}, {good} solved" + (f", {n - good} not solved" if good < n else "")
 
     def summary_lines(self) -> list[str]:
-        """A few lines: poses, solved, flags, events, the inputs' ranges, the quantities."""
+        """A few lines: poses, solved, flags, events, the inputs' ranges, the quantities.
+
+        Returns
+        -------
+        list of str
+
+        Examples
+        --------
+        >>> import kincas
+        >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
+        ...                      inputs=[kincas.Input.angle("crank")])
+        >>> sw = kincas.sweep(m, {"crank.angle": [0.0, 1.5707963267948966]}, report=["A.x", "A.y"])
+        >>> for line in sw.summary_lines():
+        ...     print(line)
+        Sweep: 2 poses, 2 solved
+          input crank.angle: 0 to 1.5708
+          reported: A.x, A.y
+        """
         out = [f"Sweep: {self._counts()}"]
         bad = {str(s): int(c) for s, c in zip(*np.unique(self.status[~self.ok].astype(str), return_counts=True))}
         if bad:
@@ -150,26 +241,107 @@ class Sweep:
     # --- in the data tools (extra kincas[data]) ---
     def to_pandas(self, length: str = ""):
         """A DataFrame: one row per pose, the inputs as index, a column per quantity, then
-        `status` and `flag`; units (radians, and `length` if named) in `df.attrs["units"]`."""
+        `status` and `flag`; units (radians, and `length` if named) in `df.attrs["units"]`.
+
+        Parameters
+        ----------
+        length : str
+            The unit of lengths, recorded in the units ("" : none).
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Examples
+        --------
+        >>> import kincas
+        >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
+        ...                      inputs=[kincas.Input.angle("crank")])
+        >>> sw = kincas.sweep(m, {"crank.angle": [0.0, 1.5707963267948966]}, report=["A.x", "A.y"])
+        >>> df = sw.to_pandas("m")
+        >>> list(df.columns), df.attrs["units"]["A.x"]
+        (['A.x', 'A.y', 'status', 'flag'], 'm')
+        """
         from .frames import sweep_to_pandas
         return sweep_to_pandas(self, length)
 
     def to_xarray(self, length: str = ""):
         """A Dataset along the dimension `pose`: inputs as coordinates, each quantity a variable
-        with `attrs["units"]`, and `status`, `flag`, `ok`, `residual`."""
+        with `attrs["units"]`, and `status`, `flag`, `ok`, `residual`.
+
+        Parameters
+        ----------
+        length : str
+            The unit of lengths, recorded in the units ("" : none).
+
+        Returns
+        -------
+        xarray.Dataset
+
+        Examples
+        --------
+        >>> import kincas
+        >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
+        ...                      inputs=[kincas.Input.angle("crank")])
+        >>> sw = kincas.sweep(m, {"crank.angle": [0.0, 1.5707963267948966]}, report=["A.x", "A.y"])
+        >>> ds = sw.to_xarray("m")
+        >>> ds["A.x"].attrs["units"], ds.sizes["pose"]
+        ('m', 2)
+        """
         from .frames import sweep_to_xarray
         return sweep_to_xarray(self, length)
 
     @property
     def ok(self) -> np.ndarray:
-        """Boolean mask of the solved poses (the same as `status == "ok"`)."""
+        """Boolean mask of the solved poses (the same as `status == "ok"`).
+
+        Examples
+        --------
+        >>> import kincas
+        >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
+        ...                      inputs=[kincas.Input.angle("crank")])
+        >>> sw = kincas.sweep(m, {"crank.angle": [0.0, 1.5707963267948966]}, report=["A.x", "A.y"])
+        >>> sw.ok.tolist(), (sw.status == "ok").tolist()
+        ([True, True], [True, True])
+        """
         return np.asarray(self.status == "ok", dtype=bool).reshape(len(self.status))
 
     @property
     def names(self) -> list[str]:
+        """The reported quantities' names (without the inputs).
+
+        Examples
+        --------
+        >>> import kincas
+        >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
+        ...                      inputs=[kincas.Input.angle("crank")])
+        >>> sw = kincas.sweep(m, {"crank.angle": [0.0, 1.5707963267948966]}, report=["A.x", "A.y"])
+        >>> sw.names
+        ['A.x', 'A.y']
+        """
         return list(self.values)
 
     def pose(self, i: int) -> Pose:
+        """Pose i of the sweep.
+
+        Parameters
+        ----------
+        i : int
+
+        Returns
+        -------
+        Pose
+
+        Examples
+        --------
+        >>> import kincas
+        >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
+        ...                      inputs=[kincas.Input.angle("crank")])
+        >>> sw = kincas.sweep(m, {"crank.angle": [0.0, 1.5707963267948966]}, report=["A.x", "A.y"])
+        >>> p = sw.pose(1)
+        >>> p.status, round(p["A.y"], 12)
+        ('ok', 2.0)
+        """
         return Pose(inputs={k: float(v[i]) for k, v in self.inputs.items()},
                     status=str(self.status[i]), flag=self.flags[i],
                     values={k: float(v[i]) for k, v in self.values.items()},

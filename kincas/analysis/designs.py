@@ -208,7 +208,19 @@ def sweep_designs(m: Mechanism, params, inputs=None, *, names=None, rates=None,
 
     Examples
     --------
-    See the module's text.
+    Two crank lengths a; at crank angle 0 and pi, B and C lie on the ground line, where
+    C.x = +-a + (3.5^2 - 3^2 + r^2) / (2 r), r = 4 -+ a:
+
+    >>> import numpy as np, kincas
+    >>> m = kincas.Mechanism(parameters={"a": 1.0}, ground={"A": (0, 0), "D": (4, 0)},
+    ...     links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", 3.5),
+    ...            kincas.Link.bar("rocker", "D", "C", 3)],
+    ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+    >>> r = sweep_designs(m, {"a": [0.9, 1.1]}, {"crank.angle": [0.0, np.pi]}, report=["C.x"])
+    >>> exact = [[a + (3.25 + (4 - a) ** 2) / (2 * (4 - a)), -a + (3.25 + (4 + a) ** 2) / (2 * (4 + a))]
+    ...          for a in (0.9, 1.1)]
+    >>> r.design_ok.tolist(), bool(np.abs(r.values["C.x"] - exact).max() < 1e-12)
+    ([True, True], True)
     """
     if gaps not in ("stop", "resume"):
         raise ModelError(f"gaps: {gaps!r} is neither \"stop\" nor \"resume\"")
@@ -293,10 +305,9 @@ class _Job:
             a, b = part
             stops[a:b] = self.kernel.full(lib, self.U, self.P[a:b], self.Ls[a:b], q0, p0, L0,
                                           self.Q[a:b], self.vals[a:b], self.Ud, self.Udd, thr)
-            for d in range(a, b):  # what the loop left (rare): on the careful path
-                if 0 < stops[d] < n:
-                    self.code[d, :stops[d]], self.fast[d, :stops[d]] = OK, True
-                    self._finish(lib, d, int(stops[d]))
+            for d in a + np.flatnonzero((stops[a:b] > 0) & (stops[a:b] < n)):  # rare: careful
+                self.code[d, :stops[d]], self.fast[d, :stops[d]] = OK, True
+                self._finish(lib, int(d), int(stops[d]))
             self._news(int(np.sum(stops[a:b] > 0)))
         if workers > 1 and len(parts) > 1:
             with ThreadPoolExecutor(workers) as ex:

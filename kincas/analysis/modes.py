@@ -93,6 +93,34 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
 
     Deterministic for a given `seed`. Modes are sorted by their points (x, then y, of each
     moving point in declaration order); an empty list means no assembly was found.
+
+    Parameters
+    ----------
+    m : Mechanism
+    inputs : dict or float, optional
+        Input key -> value; a number for a one-input mechanism.
+    starts : int
+        Scattered starting points of Newton.
+    seed : int
+    iterations : int
+        Newton iterations per start.
+
+    Returns
+    -------
+    list of Mode
+
+    Examples
+    --------
+    A four-bar has two assemblies, mirror images about the line BD:
+
+    >>> import numpy as np, kincas
+    >>> m = kincas.Mechanism(parameters={"a": 1.0}, ground={"A": (0, 0), "D": (4, 0)},
+    ...     links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", 3.5),
+    ...            kincas.Link.bar("rocker", "D", "C", 3)],
+    ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+    >>> modes = find_modes(m, {"crank.angle": 0.5})
+    >>> [round(md.points["C"][1], 6) for md in modes], [md.from_guess for md in modes]
+    ([-2.610429, 2.933719], [False, True])
     """
     if starts < 1:
         raise ModelError(f"starts: expected a whole number >= 1, got {starts!r}")

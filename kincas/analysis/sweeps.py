@@ -61,6 +61,41 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     Each solved pose gets a flag where it sits at or next to a singular position ("limit",
     "change point", "singular"); `Sweep.events` lists those positions with their input values
     located exactly, and where a sweep resumed after poses with no assembly, on which branch.
+
+    Parameters
+    ----------
+    m : Mechanism
+    inputs : dict or array_like
+        Input key -> values (radians for angles); an array for a one-input mechanism.
+    rates, accelerations, jerks : dict, optional
+        Input key -> the input's time derivatives (a number or one per pose).
+    report : list of str, optional
+        Quantity names (docs/scene-format.md).
+    guess : dict, optional
+        Point -> (x, y), overriding the mechanism's guess.
+    progress : callable, optional
+        progress(done, total).
+    method : {"fast", "careful"}
+    compile : bool, optional
+
+    Returns
+    -------
+    Sweep
+        Values per pose; poses not solved have a status saying why and NaN values.
+
+    Examples
+    --------
+    At crank angle 0 and pi, B and C lie on the ground line: C.x = +-1 + (3.5^2 - 3^2 + r^2)
+    / (2 r) with r = |BD| = 3 and 5.
+
+    >>> import numpy as np, kincas
+    >>> m = kincas.Mechanism(parameters={"a": 1.0}, ground={"A": (0, 0), "D": (4, 0)},
+    ...     links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", 3.5),
+    ...            kincas.Link.bar("rocker", "D", "C", 3)],
+    ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+    >>> sw = kincas.sweep(m, {"crank.angle": np.linspace(0, 2 * np.pi, 361)}, report=["C.x"])
+    >>> sw.ok.all(), round(float(sw["C.x"][0]), 12), round(float(sw["C.x"][180]), 12)
+    (np.True_, 3.041666666667, 1.825)
     """
     model = _model_of(m)
     report = list(default_report(m) if report is None else report)
@@ -186,7 +221,41 @@ def _measures(model: Model, J, ok, L):
 
 def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,
           guess=None, jerks=None) -> Pose:
-    """Solve one pose (inputs: key -> value, or a value for a one-input mechanism)."""
+    """Solve one pose (inputs: key -> value, or a value for a one-input mechanism).
+
+    Parameters
+    ----------
+    m : Mechanism
+    inputs : dict or float
+        Input key -> value (radians for angles); a number for a one-input mechanism.
+    rates, accelerations, jerks : dict, optional
+        Input key -> the input's time derivatives.
+    report : list of str, optional
+        Quantity names (docs/scene-format.md).
+    guess : dict, optional
+        Point -> (x, y), overriding the mechanism's guess.
+
+    Returns
+    -------
+    Pose
+        Its status is "ok" or why it was not solved (its values then NaN).
+
+    Examples
+    --------
+    At crank angle pi/2, B = (0, 1), and C is where the circles of radius 3.5 about B and 3
+    about D meet:
+
+    >>> import numpy as np, kincas
+    >>> m = kincas.Mechanism(parameters={"a": 1.0}, ground={"A": (0, 0), "D": (4, 0)},
+    ...     links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", 3.5),
+    ...            kincas.Link.bar("rocker", "D", "C", 3)],
+    ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+    >>> pose = kincas.solve(m, {"crank.angle": np.pi / 2}, report=["C.x", "C.y"])
+    >>> pose.status, bool(abs(np.hypot(pose["C.x"], pose["C.y"] - 1) - 3.5) < 1e-12)
+    ('ok', True)
+    >>> kincas.solve(m, {"crank.angle": 0.0}, report=["C.x"]).status  # a 3 m rocker is fine
+    'ok'
+    """
     return sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
                  guess=guess, jerks=jerks).pose(0)
 

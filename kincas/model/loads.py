@@ -44,6 +44,21 @@ class Load:
     together when it is longer than its free length and pushes them apart when shorter.
     `at` is the point (force) or the link (torque); `value` the force vector or the torque.
 
+    Parameters
+    ----------
+    kind : str
+        "force", "torque" or "spring" (better made by the class methods below).
+    at : str
+        The point of a force, the link of a torque.
+    value : float, str or (fx, fy)
+        The torque, or the force vector; numbers or parameter names.
+    points : (str, str)
+        A spring's two points.
+    stiffness, free_length : float or str
+        A spring's stiffness and free length.
+
+    Examples
+    --------
     >>> Load.torque("crank", -3.0).value
     -3.0
     """
@@ -57,19 +72,75 @@ class Load:
 
     @classmethod
     def force(cls, point: str, force) -> "Load":
+        """A force at a point, in global axes.
+
+        Parameters
+        ----------
+        point : str
+        force : (fx, fy)
+            Numbers or parameter names.
+
+        Returns
+        -------
+        Load
+
+        Examples
+        --------
+        >>> Load.force("C", (0, -9.81)).value
+        (0, -9.81)
+        """
         fx, fy = force
         return cls("force", at=point, value=(fx, fy))
 
     @classmethod
     def torque(cls, link: str, torque) -> "Load":
+        """A torque on a link, counter-clockwise positive.
+
+        Parameters
+        ----------
+        link : str
+        torque : float or str
+
+        Returns
+        -------
+        Load
+
+        Examples
+        --------
+        >>> Load.torque("rocker", "T").at
+        'rocker'
+        """
         return cls("torque", at=link, value=torque)
 
     @classmethod
     def spring(cls, a: str, b: str, stiffness, free_length) -> "Load":
+        """A linear spring between points a and b: tension stiffness * (|ab| - free_length).
+
+        Parameters
+        ----------
+        a, b : str
+        stiffness, free_length : float or str
+
+        Returns
+        -------
+        Load
+
+        Examples
+        --------
+        >>> Load.spring("A", "P", 200, 40).stiffness
+        200
+        """
         return cls("spring", points=(a, b), stiffness=stiffness, free_length=free_length)
 
     @property
     def link(self) -> str:
+        """The link of a torque ("" for a force or a spring).
+
+        Examples
+        --------
+        >>> Load.torque("crank", 1).link, Load.force("B", (1, 0)).link
+        ('crank', '')
+        """
         return self.at if self.kind == "torque" else ""
 
 

@@ -22,154 +22,19 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field, replace
-from typing import Iterable, Mapping, Union
+from typing import Iterable, Mapping
 
 from ..errors import ModelError
 from . import joints as _joints
-from .loads import Inertia, Load, check_loads
+from .loads import Load, check_loads
+from .parts import Input, Link, Num, Param, Slide, _pair, as_param  # noqa: F401  (the parts; their old home)
 
-# --- numbers that may name a parameter ---
-
-
-@dataclass(frozen=True)
-class Param:
-    """A reference to a named parameter, times a fixed factor (degrees -> radians, say)."""
-
-    name: str
-    scale: float = 1.0
-
-
-Num = Union[float, int, str, Param]
 GROUND = "ground"
 # How a mechanism whose count falls short learns its redundant equations: kincas.core
 # installs its rank test here when it is imported (declarations never import the solver).
 _rank_decision = None
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
 NAME_RULE = "a name starts with an ASCII letter or _, then ASCII letters, digits, _ or -"
-
-
-def as_param(v: Num) -> Param | None:
-    """The parameter a number refers to, or None for a plain number."""
-    if isinstance(v, Param):
-        return v
-    if isinstance(v, str):
-        return Param(v)
-    return None
-
-
-def _pair(v) -> tuple[Num, Num]:
-    x, y = v
-    return (x, y)
-
-
-# --- bodies, slides, inputs ---
-
-
-@dataclass(frozen=True)
-class Link:
-    """A rigid body carrying named points, given in its own frame.
-
-    `Link.bar(name, P, Q, length)` is the two-point form: origin at P, x axis towards Q.
-    `Link(name, {"A": (0, 0), "E": (550, 0)})` is the local-coordinates form; the link's
-    angle is the angle of its frame's x axis. Optional `mass`, `inertia` (about the centre
-    of gravity) and `cg` (in the link's frame; default the mean of its points) give its
-    inertia for efforts and shaking forces (kincas/model/loads.py).
-
-    >>> Link.bar("rod", "E", "F", 360).local("F")
-    (360, 0.0)
-    """
-
-    name: str
-    points: tuple[tuple[str, tuple[Num, Num]], ...]
-    two_point: bool = False
-    inertial: Inertia = Inertia()
-
-    def __init__(self, name: str, points, two_point: bool = False, *, mass: Num = 0.0,
-                 inertia: Num = 0.0, cg=None):
-        items = points.items() if isinstance(points, Mapping) else points
-        object.__setattr__(self, "name", name)
-        object.__setattr__(self, "points", tuple((p, _pair(xy)) for p, xy in items))
-        object.__setattr__(self, "two_point", two_point)
-        object.__setattr__(self, "inertial", Inertia(mass, inertia, None if cg is None else _pair(cg)))
-
-    @classmethod
-    def bar(cls, name: str, p: str, q: str, length: Num, **inertia) -> "Link":
-        """Two-point link P-Q of the given length (a number or a parameter name)."""
-        return cls(name, ((p, (0.0, 0.0)), (q, (length, 0.0))), two_point=True, **inertia)
-
-    @property
-    def point_names(self) -> tuple[str, ...]:
-        return tuple(p for p, _ in self.points)
-
-    def local(self, point: str) -> tuple[Num, Num]:
-        return dict(self.points)[point]
-
-
-@dataclass(frozen=True)
-class Slide:
-    """`point` stays on a line of body `along` (a link's name or "ground").
-
-    The line passes through `through` at `angle` (radians), both in that body's frame;
-    the default is the body's x axis. The slide's coordinate `s` is the signed distance
-    along the line from `through` to the point.
-
-    >>> Slide("F", "ground", through=(700, 0), angle=math.pi / 2, name="guide").name
-    'guide'
-    """
-
-    point: str
-    along: str
-    through: tuple[Num, Num] = (0.0, 0.0)
-    angle: Num = 0.0
-    name: str = ""
-
-    def __post_init__(self):
-        object.__setattr__(self, "through", _pair(self.through))
-        if not self.name:
-            object.__setattr__(self, "name", self.point)
-
-
-@dataclass(frozen=True)
-class Input:
-    """What drives the mechanism: a link's absolute angle, a slide's coordinate, or a parameter.
-
-    >>> Input.angle("crank").key, Input.slide("guide").key, Input.parameter("stroke").key
-    ('crank.angle', 'guide.s', 'stroke')
-    """
-
-    kind: str  # "angle" | "slide" | "parameter"
-    target: str
-
-    @classmethod
-    def angle(cls, link: str) -> "Input":
-        """The absolute angle of a link, or with "A/B" the angle of link A relative to body B
-        (a motor on B turning A; key "A/B.angle")."""
-        return cls("angle", link)
-
-    @classmethod
-    def relative(cls, link: str, body: str) -> "Input":
-        """The angle of `link` relative to `body`: `Input.angle("link/body")`.
-
-        >>> Input.relative("forearm", "upper").key
-        'forearm/upper.angle'
-        """
-        return cls("angle", f"{link}/{body}")
-
-    @classmethod
-    def slide(cls, slide: str) -> "Input":
-        return cls("slide", slide)
-
-    @classmethod
-    def parameter(cls, name: str) -> "Input":
-        return cls("parameter", name)
-
-    @property
-    def key(self) -> str:
-        return {"angle": f"{self.target}.angle", "slide": f"{self.target}.s"}.get(self.kind, self.target)
-
-    @property
-    def is_angle(self) -> bool:
-        return self.kind == "angle"
 
 
 # --- the structure of the chain: a spanning tree of revolute joints ---
@@ -238,6 +103,36 @@ class Mechanism:
 
     Every problem found is gathered into one `ModelError`. Changing anything returns a new
     mechanism (`with_parameters`, `with_guess`, `dataclasses.replace`).
+
+    Parameters
+    ----------
+    parameters : dict
+        Named numbers that other fields may refer to by name.
+    ground : dict
+        Ground points: name -> (x, y).
+    links, slides, inputs : sequence
+        Of `Link`, `Slide` and `Input`.
+    guess : dict
+        Approximate positions of moving points: they pick the assembly branch.
+    gears, racks, cams : sequence
+        Of kincas.model.joints.Gear, Rack and Cam.
+    gravity : (float, float)
+        The acceleration of gravity (for efforts).
+    loads : sequence
+        Of `Load`.
+
+    Examples
+    --------
+    >>> m = Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+    ...     links=[Link.bar("crank", "A", "B", 1), Link.bar("coupler", "B", "C", 3.5),
+    ...            Link.bar("rocker", "D", "C", 3)],
+    ...     inputs=[Input.angle("crank")], guess={"C": (3.6, 2.9)})
+    >>> m.mobility, m.moving_points
+    (1, ('B', 'C'))
+    >>> Mechanism(ground={"A": (0, 0)}, links=[Link.bar("crank", "A", "B", 1)])
+    Traceback (most recent call last):
+    ...
+    kincas.errors.ModelError: [inputs]: the mechanism has 1 degree(s) of freedom (1 unknown coordinates, 0 equations) but 0 input(s) drive it; give one input per degree of freedom
     """
 
     parameters: tuple[tuple[str, float], ...] = ()
@@ -283,7 +178,15 @@ class Mechanism:
         """Equations implied by the others (redundant joints): 0 where counting gives as many
         freedoms as inputs; otherwise decided by the constraint Jacobian's rank at an
         assembly near the guess (kincas.core.redundant, run once per mechanism), which
-        raises `ModelError` if the inputs are genuinely wrong in number."""
+        raises `ModelError` if the inputs are genuinely wrong in number.
+
+        Examples
+        --------
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m.redundant
+        0
+        """
         if not needs_rank_test(self):
             return 0
         if _rank_decision is None:  # pragma: no cover - kincas/__init__ installs it
@@ -292,39 +195,154 @@ class Mechanism:
 
     @property
     def param_values(self) -> dict[str, float]:
+        """The parameters as a dict: name -> value.
+
+        Examples
+        --------
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m.param_values
+        {'r': 2.0}
+        """
         return dict(self.parameters)
 
     def parameter(self, name: str) -> float:
+        """A parameter's value.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        float
+
+        Examples
+        --------
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m.parameter("r")
+        2.0
+        """
         return self.param_values[name]
 
     def link(self, name: str) -> Link:
+        """The link of that name.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        Link
+
+        Examples
+        --------
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m.link("crank").point_names
+        ('O', 'A')
+        """
         return {lk.name: lk for lk in self.links}[name]
 
     def slide(self, name: str) -> Slide:
+        """The slide of that name.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        Slide
+
+        Examples
+        --------
+        >>> m = Mechanism(ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", 1), Link.bar("rod", "A", "B", 3)],
+        ...     slides=[Slide("B", "ground", name="guide")], inputs=[Input.angle("crank")])
+        >>> m.slide("guide").point
+        'B'
+        """
         return {s.name: s for s in self.slides}[name]
 
     @property
     def ground_points(self) -> tuple[str, ...]:
+        """The ground points' names, in declaration order.
+
+        Examples
+        --------
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m.ground_points
+        ('O',)
+        """
         return tuple(g for g, _ in self.ground)
 
     @property
     def moving_points(self) -> tuple[str, ...]:
-        """Points carried by links and not fixed to the ground, in declaration order."""
+        """Points carried by links and not fixed to the ground, in declaration order.
+
+        Examples
+        --------
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m.moving_points
+        ('A',)
+        """
         seen = dict.fromkeys(p for lk in self.links for p in lk.point_names)
         return tuple(p for p in seen if p not in dict(self.ground))
 
     @property
     def mobility(self) -> int:
-        """Degrees of freedom counted from the structure (unknowns minus equations)."""
+        """Degrees of freedom counted from the structure (unknowns minus equations).
+
+        Examples
+        --------
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m.mobility
+        1
+        """
         return self.structure.mobility
 
     def value(self, v: Num) -> float:
-        """The number `v`, resolving a parameter reference."""
+        """The number `v`, resolving a parameter reference.
+
+        Parameters
+        ----------
+        v : float, str or Param
+
+        Returns
+        -------
+        float
+
+        Examples
+        --------
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m.value("r"), m.value(Param("r", 0.5)), m.value(3)
+        (2.0, 1.0, 3.0)
+        """
         p = as_param(v)
         return float(v) if p is None else p.scale * self.param_values[p.name]
 
     def size(self) -> float:
-        """The mechanism's characteristic length: tolerances are relative to it."""
+        """The mechanism's characteristic length: the largest distance between two points of
+        a link or two ground points (1 if there is none).
+
+        Returns
+        -------
+        float
+
+        Examples
+        --------
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m.size()
+        2.0
+        """
         pts = [(self.value(x), self.value(y)) for _, (x, y) in self.ground]
         extent = 0.0
         for lk in self.links:
@@ -346,14 +364,48 @@ class Mechanism:
 
     # --- new values ---
     def with_parameters(self, **values: float) -> "Mechanism":
-        """A new mechanism with some parameters changed."""
+        """A new mechanism with some parameters changed.
+
+        Parameters
+        ----------
+        **values : float
+            New values of existing parameters.
+
+        Returns
+        -------
+        Mechanism
+
+        Examples
+        --------
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m.with_parameters(r=3).size(), m.size()
+        (3.0, 2.0)
+        """
         unknown = [k for k in values if k not in self.param_values]
         if unknown:
             raise ModelError([f"[parameters] {k}: no such parameter" for k in unknown])
         return replace(self, parameters={**self.param_values, **{k: float(v) for k, v in values.items()}})
 
     def with_guess(self, **points: tuple[float, float]) -> "Mechanism":
-        """A new mechanism whose guess (which picks the assembly branch) is updated."""
+        """A new mechanism whose guess (which picks the assembly branch) is updated.
+
+        Parameters
+        ----------
+        **points : (float, float)
+            Approximate positions of moving points.
+
+        Returns
+        -------
+        Mechanism
+
+        Examples
+        --------
+        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
+        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
+        >>> m.with_guess(A=(0, 2)).guess
+        (('A', (0, 2)),)
+        """
         return replace(self, guess={**dict(self.guess), **points})
 
 

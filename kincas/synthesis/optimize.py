@@ -152,7 +152,50 @@ def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, con
 
     `data` gives named arrays, one value per sample, for the expressions. `deg`: quantities,
     data and trigonometric functions in the expressions use degrees for angles (the scene
-    convention); radians otherwise."""
+    convention); radians otherwise.
+
+    Parameters
+    ----------
+    m : Mechanism
+        The initial design; its guess picks the assembly branch kept at every sample.
+    samples : dict or Curve
+        Input key -> values of the samples; or target points (`kincas.curve.Curve`).
+    vary : dict
+        Parameter name -> (low, high).
+    minimize : str, optional
+        The objective (kincas/synthesis/expressions.py).
+    constraints : sequence
+        Constraint, dict {expr, min, max} or tuple (expr, min, max).
+    data : dict, optional
+        Named arrays, one value per sample.
+    rates, accelerations : dict, optional
+        As for `kincas.sweep`.
+    deg : bool
+        Angles in degrees in the expressions.
+    check_path : bool
+        Sweep the optimised design through the samples to check its branch.
+    max_iter, tol : int, float
+        IPOPT's iterations and tolerance.
+
+    Returns
+    -------
+    OptimizeResult
+        `ok` only if IPOPT converged and every check passed; otherwise `problems` says why.
+
+    Examples
+    --------
+    At crank angle 90 deg, B = (0, 1); C.y = 2.5 puts C at (sqrt(10), 2.5), so the rocker
+    from D = (4, 0) is c = sqrt((sqrt(10) - 4)^2 + 2.5^2):
+
+    >>> import numpy as np, kincas
+    >>> m = kincas.Mechanism(parameters={"c": 3.0}, ground={"A": (0, 0), "D": (4, 0)},
+    ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+    ...            kincas.Link.bar("rocker", "D", "C", "c")],
+    ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+    >>> r = optimize(m, {"crank.angle": [np.pi / 2]}, vary={"c": (2.0, 4.0)}, minimize="sum((C.y - 2.5)^2)")
+    >>> r.ok, round(r.parameters["c"], 9), round(float(np.hypot(np.sqrt(10) - 4, 2.5)), 9)
+    (True, 2.636622597, 2.636622597)
+    """
     first = _once(m, samples, vary, minimize, constraints, data, rates, accelerations, deg,
                   check_path, max_iter, tol)
     r, rounds = first, 1
