@@ -34,7 +34,7 @@ from ..core.tolerances import ACCEPT
 WIDE = 2  # a group with more unknowns than this has more assemblies than block signs
 SAME = 1e-6  # two assemblies are one when every unknown agrees to this (lengths over L)
 DEPTH = 10  # halvings of one input step while carrying groups through a gap
-BUDGET = 600  # Newton solves spent carrying groups through one gap
+BUDGET = 200  # Newton solves spent carrying groups across one input step of a gap
 
 REASON = ("its assemblies of one sign are told apart neither by continuation (it has no "
           "assembly in the gap) nor by a limit it left and came back through")
