@@ -19,8 +19,8 @@ from .model import Input, Link, Load, Mechanism, Param, Slide
 from .results import Pose, Sweep
 from .core.numeric import compile, model_of
 from .analysis.sweeps import solve, sweep
-from .analysis.designs import sweep_designs
-from .synthesis.study import study
+# sweep_designs and study are loaded on first use (kincas._aliases): `kincas solve` and
+# plain sweeps do not pay for their imports (thread pools, logging, dask hooks)
 
 _aliases.install()  # `import kincas.modes` and other paths of the flat 0.1 layout
 

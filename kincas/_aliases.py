@@ -50,7 +50,8 @@ def install() -> None:
 # functions exported from `kincas`, loaded on first use (`kincas.optimize` is the module of
 # 0.1's path and, being callable, the function too: see synthesis/optimize.py)
 FUNCTIONS = {"sensitivities": "analysis.sensitivity", "analyse": "analysis.tolerance",
-             "find_modes": "analysis.modes", "input_range": "analysis.singular"}
+             "find_modes": "analysis.modes", "input_range": "analysis.singular",
+             "sweep_designs": "analysis.designs", "study": "synthesis.study"}
 
 
 def attribute(name: str):

@@ -305,10 +305,9 @@ class _Job:
             a, b = part
             stops[a:b] = self.kernel.full(lib, self.U, self.P[a:b], self.Ls[a:b], q0, p0, L0,
                                           self.Q[a:b], self.vals[a:b], self.Ud, self.Udd, thr)
-            for d in range(a, b):  # what the loop left (rare): on the careful path
-                if 0 < stops[d] < n:
-                    self.code[d, :stops[d]], self.fast[d, :stops[d]] = OK, True
-                    self._finish(lib, d, int(stops[d]))
+            for d in a + np.flatnonzero((stops[a:b] > 0) & (stops[a:b] < n)):  # rare: careful
+                self.code[d, :stops[d]], self.fast[d, :stops[d]] = OK, True
+                self._finish(lib, int(d), int(stops[d]))
             self._news(int(np.sum(stops[a:b] > 0)))
         if workers > 1 and len(parts) > 1:
             with ThreadPoolExecutor(workers) as ex:

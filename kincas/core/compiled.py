@@ -220,7 +220,9 @@ class Backend:
 
     compile=True: compile when first needed; False (or $KINCAS_NO_COMPILE): never; None:
     compile when the library is already cached or a call has COMPILE_MIN_POSES poses or
-    more. `make_library()` builds the `Library` (code generation only) when first asked.
+    more, or in the background once `start()` is called (repeated use: the caller decides),
+    the virtual machine serving meanwhile. `make_library()` builds the `Library` (code
+    generation only) when first asked.
 
     >>> Backend(False, None, "nothing").compiled(10**6) is None
     True
@@ -232,6 +234,41 @@ class Backend:
         self.lib: ctypes.CDLL | None = None
         self.failed = False
         self._lock = threading.Lock()
+        self._thread: threading.Thread | None = None  # a compile in the background
+
+    def start(self) -> None:
+        """With compile=None, compile and load the library in a background thread (the C
+        compiler runs outside the GIL); `compiled` answers None (the virtual machine) until
+        it is loaded, and `Library.load` never loads a half-written file. Code generation is
+        done here, in the caller's thread; nothing happens if compiling is off, failed,
+        done or under way. The thread is not a daemon: a process ending meanwhile waits for
+        the compiler, and the next process finds the library cached."""
+        if self._thread is not None or self.lib is not None or self.failed or self.compile is not None \
+                or compiling_disabled():
+            return
+        with self._lock:
+            if self._thread is not None or self.lib is not None or self.failed:
+                return
+            try:
+                if self.library is None:
+                    self.library = self.make_library()
+            except Exception as e:
+                return self._failed(e)
+            self._thread = threading.Thread(target=self._load, name=f"kincas compile {self.what}")
+            self._thread.start()
+
+    def _load(self) -> None:
+        try:
+            lib = self.library.load()
+        except Exception as e:
+            self._failed(e)
+        else:
+            self.lib = lib  # one assignment: other threads see None or the loaded library
+
+    def _failed(self, e) -> None:
+        self.failed = True
+        warnings.warn(f"kincas: could not compile the {self.what} ({e}); using the slower "
+                      f"uncompiled path", RuntimeWarning, stacklevel=4)
 
     def compiled(self, n: int) -> ctypes.CDLL | None:
         """The loaded library to use for n poses, or None for the virtual machine."""
@@ -246,9 +283,7 @@ class Backend:
                 if self.compile or self.library.cached or n >= COMPILE_MIN_POSES:
                     self.lib = self.library.load()
             except Exception as e:
-                self.failed = True
-                warnings.warn(f"kincas: could not compile the {self.what} ({e}); using the slower "
-                              f"uncompiled path", RuntimeWarning, stacklevel=3)
+                self._failed(e)
         return self.lib
 
 

@@ -13,7 +13,13 @@ truly at once (a ctypes call releases the GIL):
 2. the kernel's state is made there (g_q's diagonal blocks, the tangent dq/du), and the
    fast pass of `kincas.sweep` (`kincas_sweep`, kincas/core/kernel.py: the same functions
    and checks) solves poses 0, 1, ... (pose 0 again, predicted where it is, so that its
-   quantities come from the same pass) until one is rejected.
+   quantities come from the same pass) until one is rejected;
+3. a rejected pose is tried again from the pose before in 2, 4, ..., 2^HALVINGS equal steps
+   of the inputs, every step passing every test of the kernel (so, as in one step, each
+   group's det g_q keeps its sign and no singular position lies between: the careful path
+   halves its steps the same way, and lands on the same solution); then the fast pass goes
+   on. Near a limit of the assembly the kernel rejects a step of the sweep where shorter
+   ones pass: without this, every such pose went to the careful path, in Python.
 
 Each design's result is the number of poses accepted from pose 0 (its poses and reported
 quantities written in place), or -1 where its first pose could not be continued on the
@@ -45,6 +51,7 @@ from .tolerances import ACCEPT
 STEP = 0.05  # largest parameter change per continuation step, relative to the size
 MAX_STEPS = 64  # continuation steps per design at most
 NEWTON = 8  # Newton steps per continuation step at most
+HALVINGS = 4  # a pose the kernel rejects is tried again in 2, 4, ..., 2^HALVINGS steps
 _I, _V, _D = ctypes.c_longlong, ctypes.c_void_p, ctypes.c_double
 
 
@@ -111,6 +118,32 @@ static int kincas_first_pose(const casadi_real* u0, const casadi_real* p0, const
   return 1;
 }
 
+/* Pose k again from the state s at pose k - 1 (the kernel rejected it in one step), in 2, 4,
+   ..., 2^HALVINGS equal steps of the inputs, each accepted by every test of the kernel; on
+   success its unknowns and quantities (rates ud, udd of pose k) go to qk and vk (stride ld)
+   and s is the state at pose k, else s is left as it was and 0 is returned. */
+static int kincas_substeps(casadi_int k, const casadi_real* U, const casadi_real* p,
+                           const casadi_real* L, const casadi_real* thr, casadi_int max_evals,
+                           casadi_real* s, const casadi_real* ud, const casadi_real* udd,
+                           casadi_real* qk, casadi_real* vk, casadi_int ld) {
+  casadi_real s0[NS], Us[NU*SUB], Qs[NQ*SUB], Vs[(NO > 0 ? NO : 1)*SUB], Is[5*SUB];
+  casadi_int h, m, j, i;
+  for (i = 0; i < NS; ++i) s0[i] = s[i];
+  for (h = 1; h <= HALVINGS; ++h) {
+    m = (casadi_int) 1 << h;
+    for (j = 0; j < m; ++j) for (i = 0; i < NU; ++i)  /* the last one is pose k's input exactly */
+      Us[j*NU + i] = j == m - 1 ? U[k*NU + i]
+                   : U[(k - 1)*NU + i] + (U[k*NU + i] - U[(k - 1)*NU + i]) * ((casadi_real) (j + 1) / m);
+    if (kincas_sweep(m, Us, p, L, thr, max_evals, s, Qs, Is, m, ud, 0, udd, 0, Vs, 0) == m) {
+      for (i = 0; i < NQ; ++i) qk[i] = Qs[(m - 1)*NQ + i];
+      for (i = 0; i < NO; ++i) vk[i*ld] = Vs[i*m + m - 1];
+      return 1;
+    }
+    for (i = 0; i < NS; ++i) s[i] = s0[i];
+  }
+  return 0;
+}
+
 /* Designs 0..nd-1 (parameters P, sizes Ls): first pose from (q0, p0, L0) at U[0], then poses
    0..n-1 by kincas_sweep. stops[d]: poses accepted from 0, or -1 (first pose not continued).
    info: scratch of 5 n. Q (nd, n, NQ) and vals (nd, NO, n) written in place. */
@@ -121,8 +154,8 @@ int kincas_designs_full(casadi_int nd, casadi_int n, const casadi_real* U, const
                         const casadi_real* Ud, casadi_int sud, const casadi_real* Udd,
                         casadi_int sudd, casadi_real* vals, casadi_real* stops) {
   const casadi_real* arg[SZ_ARG]; casadi_real* res[SZ_RES]; casadi_int iw[SZ_IW]; casadi_real w[SZ_W];
-  casadi_real s[NQ + NJ + 2*(NQ*NU + NU)], sign0[1 + NG];
-  casadi_int d, i;
+  casadi_real s[NS], sign0[1 + NG];
+  casadi_int d, i, k, a;
   arg[0] = q0; arg[1] = U; arg[2] = p0; arg[3] = L0; res[0] = sign0;
   if (kV(arg, res, iw, w, 0)) return -1;
   for (i = 0; i < NG; ++i) if (!(sign0[1 + i] != 0)) return -1;  /* nominal near singular */
@@ -136,8 +169,14 @@ int kincas_designs_full(casadi_int nd, casadi_int n, const casadi_real* U, const
     for (i = 0; i < NQ; ++i) s[i] = q[i];
     for (i = 0; i < NU; ++i) s[NQ + NJ + NQ*NU + i] = U[i];
     for (i = 0; i < NQ*NU + NU; ++i) s[NQ + NJ + NQ*NU + NU + i] = s[NQ + NJ + i];
-    stops[d] = (casadi_real) kincas_sweep(n, U, p, Ls + d, thr, max_evals, s, q, info, n, Ud, sud,
-                                          Udd, sudd, vals + d*NO*n, 0);
+    k = kincas_sweep(n, U, p, Ls + d, thr, max_evals, s, q, info, n, Ud, sud, Udd, sudd, vals + d*NO*n, 0);
+    while (k > 0 && k < n && kincas_substeps(k, U, p, Ls + d, thr, max_evals, s, Ud + k*sud,
+                                             Udd + k*sudd, q + k*NQ, vals + d*NO*n + k, n)) {
+      a = k + 1;  /* pose k reached in shorter steps: the kernel goes on from it */
+      k = a + kincas_sweep(n - a, U + a*NU, p, Ls + d, thr, max_evals, s, q + a*NQ, info, n,
+                           Ud + a*sud, sud, Udd + a*sudd, sudd, vals + d*NO*n + a, 0);
+    }
+    stops[d] = (casadi_real) k;
   }
   return (int) nd;
 }
@@ -185,7 +224,8 @@ class DesignsLoop:
         fns = [*sw.functions, *continuation_functions(self.model.sym, sw.blocks)]
         return Library("kincas_designs", fns, SWEEP_C + _LOOP_C,
                        {"NQ": self.nq, "NU": self.nu, "NO": self.no, "NM": self.ng + 1,
-                        "NJ": sw.nj, "NP": self.np, "NG": self.ng},
+                        "NJ": sw.nj, "NP": self.np, "NG": self.ng, "NS": sw.state_size,
+                        "HALVINGS": HALVINGS, "SUB": 2 ** HALVINGS},
                        {"kincas_sweep": _SWEEP_SIG, "kincas_designs_full": _FULL_SIG,
                         "kincas_designs": _DESIGNS_SIG})
 

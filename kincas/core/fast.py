@@ -57,6 +57,10 @@ COMPILE_MAX = 40_000
 # virtual machine took 0.3 ms a pose against 26 ms on the careful path: only a far larger
 # kernel could lose (and it is never compiled either).
 VM_MAX = 200_000
+# With compile=None, a sweeper compiles its kernel in the background from its second sweep,
+# or from its first of this many poses (the virtual machine takes ~3 us a pose, compiling a
+# small kernel ~1 s): repeated use pays for it, a one-off short sweep does not wait for it.
+BACKGROUND_POSES = 20_000
 INFO = ("residual", "step", "jac_change", "correction", "steps")
 BLOCK = 65536  # poses per call when a progress callback wants news
 _I, _V = ctypes.c_longlong, ctypes.c_void_p
@@ -164,7 +168,7 @@ class FastSweeper:
         self.blocks = _model_blocks(model)
         self.nj = diagonal_size(self.blocks)  # g_q's diagonal blocks, all the state keeps of it
         self.state_size = self.nq + self.nj + 2 * (self.nq * self.nu + self.nu)
-        self._functions, self._size = None, None
+        self._functions, self._size, self._calls = None, None, 0
         self._lock = threading.RLock()
         self._local = threading.local()  # the virtual machine's buffers, one set per thread
         self.backend = Backend(compile, self._library, "fast sweep kernel")
@@ -264,6 +268,9 @@ class FastSweeper:
         (`_from_guess`), and the careful path only where the kernel's answer is not
         certainly the careful path's."""
         r = FastRun(self, U, p, L, Ud, Udd)
+        self._calls += 1
+        if (self._calls >= 2 or r.n >= BACKGROUND_POSES) and self.size <= COMPILE_MAX:  # worth compiling
+            self.backend.start()  # (compile=None only; the virtual machine serves meanwhile)
         k, last, going = 0, None, False  # going: the last block ended with no rejection
 
         def tick(a, b):  # news at every 256th pose passed, as the careful path gives it

@@ -1,0 +1,96 @@
+"""compile=None: repeated short sweeps get the compiled kernel (issue [8]).
+
+The first short sweep of a structure runs in the virtual machine and compiles nothing; from
+the second, the kernel compiles in a background thread while the virtual machine keeps
+serving, and once it is loaded the sweeps run compiled. Every sweep, before, during and
+after, gives the circle-intersection answer written here. compile=False never compiles;
+$KINCAS_NO_COMPILE is obeyed.
+"""
+import threading
+
+import numpy as np
+import pytest
+
+import kincas
+from kincas import Input, Link, Mechanism
+from kincas.core.fast import sweeper_for
+
+REPORT = ("C.x", "C.y")
+
+
+@pytest.fixture()
+def cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("KINCAS_CACHE", str(tmp_path))
+    monkeypatch.delenv("KINCAS_NO_COMPILE", raising=False)
+    return tmp_path
+
+
+def fourbar(b, name):  # a parameter name of its own per test: a structure no other test has
+    return Mechanism(parameters={name: b}, ground={"A": (0, 0), "D": (4, 0)},
+                     links=[Link.bar("crank", "A", "B", 1.0), Link.bar("coupler", "B", "C", name),
+                            Link.bar("rocker", "D", "C", 3.0)],
+                     inputs=[Input.angle("crank")], guess={"C": (3.6, 2.9)})
+
+
+def closed_C(th, b):
+    Bx, By = np.cos(th), np.sin(th)
+    ex, ey = 4 - Bx, -By
+    r = np.hypot(ex, ey)
+    x = (b * b - 9 + r * r) / (2 * r)
+    h = np.sqrt(b * b - x * x)
+    return Bx + (x * ex - h * ey) / r, By + (x * ey + h * ex) / r
+
+
+def check(sw, th, b):
+    Cx, Cy = closed_C(th, b)
+    assert sw.ok.all()
+    assert np.abs(sw["C.x"] - Cx).max() < 1e-12 and np.abs(sw["C.y"] - Cy).max() < 1e-12
+
+
+def test_second_short_sweep_compiles_in_the_background(cache):
+    m, th = fourbar(3.5, "policy_b1"), np.linspace(0, 2 * np.pi, 360)
+    fast = sweeper_for(kincas.compile(m), REPORT, None)
+    check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.5)
+    assert fast.backend.lib is None and fast.backend._thread is None  # one sweep: nothing compiled
+    assert not list(cache.glob("*.so"))
+    check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.5)  # starts it
+    assert fast.backend._thread is not None
+    fast.backend._thread.join(timeout=120)
+    assert fast.backend.lib is not None and list(cache.glob("kincas_sweep-*.so"))
+    assert not [p for p in cache.iterdir() if p.is_dir()]  # no half-written build left
+    check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.5)  # compiled now
+
+
+def test_sweeps_from_threads_while_the_kernel_compiles(cache):
+    m, th = fourbar(3.45, "policy_b2"), np.linspace(0, 2 * np.pi, 500)
+    fast = sweeper_for(kincas.compile(m), REPORT, None)
+    kincas.sweep(m, {"crank.angle": th}, report=list(REPORT))
+    errors = []
+
+    def work():
+        try:
+            for _ in range(6):
+                check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.45)
+        except AssertionError as e:  # pragma: no cover - reported below
+            errors.append(e)
+    ts = [threading.Thread(target=work) for _ in range(3)]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join()
+    assert not errors
+    fast.backend._thread.join(timeout=120)
+    check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.45)
+    assert fast.backend.lib is not None
+
+
+def test_compile_false_and_no_compile_never_compile(cache, monkeypatch):
+    m, th = fourbar(3.4, "policy_b3"), np.linspace(0, 1, 50)
+    for _ in range(3):
+        check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT), compile=False), th, 3.4)
+    assert sweeper_for(kincas.compile(m), REPORT, False).backend._thread is None
+    monkeypatch.setenv("KINCAS_NO_COMPILE", "1")
+    for _ in range(3):
+        check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.4)
+    assert sweeper_for(kincas.compile(m), REPORT, None).backend._thread is None
+    assert not list(cache.glob("*.so"))
