@@ -264,9 +264,9 @@ class FastSweeper:
 
         `first(k)`, if given, places pose k while no pose is solved yet: a `Placement`
         (kincas/core/assembly.py) of the unknowns the careful path would start Newton from
-        (the guessed points) and each unknown's scale in its own group, or None. The kernel then solves pose k from q0
-        (`_from_guess`), and the careful path only where the kernel's answer is not
-        certainly the careful path's."""
+        (the guessed points) and each unknown's scale in its own group, or None. The kernel
+        then solves pose k from q0 (`_from_guess`), and the careful path only where the
+        kernel's answer is not certainly the careful path's."""
         r = FastRun(self, U, p, L, Ud, Udd)
         self._calls += 1
         if (self._calls >= 2 or r.n >= BACKGROUND_POSES) and self.size <= COMPILE_MAX:  # worth compiling
@@ -294,7 +294,8 @@ class FastSweeper:
                     last, going = bad - 1, bad == min(stop, r.n)
                     tick(k, bad)
                     k = bad
-                    continue
+                    if going or k == r.n:
+                        continue  # else pose k was rejected: the careful path, as after any pass
             sol = careful(k, last, r)
             r.record(k, sol)
             if sol.ok and last is None and self.nq and self.nu and self._again(r, k):
