@@ -207,3 +207,19 @@ def test_cli_study_backend_jax_writes_the_rows_of_the_casadi_backend(tmp_path, c
     monkeypatch.setattr(cli_study, "_has", lambda mod: mod not in ("jax", "jaxadi"))
     code, _, err = run_cli(capsys, "study", p, "--backend", "jax")
     assert code == 2 and "kincas[gpu]" in err and len(err.strip().splitlines()) == 1
+
+
+def test_poses_the_jax_pass_cannot_verify_are_finished_on_the_cpu_on_the_branch(spy):
+    # A rod 1e-7 longer than the crank: the two assemblies pass 2e-2 apart near 90 and 270 deg,
+    # where g_q is nearly singular; the JAX pass hands those poses to the careful path, which
+    # keeps the branch of the guess (B right of the crank pin).
+    m = slider_crank()
+    X = np.array([[50.0, 50.0 + 5e-6, 0.0], [50.0, 50.0 + 1e-5, 0.0]])
+    r = kincas.sweep_designs(m, X, {"crank.angle": TH}, names=["r", "l", "e"], report=["B.x", "guide.s"],
+                             backend="jax")
+    assert r.design_ok.all()
+    stops = np.concatenate(spy)
+    assert (stops < len(TH)).all()  # handed over, not taken from the JAX pass
+    for d, (r_, l_, _) in enumerate(X):
+        x = r_ * np.cos(TH) + np.sqrt(l_ ** 2 - (r_ * np.sin(TH)) ** 2)
+        assert np.abs(r.values["B.x"][d] - x).max() <= 1e-8 * (r_ + l_)

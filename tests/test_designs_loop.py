@@ -106,3 +106,28 @@ def test_two_threads_give_the_numbers_of_one_bit_for_bit(loop_stops):
     assert np.array_equal(one.code, two.code) and (one.code == 0).sum() > 30 * 181
     for q in REPORT:
         assert np.array_equal(one.values[q], two.values[q], equal_nan=True)
+
+
+def test_monte_carlo_chunks_on_two_threads_equal_one_thread_and_a_numpy_reference():
+    # 2,100 samples: two chunks of the executor, merged pairwise; on 1 and 2 threads.
+    from kincas.analysis.tolerance import analyse
+
+    m = fourbar()
+    th = np.linspace(0, 2 * np.pi, 37)
+    std = {"a2": 0.05, "a4": 0.05, "a5": 0.05}
+    one = analyse(m, {"crank.angle": th}, std, ["C.y", "rocker.angle"], samples=2100, seed=5, workers=1)
+    two = analyse(m, {"crank.angle": th}, std, ["C.y", "rocker.angle"], samples=2100, seed=5, workers=2)
+    for q in ("C.y", "rocker.angle"):
+        assert np.array_equal(one.monte_carlo[q], two.monte_carlo[q])
+        assert np.array_equal(one.mean_shift[q], two.mean_shift[q])
+    # the same draws swept here design by design in one batch, std and mean in one pass of numpy
+    rng = np.random.default_rng(5)
+    dp = rng.standard_normal((2100, 3)) * np.array([0.05, 0.05, 0.05])
+    X = np.array([25.0, 90.0, 70.0]) + dp
+    r = kincas.sweep_designs(m, X, {"crank.angle": th}, names=["a2", "a4", "a5"], report=["C.y"],
+                             compile=True, workers=1)
+    assert r.design_ok.all()
+    nominal = kincas.sweep(m, {"crank.angle": th}, report=["C.y"])["C.y"]
+    d = r.values["C.y"] - nominal
+    assert np.allclose(one.monte_carlo["C.y"], d.std(axis=0, ddof=1), rtol=1e-9, atol=1e-13)
+    assert np.allclose(one.mean_shift["C.y"], d.mean(axis=0), rtol=1e-7, atol=1e-13)

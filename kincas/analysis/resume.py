@@ -34,7 +34,7 @@ from ..core.tolerances import ACCEPT
 WIDE = 2  # a group with more unknowns than this has more assemblies than block signs
 SAME = 1e-6  # two assemblies are one when every unknown agrees to this (lengths over L)
 DEPTH = 10  # halvings of one input step while carrying groups through a gap
-BUDGET = 600  # Newton solves spent carrying groups through one gap
+BUDGET = 200  # Newton solves spent carrying groups across one input step of a gap
 
 REASON = ("its assemblies of one sign are told apart neither by continuation (it has no "
           "assembly in the gap) nor by a limit it left and came back through")
@@ -44,7 +44,23 @@ REASON = ("its assemblies of one sign are told apart neither by continuation (it
 
 
 def larger_groups(model) -> list[int]:
-    """Indices of the Assur groups whose block sign does not identify their assembly."""
+    """Indices of the Assur groups whose block sign does not identify their assembly.
+
+    Parameters
+    ----------
+    model : kincas.core.numeric.Model
+
+    Returns
+    -------
+    list of int
+        The groups with more than two unknowns (none where g_q is tall: redundant joints).
+
+    Examples
+    --------
+    >>> import kincas
+    >>> larger_groups(kincas.compile(_fourbar()))  # a four-bar's one group is a dyad
+    []
+    """
     if not model.square:
         return []
     return [i for i, (_, cols) in enumerate(blocks(model)) if len(cols) > WIDE]
@@ -78,6 +94,20 @@ def resume_label(model, U, p, L, j, qj, k, qk, carried=None) -> dict:
         "branch": "same", "other" (some group provably in another mode: "groups" lists
         their links) or "unknown" (no group changed provably, some could not be
         established: "unknown" lists them and "reason" says why).
+
+    Examples
+    --------
+    A triple rocker has no assembly from 151.2 to 208.8 deg; at 220 deg its dyad is back on
+    the side it left (the sign of its block, which is a dyad's mode):
+
+    >>> import numpy as np, kincas
+    >>> m = _fourbar()
+    >>> U = np.radians([[140.0], [180.0], [220.0]])
+    >>> sw = kincas.sweep(m, {"crank.angle": U[:, 0]}, report=["C.y"])
+    >>> sw.status.tolist()
+    ['ok', 'no assembly', 'ok']
+    >>> resume_label(kincas.compile(m), U, np.zeros(0), m.size(), 0, sw.q[0], 2, sw.q[2])
+    {'branch': 'same'}
     """
     before = modes(model, model.jac(qj, U[j], p), L)[0]
     after = modes(model, model.jac(qk, U[k], p), L)[0]
@@ -106,7 +136,22 @@ def resume_label(model, U, p, L, j, qj, k, qk, carried=None) -> dict:
 
 
 def label_text(e: dict) -> str:
-    """A resume event in words (for the command line)."""
+    """A resume event in words (for the command line).
+
+    Parameters
+    ----------
+    e : dict
+        A "resume" event.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> label_text({"branch": "other", "groups": [["coupler", "rocker"]]})
+    'resumed on the other branch'
+    """
     if e["branch"] != "unknown":
         return f"resumed on the {e['branch']} branch"
     groups = ", ".join("+".join(g) for g in e["unknown"])
@@ -120,7 +165,35 @@ def carry_groups(model, U, p, L, j, qj, k, groups, memo=None) -> dict:
     """{group: unknowns at U[k], or None}: each group in `groups` with the groups before it,
     continued from the solved pose j through the inputs U[j+1], ..., U[k]. `memo` (a dict
     kept by the caller for one sweep) keeps how far each carry got, so that the poses of one
-    gap, tried one after another, continue it by one step each."""
+    gap, tried one after another, continue it by one step each.
+
+    Parameters
+    ----------
+    model : kincas.core.numeric.Model
+    U, p, L, j, qj, k
+        As for `resume_label`.
+    groups : list of int
+        The groups to carry (each with the groups before it).
+    memo : dict, optional
+        How far each carry got, kept by the caller across the poses of one sweep.
+
+    Returns
+    -------
+    dict
+        {group: unknowns at U[k] (those of the groups carried; the others as in qj), or None
+        where a group or one before it has no assembly somewhere in the gap}.
+
+    Examples
+    --------
+    The triple rocker's dyad cannot be carried through the inputs where it has no assembly:
+
+    >>> import numpy as np, kincas
+    >>> m = _fourbar()
+    >>> U = np.radians([[140.0], [180.0], [220.0]])
+    >>> q0 = kincas.sweep(m, {"crank.angle": U[:1, 0]}).q[0]
+    >>> carry_groups(kincas.compile(m), U, np.zeros(0), m.size(), 0, q0, 2, [0])
+    {0: None}
+    """
     out = {}
     for i in sorted(groups, reverse=True):  # the longest chain first: it carries the others
         if i in out:
@@ -221,7 +294,36 @@ def _same_limit(model, U, p, L, j, qj, k, qk, i) -> bool:
 
 def unlabelled_resumes(model, U, p, L, Q, ok, events) -> list[dict]:
     """"resume" events for the poses solved after a gap that have none yet (the compiled
-    pass went on from the last solved pose by itself), labelled as `resume_label` does."""
+    pass went on from the last solved pose by itself), labelled as `resume_label` does.
+
+    Parameters
+    ----------
+    model : kincas.core.numeric.Model
+    U, p, L
+        As for `resume_label`.
+    Q : numpy.ndarray
+        (n, nq) unknowns per pose.
+    ok : numpy.ndarray of bool
+        Which poses are solved.
+    events : list of dict
+        The sweep's events so far.
+
+    Returns
+    -------
+    list of dict
+        The events to add.
+
+    Examples
+    --------
+    >>> import numpy as np, kincas
+    >>> m = _fourbar()
+    >>> U = np.radians([[140.0], [180.0], [220.0]])
+    >>> sw = kincas.sweep(m, {"crank.angle": U[:, 0]}, report=["C.y"])
+    >>> unlabelled_resumes(kincas.compile(m), U, np.zeros(0), m.size(), sw.q, sw.ok, sw.events)
+    []
+    >>> unlabelled_resumes(kincas.compile(m), U, np.zeros(0), m.size(), sw.q, sw.ok, [])
+    [{'kind': 'resume', 'pose': 2, 'branch': 'same'}]
+    """
     idx = np.flatnonzero(ok)
     have = {e["pose"] for e in events if e["kind"] == "resume"}
     out = []
@@ -229,3 +331,12 @@ def unlabelled_resumes(model, U, p, L, Q, ok, events) -> list[dict]:
         if k > j + 1 and int(k) not in have:
             out.append({"kind": "resume", "pose": int(k)} | resume_label(model, U, p, L, j, Q[j], k, Q[k]))
     return out
+
+
+def _fourbar():
+    """The examples' triple rocker (1, 1.9, 3, 4): the crank turns back at +-151.2 deg."""
+    import kincas
+    return kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+                            links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 1.9),
+                                   kincas.Link.bar("rocker", "D", "C", 3)],
+                            inputs=[kincas.Input.angle("crank")], guess={"C": (3.2, 2.5)})

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.limits import _scales, locate_singular, scaled_jacobians  # noqa: F401  (their old home)
+from ..core.newton import newton
 from ..model.mechanism import Mechanism
 
 FLAG_SIGMA = 1e-7  # relative smallest singular value at which a pose *is* singular
@@ -184,23 +185,18 @@ def _curve_tangent(model, q, u, p, i, scale):
 
 
 def _correct(model, zp, t, u, p, L, i, scale, max_iter=12):
-    """Newton on [g(z) = 0; t.(z - zp) = 0] (pseudo-arclength corrector)."""
+    """Newton on [g(z) = 0; t.(z - zp) = 0] (pseudo-arclength corrector): the one Newton
+    (kincas/core/newton.py) in z (angles as they are, lengths over L), g against each
+    group's length. None where it does not converge within `max_iter` or lands more than
+    half a unit from the prediction (another part of the curve)."""
     nq = model.nq
-    z = zp.copy()
-    for _ in range(max_iter):
-        q = z[:nq] * scale[:nq]
-        uu = _with(u, i, z[-1] * scale[-1])
-        g, J, Ju = model._tangent(q, uu, p)
-        g = g.ravel()
-        F = np.concatenate([g / L, [t @ (z - zp)]])
-        if np.abs(F).max() < 1e-13:
-            return z
-        A = np.vstack([np.hstack([J, Ju[:, [i]]]) * scale / L, t])
-        try:
-            d = np.linalg.solve(A, -F)
-        except np.linalg.LinAlgError:
-            return None
-        if not np.all(np.isfinite(d)) or np.abs(d).max() > 0.5:
-            return None
-        z = z + d
-    return None
+    eq, _ = model.scales(u, p)
+
+    def F(z):
+        g, J, Ju = model._tangent(z[:nq] * scale[:nq], _with(u, i, z[-1] * scale[-1]), p)
+        return np.r_[g.ravel(), t @ (z - zp)], np.vstack([np.hstack([J, Ju[:, [i]]]) * scale, t])
+
+    res = newton(F, zp, np.ones(len(zp)), np.r_[eq, 1.0], max_iter=max_iter, max_step=0.5)
+    if not res.ok or res.iterations >= max_iter or not np.abs(res.x - zp).max() <= 0.5:
+        return None
+    return res.x

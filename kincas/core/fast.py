@@ -57,6 +57,7 @@ COMPILE_MAX = 40_000
 # virtual machine took 0.3 ms a pose against 26 ms on the careful path: only a far larger
 # kernel could lose (and it is never compiled either).
 VM_MAX = 200_000
+VM_CHUNKS = (1, 8, 32, 128, CHUNK)  # poses per call of the virtual machine's sweep
 # With compile=None, a sweeper compiles its kernel in the background once its sweeps add up
 # to this many poses (one long sweep, or ~56 of 360 poses): the virtual machine costs ~1-3 us
 # a pose more than the compiled loop, compiling a small kernel ~1 s of a background thread.
@@ -359,43 +360,52 @@ class FastSweeper:
         r.solved[k] = True
         return False
 
-    # --- the virtual machine: the same arithmetic, mapaccum over CHUNK poses ---
-    def _vm_function(self) -> ca.Function:
+    # --- the virtual machine: the same arithmetic, mapaccum over chunks of VM_CHUNKS poses ---
+    def _vm_function(self, size: int) -> ca.Function:
         with self._lock:
             if getattr(self, "_vmF", None) is None:
+                self._vmF = {}
+            if size not in self._vmF:
                 nu = self.nu
-                kS = vm_step(*self.functions, self.nq, nu, self.max_evals)
-                acc = kS.mapaccum("acc", CHUNK, [0, 1, 2, 3, 4, 5], [0, 1, 2, 3, 4, 5], {})
+                kS = getattr(self, "_kS", None) or vm_step(*self.functions, self.nq, nu, self.max_evals)
+                self._kS = kS
+                acc = kS.mapaccum("acc", size, [0, 1, 2, 3, 4, 5], [0, 1, 2, 3, 4, 5], {})
                 x = [ca.MX.sym(f"x{i}", *kS.size_in(i)) for i in range(6)]
-                U, Ud, Udd = (ca.MX.sym(c, nu, CHUNK) for c in ("U", "Ud", "Udd"))
+                U, Ud, Udd = (ca.MX.sym(c, nu, size) for c in ("U", "Ud", "Udd"))
                 p, L, t = ca.MX.sym("p", kS.size1_in(7)), ca.MX.sym("L"), ca.MX.sym("t", 5)
                 Lb = self.functions[3](U[:, 0], p)  # the groups' lengths, as the C loop takes them
-                rep = lambda a: ca.repmat(a, 1, CHUNK)
-                self._vmF = ca.Function("chunk", [*x, U, p, L, t, Ud, Udd],
-                                        acc(*x, U, rep(p), rep(L), rep(t), Ud, Udd, rep(Lb)))
-        return self._vmF
+                rep = lambda a: ca.repmat(a, 1, size)
+                self._vmF[size] = ca.Function("chunk", [*x, U, p, L, t, Ud, Udd],
+                                              acc(*x, U, rep(p), rep(L), rep(t), Ud, Udd, rep(Lb)))
+            return self._vmF[size]
 
-    def _vm_buffers(self):
-        """This thread's buffers bound to the chunk function (built on first use)."""
-        vm = getattr(self._local, "vm", None)
-        if vm is None:
+    def _vm_buffers(self, size: int):
+        """This thread's buffers bound to the chunk function of `size` poses (built on first use)."""
+        vms = getattr(self._local, "vm", None)
+        if vms is None:
+            vms = self._local.vm = {}
+        if size not in vms:
             nq, nu, no, nm = self.nq, self.nu, len(self.report), len(self.blocks) + 1
-            F = self._vm_function()
+            F = self._vm_function(size)
             buf, call = F.buffer()
-            scratch = [np.zeros((CHUNK, m)) for m in (nq, self.nj, nq * nu, nu, nq * nu, nu, 6, no, nm,
-                                                      nu, nu, nu)]
+            scratch = [np.zeros((size, m)) for m in (nq, self.nj, nq * nu, nu, nq * nu, nu, 6, no, nm,
+                                                     nu, nu, nu)]
             for i, a in enumerate(scratch[:9]):
                 buf.set_res(i, memoryview(a))
-            vm = self._local.vm = (F, buf, call, scratch)  # buf holds raw pointers: keep it
-        return vm
+            vms[size] = (F, buf, call, scratch)  # buf holds raw pointers: keep it
+        return vms[size]
 
     def _vm_advance(self, r: FastRun, start: int, stop: int, s: np.ndarray) -> int:
         nq, nu = self.nq, self.nu
-        _, buf, call, (Qc, Jc, Tc, Uo, T1c, U1c, Ic, Yc, Mc, Uc, Udc, Uddc) = self._vm_buffers()
         parts = np.split(s.copy(), np.cumsum([nq, self.nj, nq * nu, nu, nq * nu]))
         k = start
-        while k < stop:
-            m = min(CHUNK, stop - k)
+        while k < stop:  # the smallest chunk that holds what is left (padded poses cost too),
+            # and a short one first: the first pose of a stretch is the likeliest to be rejected,
+            # and the chunk's later poses are computed (and thrown away) all the same
+            left = stop - k if k > start else min(stop - k, VM_CHUNKS[1])
+            size = next((c for c in VM_CHUNKS if c >= left), VM_CHUNKS[-1])
+            _, buf, call, (Qc, Jc, Tc, Uo, T1c, U1c, Ic, Yc, Mc, Uc, Udc, Uddc) = self._vm_buffers(size)
+            m = min(size, stop - k)
             for c, (a, st) in ((Uc, (r.U, 1)), (Udc, r.Ud), (Uddc, r.Udd)):
                 c[:m], c[m:] = (a[k:k + m] if st else a), (a[k + m - 1] if st else a)  # pad
             for i, a in enumerate([*parts, Uc, r.p, r.L, r.thr, Udc, Uddc]):

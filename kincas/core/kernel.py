@@ -120,21 +120,29 @@ def state_function(sym, blocks) -> ca.Function:
 
 
 def vm_step(kP, kN, kF, kL, nq, nu, max_evals) -> ca.Function:
-    """One pose for the virtual machine, the compiled loop's arithmetic with a fixed number
-    of kN evaluations: once a step is below NEAR, q stays put, so it ends where the loop stops.
+    """One pose for the virtual machine, the compiled loop's arithmetic: kN evaluated until
+    its step is below NEAR (at most max_evals times: each later evaluation is a switch that
+    the virtual machine skips once converged, so a pose costs what it costs in C), then kF.
     info = (residual, next step, Jacobian change, correction, kN steps, converged). The
-    groups' lengths Lb are an input, computed once per sweep as the compiled loop does."""
-    q0, J0, T0, u0 = ca.SX.sym("q0", nq), ca.SX.sym("J0", kF.size1_in(6)), ca.SX.sym("T0", nq, nu), ca.SX.sym("u0", nu)
-    u, p, L, thr = ca.SX.sym("u", nu), ca.SX.sym("p", kN.size1_in(2)), ca.SX.sym("L"), ca.SX.sym("t", 5)
-    Lb = ca.SX.sym("Lb", kL.size1_out(0))
-    ud, udd, T1, u1 = ca.SX.sym("ud", nu), ca.SX.sym("udd", nu), ca.SX.sym("T1", nq, nu), ca.SX.sym("u1", nu)
+    groups' lengths Lb are an input, computed once per sweep as the compiled loop does.
+    Functions written group by group are inlined (`expand`) for the virtual machine."""
+    kP, kN, kF = (f.expand() if f.is_a("MXFunction") else f for f in (kP, kN, kF))
+    x, u, p = ca.SX.sym("q", nq), ca.SX.sym("u", nu), ca.SX.sym("p", kN.size1_in(2))
+    Lx, t4 = ca.SX.sym("Lb", kL.size1_out(0)), ca.SX.sym("t4")
+    dq, rs = kN(x, u, p, Lx)
+    once = ca.Function.conditional(  # index 0 (not converged): one Newton step; else stay
+        "vm_newton", [ca.Function("vm_step", [x, u, p, Lx, t4], [x - dq, rs[1] <= t4])],
+        ca.Function("vm_stay", [x, u, p, Lx, t4], [x, ca.SX(1)]))
+    q0, J0, T0, u0 = ca.MX.sym("q0", nq), ca.MX.sym("J0", kF.size1_in(6)), ca.MX.sym("T0", nq, nu), ca.MX.sym("u0", nu)
+    u, p, L, thr = ca.MX.sym("u", nu), ca.MX.sym("p", kN.size1_in(2)), ca.MX.sym("L"), ca.MX.sym("t", 5)
+    Lb = ca.MX.sym("Lb", kL.size1_out(0))
+    ud, udd, T1, u1 = ca.MX.sym("ud", nu), ca.MX.sym("udd", nu), ca.MX.sym("T1", nq, nu), ca.MX.sym("u1", nu)
     q = qp = kP(q0, T0, u0, u, T1, u1)
-    done, evals = ca.SX(0), ca.SX(0)
+    done, evals = ca.MX(0), ca.MX(0)
     for _ in range(max_evals):
-        dq, rs = kN(q, u, p, Lb)
         evals += 1 - done
-        q = ca.if_else(done, q, q - dq)
-        done = ca.logic_or(done, rs[1] <= thr[4])
+        q, conv = once(done, q, u, p, Lb, thr[4])
+        done = ca.logic_or(done, conv)
     J, T, rs, mc, meas, y, dq = kF(q, u, p, L, ud, udd, J0, qp, Lb)
     conv = ca.logic_and(rs[0] <= thr[0], rs[1] <= thr[1])
     q = ca.if_else(conv, q - dq, q)
