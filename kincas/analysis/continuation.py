@@ -155,11 +155,11 @@ def _passes_singular(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
     point with its mode unchanged (branches cross there), and the step must be cut."""
     from .singular import locate_singular
     c = np.minimum(modes(model, J0, L)[1], modes(model, sol.J, L)[1])
-    for i in np.flatnonzero(c < WATCH):
-        s = locate_singular(model, q0, u0, p, L, u1 - u0, max_iter=2, group=int(i), probe=True)
-        if s is None or not -0.5 < s < 1.5:  # two extended Newton steps: not in this step
-            continue
-        found = locate_singular(model, q0, u0, p, L, u1 - u0, group=int(i))
+    watch = np.flatnonzero(c < WATCH)
+    scales = model.scales(u0, p) if watch.size else None  # one pose's: shared by every search
+    for i in watch:
+        # two extended Newton steps putting s outside (-0.5, 1.5): not in this step
+        found = locate_singular(model, q0, u0, p, L, u1 - u0, group=int(i), window=(-0.5, 1.5), scales=scales)
         if found is not None and 0 < found[2] < 1:
             return True
     return False
