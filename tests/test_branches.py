@@ -418,3 +418,22 @@ def test_no_assembly_is_decided_without_the_optimiser(method, monkeypatch):
     C = fourbar_C(th, a, b, c, d, 1)
     assert np.array_equal(sw.ok, np.isfinite(C[:, 0]))
     assert np.abs(xy(sw, "C")[sw.ok] - C[sw.ok]).max() <= 1e-9
+
+
+@pytest.mark.parametrize("order", ["coupler first", "rocker first", "rocker reversed"])
+def test_guessless_default_mode_is_the_documented_one(order):
+    # docs/scene-format.md: the default mode of the four-bar's dyad has B, D, C counter-clockwise
+    # (C to the left of B -> D), whatever the declaration order or direction of the links
+    a, b, c, d = 1, 3.5, 3, 4
+    crank = Link.bar("crank", "A", "B", a)
+    coupler = Link.bar("coupler", "B", "C", b)
+    rocker = Link.bar("rocker", "C", "D", c) if order == "rocker reversed" else Link.bar("rocker", "D", "C", c)
+    links = [crank, rocker, coupler] if order == "rocker first" else [crank, coupler, rocker]
+    m = Mechanism(ground={"A": (0, 0), "D": (d, 0)}, links=links, inputs=[Input.angle("crank")])
+    for th in np.radians([0.0, 75.0, 200.0, 300.0]):
+        sw = kincas.sweep(m, {"crank.angle": [th]}, report=["C.x", "C.y"])
+        B = np.array([a * math.cos(th), a * math.sin(th)])
+        want = circle_point(B[None], b, np.array([[d, 0.0]]), c, 1)[0]  # left of B -> D
+        assert (want[0] - B[0]) * want[1] - (want[1] - B[1]) * (want[0] - d) > 0  # (C-B) x (C-D)
+        C = xy(sw, "C")[0]
+        assert np.abs(C - want).max() <= 1e-12 * d

@@ -1,8 +1,8 @@
 """compile=None: repeated short sweeps get the compiled kernel (issue [8]).
 
-The first short sweep of a structure runs in the virtual machine and compiles nothing; from
-the second, the kernel compiles in a background thread while the virtual machine keeps
-serving, and once it is loaded the sweeps run compiled. Every sweep, before, during and
+Short sweeps of a structure run in the virtual machine and compile nothing until they add
+up to BACKGROUND_POSES; then the kernel compiles in a background thread while the virtual
+machine keeps serving, and once it is loaded the sweeps run compiled. Every sweep, before, during and
 after, gives the circle-intersection answer written here. compile=False never compiles;
 $KINCAS_NO_COMPILE is obeyed.
 """
@@ -47,13 +47,19 @@ def check(sw, th, b):
     assert np.abs(sw["C.x"] - Cx).max() < 1e-12 and np.abs(sw["C.y"] - Cy).max() < 1e-12
 
 
-def test_second_short_sweep_compiles_in_the_background(cache):
+@pytest.fixture()
+def poses(monkeypatch):  # compile after 1,000 poses (20,000 by default): quick tests
+    monkeypatch.setattr(kincas.core.fast, "BACKGROUND_POSES", 1000)
+
+
+def test_repeated_short_sweeps_compile_in_the_background(cache, poses):
     m, th = fourbar(3.5, "policy_b1"), np.linspace(0, 2 * np.pi, 360)
     fast = sweeper_for(kincas.compile(m), REPORT, None)
-    check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.5)
-    assert fast.backend.lib is None and fast.backend._thread is None  # one sweep: nothing compiled
+    for _ in range(2):  # 720 poses so far: nothing compiled
+        check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.5)
+    assert fast.backend.lib is None and fast.backend._thread is None
     assert not list(cache.glob("*.so"))
-    check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.5)  # starts it
+    check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.5)  # 1,080: starts it
     assert fast.backend._thread is not None
     fast.backend._thread.join(timeout=120)
     assert fast.backend.lib is not None and list(cache.glob("kincas_sweep-*.so"))
@@ -61,7 +67,7 @@ def test_second_short_sweep_compiles_in_the_background(cache):
     check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.5)  # compiled now
 
 
-def test_sweeps_from_threads_while_the_kernel_compiles(cache):
+def test_sweeps_from_threads_while_the_kernel_compiles(cache, poses):
     m, th = fourbar(3.45, "policy_b2"), np.linspace(0, 2 * np.pi, 500)
     fast = sweeper_for(kincas.compile(m), REPORT, None)
     kincas.sweep(m, {"crank.angle": th}, report=list(REPORT))
@@ -84,8 +90,8 @@ def test_sweeps_from_threads_while_the_kernel_compiles(cache):
     assert fast.backend.lib is not None
 
 
-def test_compile_false_and_no_compile_never_compile(cache, monkeypatch):
-    m, th = fourbar(3.4, "policy_b3"), np.linspace(0, 1, 50)
+def test_compile_false_and_no_compile_never_compile(cache, monkeypatch, poses):
+    m, th = fourbar(3.4, "policy_b3"), np.linspace(0, 1, 400)
     for _ in range(3):
         check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT), compile=False), th, 3.4)
     assert sweeper_for(kincas.compile(m), REPORT, False).backend._thread is None

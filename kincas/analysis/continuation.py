@@ -76,7 +76,12 @@ def _resume(model: Model, U, p, L, k, j, run, events) -> Solution:
     assembly is conclusive (`_ambiguous`): in the modes of pose j, nearest it, or where a
     group's mode does not assemble its other mode (named in the "resume" event); no
     assembly when a group's circles miss each other (a discriminant: no Newton at all)."""
-    before = modes(model, model.jac(run.Q[j], U[j], p), L)[0]
+    # pose j's modes, once per gap (every pose of a gap resumes from the same pose j)
+    memo = run.__dict__.setdefault("gap_modes", {})
+    if j not in memo or not np.array_equal(memo[j][0], run.Q[j]):
+        memo.clear()
+        memo[j] = np.array(run.Q[j]), modes(model, model.jac(run.Q[j], U[j], p), L)[0]
+    before = memo[j][1]
     sol = assemble(model, U[k], p, L, want=before, near=run.Q[j])
     if sol is None:
         return _no_assembly(model, run.Q[j])
@@ -155,11 +160,11 @@ def _passes_singular(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
     point with its mode unchanged (branches cross there), and the step must be cut."""
     from .singular import locate_singular
     c = np.minimum(modes(model, J0, L)[1], modes(model, sol.J, L)[1])
-    for i in np.flatnonzero(c < WATCH):
-        s = locate_singular(model, q0, u0, p, L, u1 - u0, max_iter=2, group=int(i), probe=True)
-        if s is None or not -0.5 < s < 1.5:  # two extended Newton steps: not in this step
-            continue
-        found = locate_singular(model, q0, u0, p, L, u1 - u0, group=int(i))
+    watch = np.flatnonzero(c < WATCH)
+    scales = model.scales(u0, p) if watch.size else None  # one pose's: shared by every search
+    for i in watch:
+        # two extended Newton steps putting s outside (-0.5, 1.5): not in this step
+        found = locate_singular(model, q0, u0, p, L, u1 - u0, group=int(i), window=(-0.5, 1.5), scales=scales)
         if found is not None and 0 < found[2] < 1:
             return True
     return False

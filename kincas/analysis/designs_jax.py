@@ -6,15 +6,7 @@ design from there on the CPU exactly as after a rejection of the compiled pass (
 halving, then the compiled pass again), so a pose the JAX pass could not verify is never
 taken from it.
 
->>> import numpy as np, kincas
->>> m = kincas.Mechanism(parameters={"a": 1.0}, ground={"A": (0, 0), "D": (4, 0)},
-...     links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", 3.5),
-...            kincas.Link.bar("rocker", "D", "C", 3)],
-...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
->>> r = kincas.sweep_designs(m, {"a": [0.9, 1.1]}, {"crank.angle": np.linspace(0, 6.2, 63)},
-...                          report=["C.y"], backend="jax")  # doctest: +SKIP
->>> r.design_ok.tolist()  # doctest: +SKIP
-[True, True]
+Tested against `kincas.sweep` design by design in tests/test_designs_jax.py.
 """
 from __future__ import annotations
 
@@ -22,12 +14,11 @@ import numpy as np
 
 from ..core.jax_backend import jax_designs
 
-BACKENDS = ("casadi", "jax")
-
 
 def jax_pass(job, todo, thresholds) -> np.ndarray:
     """The JAX pass over designs `todo` of a `sweep_designs` job (their first poses solved,
-    their kernel states in job.S): fills the accepted poses' unknowns and values, and returns each design's first rejected pose (n if none was)."""
+    their kernel states in job.S): fills the accepted poses' unknowns and values, and returns
+    each design's first rejected pose (n if none was)."""
     todo = np.asarray(todo, dtype=int)
     jd = jax_designs(job.model, tuple(job.report))
     # poses 1.. of each design written straight into the job's rows (NaN where not accepted)

@@ -325,10 +325,14 @@ def unlabelled_resumes(model, U, p, L, Q, ok, events) -> list[dict]:
     [{'kind': 'resume', 'pose': 2, 'branch': 'same'}]
     """
     idx = np.flatnonzero(ok)
+    gaps = np.flatnonzero(np.diff(idx) > 1)  # only a pose after a gap can need one (no loop over all)
+    if not gaps.size:
+        return []
     have = {e["pose"] for e in events if e["kind"] == "resume"}
     out = []
-    for j, k in zip(idx[:-1], idx[1:]):
-        if k > j + 1 and int(k) not in have:
+    for g in gaps:
+        j, k = idx[g], idx[g + 1]
+        if int(k) not in have:
             out.append({"kind": "resume", "pose": int(k)} | resume_label(model, U, p, L, j, Q[j], k, Q[k]))
     return out
 

@@ -103,16 +103,30 @@ def modes(model, J, L) -> tuple[np.ndarray, np.ndarray]:
     n, bl = J.shape[0], blocks(model)
     sign, cond = np.zeros((n, len(bl)), int), np.zeros((n, len(bl)))
     c = model.column_scale(L)
-    for i, (rows, cols) in enumerate(bl):
-        B = J[:, rows][:, :, cols] * c[cols]
-        good = np.isfinite(B).all(axis=(1, 2))
+    # the blocks of one shape in one batched SVD (LAPACK runs per matrix: the same numbers)
+    for idx, R, C in _by_shape(model):
+        B = J[:, R[:, :, None], C[:, None, :]] * c[C][None, :, None, :]  # (n, blocks, r, c)
+        good = np.isfinite(B).all(axis=(2, 3))
         if not good.any():
             continue
         s = np.linalg.svd(B[good], compute_uv=False)
-        cond[good, i] = s[:, -1] / np.maximum(s[:, 0], np.finfo(float).tiny)
-        if B.shape[1] == B.shape[2]:
-            sign[good, i] = np.sign(np.linalg.det(B[good])) * (cond[good, i] >= SIGN_TOL)
+        ni = np.nonzero(good)
+        cond[ni[0], idx[ni[1]]] = s[:, -1] / np.maximum(s[:, 0], np.finfo(float).tiny)
+        if B.shape[2] == B.shape[3]:
+            sign[ni[0], idx[ni[1]]] = np.sign(np.linalg.det(B[good])) * (cond[ni[0], idx[ni[1]]] >= SIGN_TOL)
     return (sign[0], cond[0]) if one else (sign, cond)
+
+
+def _by_shape(model):
+    """The groups by block shape: (their indices, rows (k, r), cols (k, c)) per shape."""
+    def build():
+        shapes = {}
+        for i, (rows, cols) in enumerate(blocks(model)):
+            shapes.setdefault((len(rows), len(cols)), []).append(i)
+        bl = blocks(model)
+        return [(np.array(ix), np.array([bl[i][0] for i in ix]), np.array([bl[i][1] for i in ix]))
+                for ix in shapes.values()]
+    return model.memo("assembly.by_shape", build)
 
 
 # --- group by group assembly ---

@@ -58,9 +58,11 @@ COMPILE_MAX = 40_000
 # kernel could lose (and it is never compiled either).
 VM_MAX = 200_000
 VM_CHUNKS = (1, 8, 32, 128, CHUNK)  # poses per call of the virtual machine's sweep
-# With compile=None, a sweeper compiles its kernel in the background from its second sweep,
-# or from its first of this many poses (the virtual machine takes ~3 us a pose, compiling a
-# small kernel ~1 s): repeated use pays for it, a one-off short sweep does not wait for it.
+# With compile=None, a sweeper compiles its kernel in the background once its sweeps add up
+# to this many poses (one long sweep, or ~56 of 360 poses): the virtual machine costs ~1-3 us
+# a pose more than the compiled loop, compiling a small kernel ~1 s of a background thread.
+# Repeated use pays for it; a one-off short sweep (`kincas solve`) compiles nothing, and a
+# test suite sweeping hundreds of structures a few times each does not compile them all.
 BACKGROUND_POSES = 20_000
 INFO = ("residual", "step", "jac_change", "correction", "steps")
 BLOCK = 65536  # poses per call when a progress callback wants news
@@ -169,7 +171,7 @@ class FastSweeper:
         self.blocks = _model_blocks(model)
         self.nj = diagonal_size(self.blocks)  # g_q's diagonal blocks, all the state keeps of it
         self.state_size = self.nq + self.nj + 2 * (self.nq * self.nu + self.nu)
-        self._functions, self._size, self._calls = None, None, 0
+        self._functions, self._size, self._poses = None, None, 0  # _poses: swept so far
         self._lock = threading.RLock()
         self._local = threading.local()  # the virtual machine's buffers, one set per thread
         self.backend = Backend(compile, self._library, "fast sweep kernel")
@@ -265,12 +267,12 @@ class FastSweeper:
 
         `first(k)`, if given, places pose k while no pose is solved yet: a `Placement`
         (kincas/core/assembly.py) of the unknowns the careful path would start Newton from
-        (the guessed points) and each unknown's scale in its own group, or None. The kernel then solves pose k from q0
-        (`_from_guess`), and the careful path only where the kernel's answer is not
-        certainly the careful path's."""
+        (the guessed points) and each unknown's scale in its own group, or None. The kernel
+        then solves pose k from q0 (`_from_guess`), and the careful path only where the
+        kernel's answer is not certainly the careful path's."""
         r = FastRun(self, U, p, L, Ud, Udd)
-        self._calls += 1
-        if (self._calls >= 2 or r.n >= BACKGROUND_POSES) and self.size <= COMPILE_MAX:  # worth compiling
+        self._poses += r.n
+        if self._poses >= BACKGROUND_POSES and self.size <= COMPILE_MAX:  # worth compiling now
             self.backend.start()  # (compile=None only; the virtual machine serves meanwhile)
         k, last, going = 0, None, False  # going: the last block ended with no rejection
 
@@ -295,7 +297,8 @@ class FastSweeper:
                     last, going = bad - 1, bad == min(stop, r.n)
                     tick(k, bad)
                     k = bad
-                    continue
+                    if going or k == r.n:
+                        continue  # else pose k was rejected: the careful path, as after any pass
             sol = careful(k, last, r)
             r.record(k, sol)
             if sol.ok and last is None and self.nq and self.nu and self._again(r, k):

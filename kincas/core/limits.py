@@ -78,7 +78,7 @@ def _extended(model):
 
 
 def locate_singular(model, q, u, p, L, direction, max_iter: int = MAX_ITER, group: int | None = None,
-                    probe: bool = False):
+                    probe: bool = False, window: tuple[float, float] | None = None, scales=None):
     """Newton on the extended system from a pose near a singular position, moving the
     inputs along u + s * direction. Returns (q*, u*, s*) there, or None.
 
@@ -106,6 +106,14 @@ def locate_singular(model, q, u, p, L, direction, max_iter: int = MAX_ITER, grou
         unknowns).
     probe : bool
         Return s after `max_iter` iterations, converged or not (a cheap estimate of where).
+    window : (float, float), optional
+        Give up (None) when s after two iterations lies outside (lo, hi): the singular
+        position is not near the step. The same iterates as a probe of two iterations
+        followed by a full search from the same start (Newton keeps no state but x), at
+        the cost of one search.
+    scales : (numpy.ndarray, numpy.ndarray), optional
+        `model.scales(u, p)`, where the caller has it already (several groups searched
+        from one pose).
 
     Returns
     -------
@@ -129,7 +137,7 @@ def locate_singular(model, q, u, p, L, direction, max_iter: int = MAX_ITER, grou
     d = np.asarray(direction, float)
     sel = np.r_[np.arange(ng), ng + rows, 2 * ng]  # g, the group's rows of g_q v, v0.v - 1
     u0 = np.array(u, float)
-    eq, qs = model.scales(u0, p)
+    eq, qs = model.scales(u0, p) if scales is None else scales
     # s moves the inputs by s d: its unit is the step that moves them by one radian, or by L
     s_unit = 1.0 / max(np.abs(d * cu * L).max(initial=0.0), 1e-300)
     step_scale = np.r_[qs, s_unit, cq[cols]]
@@ -142,7 +150,24 @@ def locate_singular(model, q, u, p, L, direction, max_iter: int = MAX_ITER, grou
         A = np.hstack([JF[:, :nq], JF[:, nq:-nq] @ d[:, None], JF[:, -nq:][:, cols]])
         return Fx.ravel()[sel], A[sel]
 
-    res = newton(F, np.r_[np.asarray(q, float), 0.0, v[cols]], step_scale, res_scale, max_iter=max_iter)
+    x0 = np.r_[np.asarray(q, float), 0.0, v[cols]]
+    if window is not None and max_iter > 2:  # two iterations first: is s near the window?
+        seen = []  # the last point F was evaluated at
+
+        def F2(x):
+            seen[:] = [x]
+            return F(x)
+        early = newton(F2, x0, step_scale, res_scale, max_iter=2)
+        s = float(early.x[nq])
+        if not (np.isfinite(s) and window[0] < s < window[1]):
+            return None
+        # Newton ran out of its two iterations exactly when it returns the last point it
+        # evaluated after two steps (converged: a step applied unevaluated; stalled: a
+        # rejected point evaluated last): then go on from there, as one longer run would
+        going = early.iterations == 2 and np.array_equal(early.x, seen[0])
+        res = newton(F, early.x, step_scale, res_scale, max_iter=max_iter - 2) if going else early
+    else:
+        res = newton(F, x0, step_scale, res_scale, max_iter=max_iter)
     qx, s = res.x[:nq], float(res.x[nq])
     if probe:
         return s if np.isfinite(s) else None
