@@ -76,7 +76,12 @@ def _resume(model: Model, U, p, L, k, j, run, events) -> Solution:
     assembly is conclusive (`_ambiguous`): in the modes of pose j, nearest it, or where a
     group's mode does not assemble its other mode (named in the "resume" event); no
     assembly when a group's circles miss each other (a discriminant: no Newton at all)."""
-    before = modes(model, model.jac(run.Q[j], U[j], p), L)[0]
+    # pose j's modes, once per gap (every pose of a gap resumes from the same pose j)
+    memo = run.__dict__.setdefault("gap_modes", {})
+    if j not in memo or not np.array_equal(memo[j][0], run.Q[j]):
+        memo.clear()
+        memo[j] = np.array(run.Q[j]), modes(model, model.jac(run.Q[j], U[j], p), L)[0]
+    before = memo[j][1]
     sol = assemble(model, U[k], p, L, want=before, near=run.Q[j])
     if sol is None:
         return _no_assembly(model, run.Q[j])
