@@ -266,8 +266,9 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, 
     client : dask.distributed.Client, optional
         Run the chunks on its cluster; else on `workers` local threads (default: all cores).
     chunk : int, optional
-        Designs per chunk (default: about four chunks per worker, at most 512 designs; with
-        the JAX backend, up to 4096 designs a chunk).
+        Designs per chunk (default: one per local thread, at most 2,048 designs; on a
+        cluster about four chunks per worker, at most 512 designs; with the JAX backend, up
+        to 4096 designs a chunk).
     backend : {"casadi", "jax"}
         The designs' fast pass, as for `kincas.sweep_designs`.
 
@@ -309,7 +310,11 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, 
     U = _input_table(m, inputs, "inputs", None)
     nd = len(X)
     w = default_workers() if workers is None else workers
-    size = chunk or max(1, min(512, math.ceil(nd / (4 * w))))
+    # On a cluster about four chunks per worker (retries lose little); on local threads one
+    # per thread up to 2,048 designs: each chunk's designs go in one compiled call, and a
+    # thread back from C waits for the GIL while another runs Python, so fewer is faster.
+    size = chunk or (max(1, min(512, math.ceil(nd / (4 * w)))) if client is not None
+                     else max(1, min(2048, math.ceil(nd / w))))
     if backend == "jax" and not chunk:  # one vmapped call does many designs: few large chunks
         size = max(1, min(4096, math.ceil(nd / w)))
     parts = [(np.arange(a, min(a + size, nd)), X[a:a + size]) for a in range(0, nd, size)]
