@@ -58,6 +58,14 @@ COMPILE_MAX = 40_000
 # kernel could lose (and it is never compiled either).
 VM_MAX = 200_000
 VM_CHUNKS = (1, 8, 32, 128, CHUNK)  # poses per call of the virtual machine's sweep
+# Above VM_SKIP instructions a kernel pass (40 chained four-bars: 10,500), the virtual machine
+# skips the Newton steps after convergence and sizes its chunks to the poses left: a padded
+# or wasted pose costs more than the switches' calls and the build of a chunk function per
+# size (which grows with the size: 12 ms for 256 poses of a four-bar). Below (a four-bar:
+# 240), one flat SX pose, and chunks of VM_FLAT poses, the last one padded: CHUNK for a
+# stretch of at least 4 * CHUNK poses (fewer calls); a short sweep builds only 64 (3 ms).
+VM_SKIP = 2_000
+VM_FLAT = 64
 # With compile=None, a sweeper compiles its kernel in the background once its sweeps add up
 # to this many poses (one long sweep, or ~56 of 360 poses): the virtual machine costs ~1-3 us
 # a pose more than the compiled loop, compiling a small kernel ~1 s of a background thread.
@@ -367,7 +375,8 @@ class FastSweeper:
                 self._vmF = {}
             if size not in self._vmF:
                 nu = self.nu
-                kS = getattr(self, "_kS", None) or vm_step(*self.functions, self.nq, nu, self.max_evals)
+                kS = getattr(self, "_kS", None) or vm_step(*self.functions, self.nq, nu, self.max_evals,
+                                                           skip=self.work > VM_SKIP)
                 self._kS = kS
                 acc = kS.mapaccum("acc", size, [0, 1, 2, 3, 4, 5], [0, 1, 2, 3, 4, 5], {})
                 x = [ca.MX.sym(f"x{i}", *kS.size_in(i)) for i in range(6)]
@@ -398,12 +407,14 @@ class FastSweeper:
     def _vm_advance(self, r: FastRun, start: int, stop: int, s: np.ndarray) -> int:
         nq, nu = self.nq, self.nu
         parts = np.split(s.copy(), np.cumsum([nq, self.nj, nq * nu, nu, nq * nu]))
-        k = start
-        while k < stop:  # the smallest chunk that holds what is left (padded poses cost too),
-            # and a short one first: the first pose of a stretch is the likeliest to be rejected,
-            # and the chunk's later poses are computed (and thrown away) all the same
+        k, sized = start, self.work > VM_SKIP
+        flat = CHUNK if stop - start >= 4 * CHUNK else VM_FLAT
+        while k < stop:  # a large kernel: the smallest chunk that holds what is left (padded
+            # poses cost too), and a short one first: the first pose of a stretch is the
+            # likeliest to be rejected, and the chunk's later poses are computed all the same
             left = stop - k if k > start else min(stop - k, VM_CHUNKS[1])
-            size = next((c for c in VM_CHUNKS if c >= left), VM_CHUNKS[-1])
+            size = (next((c for c in VM_CHUNKS if c >= left), VM_CHUNKS[-1]) if sized
+                    else flat)
             _, buf, call, (Qc, Jc, Tc, Uo, T1c, U1c, Ic, Yc, Mc, Uc, Udc, Uddc) = self._vm_buffers(size)
             m = min(size, stop - k)
             for c, (a, st) in ((Uc, (r.U, 1)), (Udc, r.Ud), (Uddc, r.Udd)):

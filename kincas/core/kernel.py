@@ -119,26 +119,35 @@ def state_function(sym, blocks) -> ca.Function:
                        {"cse": True})
 
 
-def vm_step(kP, kN, kF, kL, nq, nu, max_evals) -> ca.Function:
+def vm_step(kP, kN, kF, kL, nq, nu, max_evals, skip: bool = True) -> ca.Function:
     """One pose for the virtual machine, the compiled loop's arithmetic: kN evaluated until
-    its step is below NEAR (at most max_evals times: each later evaluation is a switch that
-    the virtual machine skips once converged, so a pose costs what it costs in C), then kF.
+    its step is below NEAR (at most max_evals times), then kF.
+    With `skip`, each later evaluation is a switch that the virtual machine skips once
+    converged, so a pose costs what it costs in C (a large kernel: 40 chained four-bars);
+    without, the pose is one flat SX function evaluating kN max_evals times, q held once
+    converged (a small kernel: the switch's function calls cost more than a 2x2 kN).
     info = (residual, next step, Jacobian change, correction, kN steps, converged). The
     groups' lengths Lb are an input, computed once per sweep as the compiled loop does.
     Functions written group by group are inlined (`expand`) for the virtual machine."""
     kP, kN, kF = (f.expand() if f.is_a("MXFunction") else f for f in (kP, kN, kF))
-    x, u, p = ca.SX.sym("q", nq), ca.SX.sym("u", nu), ca.SX.sym("p", kN.size1_in(2))
-    Lx, t4 = ca.SX.sym("Lb", kL.size1_out(0)), ca.SX.sym("t4")
-    dq, rs = kN(x, u, p, Lx)
-    once = ca.Function.conditional(  # index 0 (not converged): one Newton step; else stay
-        "vm_newton", [ca.Function("vm_step", [x, u, p, Lx, t4], [x - dq, rs[1] <= t4])],
-        ca.Function("vm_stay", [x, u, p, Lx, t4], [x, ca.SX(1)]))
-    q0, J0, T0, u0 = ca.MX.sym("q0", nq), ca.MX.sym("J0", kF.size1_in(6)), ca.MX.sym("T0", nq, nu), ca.MX.sym("u0", nu)
-    u, p, L, thr = ca.MX.sym("u", nu), ca.MX.sym("p", kN.size1_in(2)), ca.MX.sym("L"), ca.MX.sym("t", 5)
-    Lb = ca.MX.sym("Lb", kL.size1_out(0))
-    ud, udd, T1, u1 = ca.MX.sym("ud", nu), ca.MX.sym("udd", nu), ca.MX.sym("T1", nq, nu), ca.MX.sym("u1", nu)
+    X = ca.MX if skip else ca.SX
+    if skip:
+        x, u, p = ca.SX.sym("q", nq), ca.SX.sym("u", nu), ca.SX.sym("p", kN.size1_in(2))
+        Lx, t4 = ca.SX.sym("Lb", kL.size1_out(0)), ca.SX.sym("t4")
+        dq, rs = kN(x, u, p, Lx)
+        once = ca.Function.conditional(  # index 0 (not converged): one Newton step; else stay
+            "vm_newton", [ca.Function("vm_step", [x, u, p, Lx, t4], [x - dq, rs[1] <= t4])],
+            ca.Function("vm_stay", [x, u, p, Lx, t4], [x, ca.SX(1)]))
+    else:
+        def once(done, q, u, p, Lb, t4):  # every step evaluated, q held once converged
+            dq, rs = kN(q, u, p, Lb)
+            return ca.if_else(done, q, q - dq), rs[1] <= t4
+    q0, J0, T0, u0 = X.sym("q0", nq), X.sym("J0", kF.size1_in(6)), X.sym("T0", nq, nu), X.sym("u0", nu)
+    u, p, L, thr = X.sym("u", nu), X.sym("p", kN.size1_in(2)), X.sym("L"), X.sym("t", 5)
+    Lb = X.sym("Lb", kL.size1_out(0))
+    ud, udd, T1, u1 = X.sym("ud", nu), X.sym("udd", nu), X.sym("T1", nq, nu), X.sym("u1", nu)
     q = qp = kP(q0, T0, u0, u, T1, u1)
-    done, evals = ca.MX(0), ca.MX(0)
+    done, evals = X(0), X(0)
     for _ in range(max_evals):
         evals += 1 - done
         q, conv = once(done, q, u, p, Lb, thr[4])
