@@ -297,7 +297,9 @@ class _Job:
         if lib is None or not nominal.ok or nd == 0:
             return todo
         thr, q0 = _thresholds(), np.ascontiguousarray(nominal.q)
-        size = max(1, min(FULL_BLOCK, math.ceil(nd / (4 * workers))))
+        # one call on one thread (each return waits for the GIL: fewer is faster beside
+        # other threads running Python), else about four blocks per thread
+        size = nd if workers == 1 else max(1, min(FULL_BLOCK, math.ceil(nd / (4 * workers))))
         parts = [(a, min(a + size, nd)) for a in range(0, nd, size)]
         stops = np.full(nd, -1)
 
