@@ -121,6 +121,24 @@ def test_compiled_and_uncompiled_give_the_same_poses(fourbar_sweepers):
     np.testing.assert_array_equal(a.iterations, b.iterations)
 
 
+@pytest.mark.parametrize("skip", [False, True])
+@pytest.mark.parametrize("n", [40, 301, 1500])
+def test_both_virtual_machine_forms_follow_the_compiled_loop(fourbar_sweepers, monkeypatch, skip, n):
+    """The flat SX pose in 64- or 256-pose chunks (a small kernel) and the switched pose in
+    chunks sized to what is left (a large one, forced here) stop where the C loop stops."""
+    monkeypatch.setattr("kincas.core.fast.VM_SKIP", -1 if skip else 10**9)
+    th = np.linspace(0.3, 0.3 + 2 * np.pi, n)
+    U = th[:, None]
+    model, p, L, q0 = first_pose(fourbar(), U)
+    a = fourbar_sweepers[True].run(U, p, L, q0, U[0], start=1)
+    b = FastSweeper(model, FOURBAR_REPORT, compile=False).run(U, p, L, q0, U[0], start=1)
+    assert a.first_bad == b.first_bad == n
+    np.testing.assert_allclose(a.Q, b.Q, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(a.values[:, 1:], b.values[:, 1:], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(a.iterations, b.iterations)
+    check_residuals(model, b, p, L)
+
+
 @pytest.mark.parametrize("scale", [1.0, 1000.0])
 def test_offset_slider_crank_positions_velocities_accelerations(scale):
     r, l, e = 1.0 * scale, 3.2 * scale, 0.4 * scale

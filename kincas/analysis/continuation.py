@@ -161,6 +161,7 @@ def _passes_singular(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
     from .singular import locate_singular
     c = np.minimum(modes(model, J0, L)[1], modes(model, sol.J, L)[1])
     watch = np.flatnonzero(c < WATCH)
+    watch = watch[np.argsort(c[watch], kind="stable")]  # the likeliest crossing first: any one decides
     scales = model.scales(u0, p) if watch.size else None  # one pose's: shared by every search
     for i in watch:
         # two extended Newton steps putting s outside (-0.5, 1.5): not in this step
