@@ -14,7 +14,7 @@ usually is already). A pose is *accepted* only when it is verified in the same p
   L), every matrix on the segment from I to M is invertible, so det M > 0: det g_q kept its
   sign and no singular position lies between the two poses. The test fails near a singular
   position too (J_prev^-1 grows), where fixed-step kernels jump branch silently;
-- small correction: ||D^-1 (q - q_pred)|| <= CORRECTION.
+- small correction: ||D^-1 (q - q_pred)||_1 <= CORRECTION in every Assur group.
 
 The pass stops at the first pose that fails (every later pose would start from it); the
 caller re-solves that pose carefully and restarts the pass after it (`FastRun.advance`: a
@@ -117,7 +117,7 @@ class FastRun:
     residual = property(lambda self: self.info[0], doc="max |g| / L at each pose (L: each group's)")
     step = property(lambda self: self.info[1], doc="the last Newton step (negligible, applied)")
     jac_change = property(lambda self: self.info[2], doc="max per group of sum |D^-1 (A_prev^-1 A - I) D|")
-    correction = property(lambda self: self.info[3], doc="||D^-1 (q - q_pred)||_1")
+    correction = property(lambda self: self.info[3], doc="max per group of ||D^-1 (q - q_pred)||_1")
     iterations = property(lambda self: np.where(np.isnan(self.info[4]), 0.0, self.info[4]).astype(int),
                           doc="Newton steps taken at each pose (0 where none was attempted)")
     signs = property(lambda self: self.measures[:-1].T, doc="(N, groups) signs of det per group")

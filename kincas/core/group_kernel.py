@@ -173,7 +173,7 @@ class GroupFunctions:
         step = ca.vertcat(*dxs) if nq else ca.MX(0, 1)
         T = ca.vertcat(*Ts) if nq else ca.MX(0, nu)
         change = ca.mmax(ca.vertcat(0, *ch))
-        corr = ca.sum1(ca.vertcat(*co)) if co else ca.MX(0)
+        corr = ca.mmax(ca.vertcat(*co)) if co else ca.MX(0)  # per group, as the flat kernel
         sigma = ca.mmin(ca.vertcat(*sig)) if sig else ca.MX(1)
         kF = ca.Function("kF", [q, u, p, L, ud, udd, J0, qp, Lb],
                          [ca.vertcat(*A) if A else ca.MX(0, 1), T, _max_rows(r), ca.vertcat(change, corr),
