@@ -44,7 +44,7 @@ import numpy as np
 
 from .blocks import block_measures, block_solve, diagonal_blocks
 from .compiled import Backend, Library, ptr, rows
-from .fast import COMPILE_MAX, sweeper_for
+from .fast import COMPILE_MAX, SWEEP_SIG, sweeper_for
 from .kernel import NEAR, SWEEP_C
 from .tolerances import ACCEPT
 
@@ -198,7 +198,6 @@ int kincas_designs(casadi_int nd, casadi_int n, const casadi_real* U, const casa
   return (int) nd;
 }
 """
-_SWEEP_SIG = [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V, _V]
 _FULL_SIG = [_I, _I, _V, _V, _V, _V, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _V]
 _DESIGNS_SIG = [_I, _I, _V, _V, _I, _V, _V, _I, _V, _I, _V, _V, _V, _I, _V, _I, _V, _V]
 
@@ -223,10 +222,9 @@ class DesignsLoop:
         sw = self.sweeper
         fns = [*sw.functions, *continuation_functions(self.model.sym, sw.blocks)]
         return Library("kincas_designs", fns, SWEEP_C + _LOOP_C,
-                       {"NQ": self.nq, "NU": self.nu, "NO": self.no, "NM": self.ng + 1,
-                        "NJ": sw.nj, "NP": self.np, "NG": self.ng, "NS": sw.state_size,
+                       {**sw.sweep_macros(), "NP": self.np, "NG": self.ng, "NS": sw.state_size,
                         "HALVINGS": HALVINGS, "SUB": 2 ** HALVINGS},
-                       {"kincas_sweep": _SWEEP_SIG, "kincas_designs_full": _FULL_SIG,
+                       {"kincas_sweep": SWEEP_SIG, "kincas_designs_full": _FULL_SIG,
                         "kincas_designs": _DESIGNS_SIG})
 
     def lib(self, n: int):

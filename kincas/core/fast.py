@@ -75,6 +75,8 @@ BACKGROUND_POSES = 20_000
 INFO = ("residual", "step", "jac_change", "correction", "steps")
 BLOCK = 65536  # poses per call when a progress callback wants news
 _I, _V = ctypes.c_longlong, ctypes.c_void_p
+# kincas_sweep's C signature (SWEEP_C): every library that links the loop declares it so
+SWEEP_SIG = [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V, _V]
 
 
 # --- the sweep driver ---
@@ -218,10 +220,13 @@ class FastSweeper:
         return self._functions
 
     def _library(self) -> Library:
-        return Library("kincas_sweep", self.functions, SWEEP_C,
-                       {"NQ": self.nq, "NU": self.nu, "NO": len(self.report), "NM": len(self.blocks) + 1,
-                        "NJ": self.nj},
-                       {"kincas_sweep": [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V, _V]})
+        return Library("kincas_sweep", self.functions, SWEEP_C, self.sweep_macros(),
+                       {"kincas_sweep": SWEEP_SIG})
+
+    def sweep_macros(self) -> dict:
+        """The sizes SWEEP_C is compiled with (kincas/core/kernel.py)."""
+        return {"NQ": self.nq, "NU": self.nu, "NO": len(self.report), "NM": len(self.blocks) + 1,
+                "NJ": self.nj}
 
     def state(self, q, u, p, out=None) -> np.ndarray:
         """(q, J, T = dq/du, u, T, u) at a solved pose, matrices column-major as in casadi
