@@ -133,3 +133,86 @@ def test_newton_onto_a_double_root_stops_at_rounding():
     F = lambda x: (np.array([x[0] * x[0] - d]), np.array([[2 * x[0]]]))
     r = newton(F, np.array([1e-3]), np.ones(1), np.ones(1))
     assert r.ok and abs(r.x[0] - 1e-8) <= 1e-8 * 1e-12
+
+
+# --- item 7: crossings inside one step, and poses a hair past a limit ---
+
+
+def fourbar(b):
+    return Mechanism(ground={"A": (0, 0), "D": (D_, 0)},
+                     links=[Link.bar("crank", "A", "B", A_), Link.bar("coupler", "B", "C", b),
+                            Link.bar("rocker", "D", "C", C_)],
+                     inputs=[Input.angle("crank")], guess={"C": (3.2, 2.5)})
+
+
+def gap_edges(b):
+    """The crank angles (in (0, 2 pi)) where |BD| = b + c: no assembly between them."""
+    t = float(mp.acos((A_ ** 2 + D_ ** 2 - (mp.mpf(b) + C_) ** 2) / (2 * A_ * D_)))
+    return t, 2 * np.pi - t
+
+
+@pytest.mark.parametrize("method", ["fast", "careful"])
+def test_a_gap_inside_one_step_is_flagged_and_located(method):
+    """b = 1.999: |BD| exceeds b + c = 4.999 for |t - pi| < 0.05. Steps of 0.13 rad put the
+    whole gap inside one step, between two solved poses: both limits are located to the
+    law of cosines, the poses on either side flagged "limit", and the pose after the gap is
+    a "resume" (before, the sweep went straight on: nothing said)."""
+    lo, hi = gap_edges(1.999)
+    th = np.r_[lo - 0.02 - 0.13 * np.arange(5, 0, -1), lo - 0.02, hi + 0.03 + 0.13 * np.arange(4)]
+    k = 5  # the pose before the gap
+    sw = kincas.sweep(fourbar(1.999), {"crank.angle": th}, report=["C.x", "C.y", "C.vx"], method=method)
+    assert sw.ok.all() and np.all(sw.residual <= 1e-12)
+    assert sw.flags[k] == "limit" and sw.flags[k + 1] == "limit"
+    assert all(f is None for i, f in enumerate(sw.flags) if i not in (k, k + 1))
+    limits = sorted(e["inputs"]["crank.angle"] for e in sw.events if e["kind"] == "limit")
+    assert len(limits) == 2 and abs(limits[0] - lo) < 1e-9 and abs(limits[1] - hi) < 1e-9
+    assert [e["pose"] for e in sw.events if e["kind"] == "resume"] == [k + 1]
+
+
+@pytest.mark.parametrize("b", [1.9995, 1.9999])
+def test_every_gap_a_coarse_sweep_steps_over_is_flagged(b):
+    """Five turns in steps of 7.3 degrees over gaps of 4.1 and 1.8 degrees: wherever a gap
+    falls inside one step between two solved poses (the law of cosines says where), a limit
+    event lies in that step."""
+    lo, hi = gap_edges(b)
+    th = 0.3 + np.radians(7.3) * np.arange(250)
+    sw = kincas.sweep(fourbar(b), {"crank.angle": th}, report=["C.x"])
+    crossings = 0
+    for k in range(len(th) - 1):
+        a0, a1 = th[k] % (2 * np.pi), th[k + 1] % (2 * np.pi)
+        if not (sw.ok[k] and sw.ok[k + 1] and a0 < lo and hi < a1):
+            continue
+        crossings += 1
+        assert any(e["kind"] == "limit" and th[k] <= e["inputs"]["crank.angle"] <= th[k + 1] for e in sw.events), k
+        assert sw.flags[k] and sw.flags[k + 1]
+    assert crossings >= 3
+
+
+SLIDER = Mechanism(ground={"O": (0, 0)},
+                   links=[Link.bar("crank", "O", "A", 1), Link.bar("rod", "A", "B", 1)],
+                   slides=[kincas.Slide("B", "ground", through=(0, 0.5), name="slider")],
+                   inputs=[Input.angle("crank")], guess={"B": (1.0, 0.5)})
+
+
+@pytest.mark.parametrize("method", ["fast", "careful"])
+@pytest.mark.parametrize("past", [1e-15, 1e-14, 1e-13, 1e-12])
+def test_a_hair_past_a_limit_is_no_ordinary_pose(past, method):
+    """Slider-crank r = l = 1, slide y = 0.5: B is reachable while sin t >= -0.5, so the crank
+    turning down stops at t* = -pi/6 (rod square to the slide). Past it by 1e-15 .. 1e-12 no
+    assembly exists; the residual of the nearest pose is below ACCEPT all the same. So the
+    pose is either "no assembly", or solved within reach of the limit: flagged "limit", its
+    velocities null (before: "ok", unflagged, B.vx ~ 1e7) and B at the limit's position
+    to sqrt(past) (the rod's angle moves by sqrt(2 past) per past)."""
+    t_lim = -mp.pi / 6
+    u = float(t_lim - mp.mpf(past))
+    assert t_lim - mp.mpf(u) > 0  # past it, as a float
+    sw = kincas.sweep(SLIDER, {"crank.angle": [0.0, -0.3, -0.5, u]},
+                      report=["B.x", "B.vx", "rod.omega"], method=method)
+    if sw.status[-1] == "ok":
+        assert sw.flags[-1] == "limit"
+        assert np.isnan(sw["B.vx"][-1]) and np.isnan(sw["rod.omega"][-1])
+        assert abs(sw["B.x"][-1] - float(mp.cos(t_lim))) <= 1e-6
+        assert any(e["kind"] == "limit" and e["pose"] == 3 for e in sw.events)
+    else:
+        assert sw.status[-1] == "no assembly"
+    assert sw.status[:3].tolist() == ["ok"] * 3 and all(f is None for f in sw.flags[:3])
