@@ -14,11 +14,11 @@ from ..core.assembly import NEAR, assemble, modes, polish_singular
 # the first pose of a sweep (its home is the core: `kincas modes` and `range` start there too)
 from ..core.assembly import ambiguous as _ambiguous, first_pose as _first, no_assembly as _no_assembly  # noqa: F401
 from ..core.numeric import Model, Solution
+from ..core.tolerances import BRANCH, STEP_SLACK, STRAIGHT, WATCH
 from ..model.mechanism import Mechanism
 from .resume import carry_groups, larger_groups, resume_label
 
 
-WATCH = 0.5  # a group conditioned below this at either end of a step is checked for a crossing
 MAX_GROUPS = 8  # groups searched for a limit where continuation of a step failed (the worst conditioned first)
 
 # --- a pose of a sweep on the careful path ---
@@ -185,7 +185,7 @@ def _gap_inside(model: Model, run, U, p, L, j, k, sol: Solution, reach) -> bool:
     cond = modes(model, model.jac(near_j[0], near_j[1], p), L)[1]
     for i in np.argsort(cond, kind="stable")[:MAX_GROUPS]:
         found = locate_singular(model, *near_j, p, L, d, group=int(i), window=(-0.5, 1.5))
-        if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
+        if found is not None and -STEP_SLACK <= found[2] <= 1 + STEP_SLACK:
             back = []  # and from pose k back towards pose j: the other end of the gap
             _continue(model, sol.q, U[k], U[j], p, L, depth=8, reach=back)
             near_k = back[-1] if back else (sol.q, U[k])
@@ -222,7 +222,7 @@ def _crossed(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
         if min(c0[i], c1[i]) < NEAR and polish_singular(model, *start, p, L, [int(i)]) is not None:
             continue  # that end is the singular position (within rounding)
         found = locate_singular(model, start[0], start[1], p, L, d, group=int(i))
-        if found is None or not -1e-9 <= found[2] <= 1 + 1e-9:
+        if found is None or not -STEP_SLACK <= found[2] <= 1 + STEP_SLACK:
             return False
     return True
 
@@ -247,7 +247,7 @@ def _secant(q0, u0, u1, prev):
     if n0 == 0.0:
         return None
     t = float(d1 @ d0) / n0
-    if np.linalg.norm(d1 - t * d0) > 1e-9 * np.linalg.norm(d1):
+    if np.linalg.norm(d1 - t * d0) > STRAIGHT * np.linalg.norm(d1):
         return None  # the inputs turned: no straight line to follow
     return q0 + (q0 - qp) * t
 
@@ -275,4 +275,4 @@ def _same_branch(model: Model, J0, sol: Solution, L) -> bool:
     c = model.column_scale(L)
     Q0, R0 = np.linalg.qr(J0 * c)
     d0, d1 = float(np.prod(np.diag(R0))), float(np.linalg.det(Q0.T @ (sol.J * c)))
-    return np.sign(d0) == np.sign(d1) or min(abs(d0), abs(d1)) < 1e-8
+    return np.sign(d0) == np.sign(d1) or min(abs(d0), abs(d1)) < BRANCH

@@ -29,10 +29,10 @@ import numpy as np
 
 from ..core.assembly import _block_newton, blocks, group_links, modes
 from ..core.limits import locate_singular
-from ..core.tolerances import ACCEPT
+from ..core.tolerances import ACCEPT, SAME_ASSEMBLY as SAME, SAME_INPUT, STEP_SLACK
 
 WIDE = 2  # a group with more unknowns than this has more assemblies than block signs
-SAME = 1e-6  # two assemblies are one when every unknown agrees to this (lengths over L)
+# SAME: two assemblies are one when every unknown agrees to this (lengths over L)
 DEPTH = 10  # halvings of one input step while carrying groups through a gap
 BUDGET = 200  # Newton solves spent carrying groups across one input step of a gap
 
@@ -280,11 +280,11 @@ def _same_limit(model, U, p, L, j, qj, k, qk, i) -> bool:
     ends = []
     for q, u, nb in ((qj, U[j], U[j + 1]), (qk, U[k], U[k - 1])):
         found = locate_singular(model, q, u, p, L, nb - u, group=i)
-        if found is None or not -1e-9 <= found[2] <= 1 + 1e-9:
+        if found is None or not -STEP_SLACK <= found[2] <= 1 + STEP_SLACK:
             return False
         ends.append(found)
     (qa, ua, _), (qb, ub, _) = ends
-    if np.abs(np.asarray(ua) - np.asarray(ub)).max() > 1e-9 * max(1.0, float(np.abs(ua).max())):
+    if np.abs(np.asarray(ua) - np.asarray(ub)).max() > SAME_INPUT * max(1.0, float(np.abs(ua).max())):
         return False
     return _same(model, qa, qb, L, i)
 

@@ -37,15 +37,8 @@ import numpy as np
 from .newton import newton
 from .joints import settle_first
 from .numeric import Solution, _Call
-from .tolerances import ACCEPT, TOL
-
-SIGN_TOL = 1e-8  # a block whose conditioning is below this has no trustworthy sign (mode 0)
-# Newton converges only linearly onto a singular position, and stops about sqrt(TOL) from
-# it: a group conditioned below NEAR may be *at* one; `polish_singular` decides.
-NEAR = 1e-5
-# A pose is *at* a singular position when one satisfies g = 0 there to rounding: a pose 1e-12
-# of the input away from a limit is 1e-6 of the size away from the limit's positions.
-ROUNDING = 1e-15
+from .tolerances import (ACCEPT, NEAR_SINGULAR as NEAR, NULL_RESIDUAL, ROUNDING, ROUNDING_REL,  # noqa: F401
+                         SIGN_TOL, SINGULAR_RESIDUAL, TOL)
 
 
 # --- the groups: blocks of g_q ---
@@ -192,12 +185,12 @@ def _dyad(model, q, u, p, L, i):
     b2 = g(0.0, np.pi / 2) - (g00 + g0p) / 2  # M2 e2
     c = (g00 + gp0) / 2 - a2
     M1, M2 = np.column_stack([a1, b1]), np.column_stack([a2, b2])
-    rot = lambda M: abs(M[0, 0] - M[1, 1]) + abs(M[0, 1] + M[1, 0]) <= 1e-12 * (np.abs(M).max() + L)
+    rot = lambda M: abs(M[0, 0] - M[1, 1]) + abs(M[0, 1] + M[1, 0]) <= ROUNDING_REL * (np.abs(M).max() + L)
     if not (rot(M1) and rot(M2)):
         return None  # not two rotations (a reflected frame, a slide): Newton's business
     t = np.array([0.7, -1.9])
     e = lambda a: np.array([np.cos(a), np.sin(a)])
-    if np.abs(c + M1 @ e(t[0]) + M2 @ e(t[1]) - g(*t)).max() > 1e-12 * L:
+    if np.abs(c + M1 @ e(t[0]) + M2 @ e(t[1]) - g(*t)).max() > ROUNDING_REL * L:
         return None
     return c, a1, a2
 
@@ -212,11 +205,11 @@ def _dyad_solutions(model, q, u, p, L, i, near):
     c, m1, m2 = form
     v, r1, r2 = -c, float(np.hypot(*m1)), float(np.hypot(*m2))
     d = float(np.hypot(*v))
-    if d <= 1e-12 * L:
-        return None if abs(r1 - r2) <= 1e-12 * L else []  # concentric: a continuum, or none
+    if d <= ROUNDING_REL * L:
+        return None if abs(r1 - r2) <= ROUNDING_REL * L else []  # concentric: a continuum, or none
     x = (d * d + r1 * r1 - r2 * r2) / (2 * d)
     h2 = r1 * r1 - x * x
-    if h2 < -1e-12 * L * L:
+    if h2 < -ROUNDING_REL * L * L:
         return []  # the circles miss each other: no assembly
     h = np.sqrt(max(h2, 0.0))
     e = v / d
@@ -383,7 +376,7 @@ def polish_singular(model, q, u, p, L, groups, max_iter: int = 30):
             A.append(row)
             F.append(np.r_[Jv.ravel()[rows], v0s[k] @ vs[k] - 1])
         F, A = np.concatenate(F), np.vstack(A)
-        if np.abs(F).max() <= 1e-14 or it == max_iter:
+        if np.abs(F).max() <= SINGULAR_RESIDUAL or it == max_iter:
             break
         step = np.linalg.lstsq(A, -F, rcond=None)[0]
         if not np.all(np.isfinite(step)):
@@ -394,7 +387,7 @@ def polish_singular(model, q, u, p, L, groups, max_iter: int = 30):
             n = len(bl[i][1])
             vs[k] = vs[k] + step[off:off + n]
             off += n
-    if np.abs(F[:ng]).max() > ROUNDING or np.abs(F[ng:]).max() > 1e-10:
+    if np.abs(F[:ng]).max() > ROUNDING or np.abs(F[ng:]).max() > NULL_RESIDUAL:
         return None
     return q
 

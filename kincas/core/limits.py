@@ -28,7 +28,7 @@ import numpy as np
 
 from .assembly import blocks
 from .newton import newton
-from .tolerances import MAX_ITER
+from .tolerances import MAX_ITER, TINY
 
 
 # --- scaled Jacobians ---
@@ -139,7 +139,7 @@ def locate_singular(model, q, u, p, L, direction, max_iter: int = MAX_ITER, grou
     u0 = np.array(u, float)
     eq, qs = model.scales(u0, p) if scales is None else scales
     # s moves the inputs by s d: its unit is the step that moves them by one radian, or by L
-    s_unit = 1.0 / max(np.abs(d * cu * L).max(initial=0.0), 1e-300)
+    s_unit = 1.0 / max(np.abs(d * cu * L).max(initial=0.0), TINY)
     step_scale = np.r_[qs, s_unit, cq[cols]]
     res_scale = np.r_[eq, np.ones(len(rows) + 1)]
 

@@ -1,0 +1,48 @@
+"""Each algorithm and each threshold once, checked from the source (issue [15], "the same
+algorithm several times"): the numerical thresholds of kincas/core and kincas/analysis live in
+kincas/core/tolerances.py; the branch test (two modes differ, both defined) and the window of
+a located singular position along a step are each written once.
+"""
+from __future__ import annotations
+
+import ast
+import re
+
+from conftest import ROOT
+
+PKG = ROOT / "kincas"
+HOME = PKG / "core" / "tolerances.py"
+# a float literal this small is a tolerance, whatever its use
+SMALL = 1e-2
+
+
+def sources(*layers):
+    for layer in layers:
+        yield from sorted((PKG / layer).rglob("*.py"))
+
+
+def tolerance_literals(path):
+    """(line, value) of every float literal 0 < |v| <= SMALL in the code (docstrings and
+    comments are strings, not literals), and of every module-level UPPER_CASE name bound
+    to a float literal (a threshold by its name, whatever its size)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    out = [(n.lineno, n.value) for n in ast.walk(tree)
+           if isinstance(n, ast.Constant) and type(n.value) is float and 0 < abs(n.value) <= SMALL]
+    for n in tree.body:
+        if (isinstance(n, ast.Assign) and isinstance(n.value, ast.Constant) and type(n.value.value) is float
+                and all(isinstance(t, ast.Name) and t.id.upper() == t.id for t in n.targets)):
+            out.append((n.lineno, n.value.value))
+    return sorted(set(out))
+
+
+def test_every_threshold_in_tolerances():
+    bad = [f"{p.relative_to(ROOT)}:{line}: {v!r}" for p in sources("core", "analysis") if p != HOME
+           for line, v in tolerance_literals(p)]
+    assert not bad, "thresholds outside kincas/core/tolerances.py:\n" + "\n".join(bad)
+
+
+def test_the_scan_finds_thresholds(tmp_path):
+    """The scan above can fail: it sees a literal in code, a named constant, not a docstring."""
+    f = tmp_path / "m.py"
+    f.write_text('"""1e-9 in text."""\nWIDE = 0.5\ndef f(x):\n    return x < 1e-9\n')
+    assert tolerance_literals(f) == [(2, 0.5), (4, 1e-9)]
