@@ -46,3 +46,17 @@ def test_the_scan_finds_thresholds(tmp_path):
     f = tmp_path / "m.py"
     f.write_text('"""1e-9 in text."""\nWIDE = 0.5\ndef f(x):\n    return x < 1e-9\n')
     assert tolerance_literals(f) == [(2, 0.5), (4, 1e-9)]
+
+
+# (a != b) & (a != 0) & (b != 0): the modes changed and both are defined
+BRANCH_TEST = re.compile(r"\((\w[\w\[\]:\-+ ]*?) != (\w[\w\[\]:\-+ ]*?)\) & \(\1 != 0\) & \(\2 != 0\)")
+WINDOW = re.compile(r"-\s*(1e-9|STEP_SLACK)\s*<=.*<=\s*1\s*\+\s*(1e-9|STEP_SLACK)")
+
+
+def test_one_branch_test():
+    """Written once, in kincas/core/branch.py (it was written 7 times in continuation, resume, events)."""
+    hits = [f"{p.relative_to(ROOT)}:{i}" for p in sources("core", "analysis")
+            for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1) if BRANCH_TEST.search(line)]
+    assert len(hits) == 1 and hits[0].startswith("kincas/core/branch.py:"), "the branch test written out instead of core.branch.changed:\n" + "\n".join(hits)
+    assert BRANCH_TEST.search("np.any((s0 != s1) & (s0 != 0) & (s1 != 0))")
+    assert BRANCH_TEST.search("(signs[:-1] != signs[1:]) & (signs[:-1] != 0) & (signs[1:] != 0)")

@@ -13,6 +13,7 @@ import numpy as np
 from ..core.assembly import NEAR, assemble, modes, polish_singular
 # the first pose of a sweep (its home is the core: `kincas modes` and `range` start there too)
 from ..core.assembly import ambiguous as _ambiguous, first_pose as _first, no_assembly as _no_assembly  # noqa: F401
+from ..core import branch
 from ..core.numeric import Model, Solution
 from ..core.tolerances import BRANCH, STEP_SLACK, STRAIGHT, WATCH
 from ..model.mechanism import Mechanism
@@ -61,12 +62,12 @@ def careful_pose(model: Model, m: Mechanism, U, p, L, guess, k: int, j: int | No
     if sol.ok and not fresh:  # back in range: in the modes it left where they assemble
         before = modes(model, model.jac(run.Q[j], U[j], p), L)[0]
         after = modes(model, sol.J, L)[0]
-        changed = np.flatnonzero((before != after) & (before != 0) & (after != 0))
+        changed = np.flatnonzero(branch.changed(before, after))
         if changed.size:  # first the modes it left, group by group
             alt = assemble(model, u, p, L, want=before, near=run.Q[j])
             if alt is not None:
                 got = modes(model, alt.J, L)[0]
-                moved = np.flatnonzero((before != got) & (before != 0) & (got != 0))
+                moved = np.flatnonzero(branch.changed(before, got))
                 if moved.size < changed.size:
                     sol = alt
         events.append({"kind": "resume", "pose": int(k)}
@@ -110,7 +111,7 @@ def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:
 
     def keeps(sol):
         got = modes(model, sol.J, L)[0]
-        return not np.any((got != want) & (got != 0) & (want != 0))
+        return not branch.changed(got, want).any()
     sol = model.newton(last[0], u, p, L)
     if sol.ok and keeps(sol):
         return sol
@@ -217,7 +218,7 @@ def _crossed(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
     from .singular import locate_singular
     s0, c0 = modes(model, J0, L)
     s1, c1 = modes(model, sol.J, L)
-    for i in np.flatnonzero((s0 != s1) & (s0 != 0) & (s1 != 0)):
+    for i in np.flatnonzero(branch.changed(s0, s1)):
         start, d = ((q0, u0), u1 - u0) if c0[i] <= c1[i] else ((sol.q, u1), u0 - u1)
         if min(c0[i], c1[i]) < NEAR and polish_singular(model, *start, p, L, [int(i)]) is not None:
             continue  # that end is the singular position (within rounding)
@@ -271,7 +272,7 @@ def _same_branch(model: Model, J0, sol: Solution, L) -> bool:
     crossed, exactly as det g_q's sign change does for a square system."""
     if model.square:
         s0, s1 = modes(model, J0, L)[0], modes(model, sol.J, L)[0]
-        return not np.any((s0 != s1) & (s0 != 0) & (s1 != 0))
+        return not branch.changed(s0, s1).any()
     c = model.column_scale(L)
     Q0, R0 = np.linalg.qr(J0 * c)
     d0, d1 = float(np.prod(np.diag(R0))), float(np.linalg.det(Q0.T @ (sol.J * c)))

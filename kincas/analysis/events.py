@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core import branch
 from ..core.assembly import NEAR, group_links, modes, polish_singular, refine
 from ..core.symbolic import parse_quantity
 from ..core.tolerances import CLASSIFY, REACHED, SAME_INPUT, STEP_SLACK
@@ -133,7 +134,7 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
     # a group changing mode between two solved poses crossed a singular position of its own
     # (the changes found for all poses at once: a Python loop over every pose cost more than
     # the compiled solve of a long sweep)
-    flips = (signs[:-1] != signs[1:]) & (signs[:-1] != 0) & (signs[1:] != 0)
+    flips = branch.changed(signs[:-1], signs[1:])
     for k in np.flatnonzero(ok[:-1] & ok[1:] & flips.any(axis=1)):
         for i in np.flatnonzero(flips[k]):
             c0, c1 = measure(k)[1][i], measure(k + 1)[1][i]

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core import branch
 from ..core.assembly import _block_newton, blocks, group_links, modes
 from ..core.limits import locate_singular
 from ..core.tolerances import ACCEPT, SAME_ASSEMBLY as SAME, SAME_INPUT, STEP_SLACK
@@ -111,7 +112,7 @@ def resume_label(model, U, p, L, j, qj, k, qk, carried=None) -> dict:
     """
     before = modes(model, model.jac(qj, U[j], p), L)[0]
     after = modes(model, model.jac(qk, U[k], p), L)[0]
-    changed = {int(i) for i in np.flatnonzero((before != after) & (before != 0) & (after != 0))}
+    changed = {int(i) for i in np.flatnonzero(branch.changed(before, after))}
     unknown = []
     for i in larger_groups(model):
         if i in changed or before[i] == 0 or after[i] == 0:
