@@ -60,3 +60,12 @@ def test_one_branch_test():
     assert len(hits) == 1 and hits[0].startswith("kincas/core/branch.py:"), "the branch test written out instead of core.branch.changed:\n" + "\n".join(hits)
     assert BRANCH_TEST.search("np.any((s0 != s1) & (s0 != 0) & (s1 != 0))")
     assert BRANCH_TEST.search("(signs[:-1] != signs[1:]) & (signs[:-1] != 0) & (signs[1:] != 0)")
+
+
+def test_one_step_window():
+    """Written once, in kincas/core/limits.on_step (it was written 5 times in continuation, events, resume)."""
+    hits = [f"{p.relative_to(ROOT)}:{i}" for p in sources("core", "analysis")
+            for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1) if WINDOW.search(line)]
+    assert len(hits) == 1 and hits[0].startswith("kincas/core/limits.py:"), "the window of a located position written out instead of core.limits.on_step:\n" + "\n".join(hits)
+    assert WINDOW.search("if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:")
+    assert WINDOW.search("if found is None or not -STEP_SLACK <= found[2] <= 1 + STEP_SLACK:")

@@ -15,7 +15,8 @@ from ..core.assembly import NEAR, assemble, modes, polish_singular
 from ..core.assembly import ambiguous as _ambiguous, first_pose as _first, no_assembly as _no_assembly  # noqa: F401
 from ..core import branch
 from ..core.numeric import Model, Solution
-from ..core.tolerances import BRANCH, STEP_SLACK, STRAIGHT, WATCH
+from ..core.limits import on_step
+from ..core.tolerances import BRANCH, STRAIGHT, WATCH
 from ..model.mechanism import Mechanism
 from .resume import carry_groups, larger_groups, resume_label
 
@@ -186,7 +187,7 @@ def _gap_inside(model: Model, run, U, p, L, j, k, sol: Solution, reach) -> bool:
     cond = modes(model, model.jac(near_j[0], near_j[1], p), L)[1]
     for i in np.argsort(cond, kind="stable")[:MAX_GROUPS]:
         found = locate_singular(model, *near_j, p, L, d, group=int(i), window=(-0.5, 1.5))
-        if found is not None and -STEP_SLACK <= found[2] <= 1 + STEP_SLACK:
+        if on_step(found):
             back = []  # and from pose k back towards pose j: the other end of the gap
             _continue(model, sol.q, U[k], U[j], p, L, depth=8, reach=back)
             near_k = back[-1] if back else (sol.q, U[k])
@@ -223,7 +224,7 @@ def _crossed(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
         if min(c0[i], c1[i]) < NEAR and polish_singular(model, *start, p, L, [int(i)]) is not None:
             continue  # that end is the singular position (within rounding)
         found = locate_singular(model, start[0], start[1], p, L, d, group=int(i))
-        if found is None or not -STEP_SLACK <= found[2] <= 1 + STEP_SLACK:
+        if not on_step(found):
             return False
     return True
 

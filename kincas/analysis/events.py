@@ -36,7 +36,8 @@ import numpy as np
 from ..core import branch
 from ..core.assembly import NEAR, group_links, modes, polish_singular, refine
 from ..core.symbolic import parse_quantity
-from ..core.tolerances import CLASSIFY, REACHED, SAME_INPUT, STEP_SLACK
+from ..core.limits import on_step
+from ..core.tolerances import CLASSIFY, REACHED, SAME_INPUT
 from .singular import FLAG_SIGMA, classify, locate_singular, scaled_jacobians
 
 MAX_GROUPS_AT_GAP = 8  # groups tried for a limit next to a gap (the worst conditioned first)
@@ -140,7 +141,7 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
             c0, c1 = measure(k)[1][i], measure(k + 1)[1][i]
             start, other = (k, k + 1) if c0 <= c1 else (k + 1, k)
             found = locate_singular(model, Q[start], U[start], p, L, U[other] - U[start], group=int(i))
-            if found is not None and -STEP_SLACK <= found[2] <= 1 + STEP_SLACK:
+            if on_step(found):
                 pose = start if found[2] <= 0.5 else other
                 event(kind_at(found[0], found[1]), pose, found[1], int(i))
             else:  # crossed, but not located: said all the same
@@ -153,7 +154,7 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
                 continue
             for i in np.argsort(measure(k)[1])[:MAX_GROUPS_AT_GAP]:
                 found = locate_singular(model, Q[k], U[k], p, L, U[nb] - U[k], group=int(i))
-                if found is not None and -STEP_SLACK <= found[2] <= 1 + STEP_SLACK:
+                if on_step(found):
                     event(kind_at(found[0], found[1]), k, found[1], int(i))
     # a gap inside one step between two solved poses: its limits, located from the poses
     # nearest it on either side, flag the poses before and after it
@@ -165,7 +166,7 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
             cond = modes(model, model.jac(q, u, p), L)[1]
             for i in np.argsort(cond, kind="stable")[:MAX_GROUPS_AT_GAP]:
                 found = locate_singular(model, q, u, p, L, other - u, group=int(i))
-                if found is not None and -STEP_SLACK <= found[2] <= 1 + STEP_SLACK:
+                if on_step(found):
                     event(kind_at(found[0], found[1]), pose, found[1], int(i))
                     break
         if len(events) == seen:  # crossed, but not located: said all the same

@@ -29,8 +29,8 @@ import numpy as np
 
 from ..core import branch
 from ..core.assembly import _block_newton, blocks, group_links, modes
-from ..core.limits import locate_singular
-from ..core.tolerances import ACCEPT, SAME_ASSEMBLY as SAME, SAME_INPUT, STEP_SLACK
+from ..core.limits import locate_singular, on_step
+from ..core.tolerances import ACCEPT, SAME_ASSEMBLY as SAME, SAME_INPUT
 
 WIDE = 2  # a group with more unknowns than this has more assemblies than block signs
 # SAME: two assemblies are one when every unknown agrees to this (lengths over L)
@@ -281,7 +281,7 @@ def _same_limit(model, U, p, L, j, qj, k, qk, i) -> bool:
     ends = []
     for q, u, nb in ((qj, U[j], U[j + 1]), (qk, U[k], U[k - 1])):
         found = locate_singular(model, q, u, p, L, nb - u, group=i)
-        if found is None or not -STEP_SLACK <= found[2] <= 1 + STEP_SLACK:
+        if not on_step(found):
             return False
         ends.append(found)
     (qa, ua, _), (qb, ub, _) = ends

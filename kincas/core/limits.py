@@ -28,7 +28,7 @@ import numpy as np
 
 from .assembly import blocks
 from .newton import newton
-from .tolerances import MAX_ITER, TINY
+from .tolerances import MAX_ITER, STEP_SLACK, TINY
 
 
 # --- scaled Jacobians ---
@@ -174,3 +174,14 @@ def locate_singular(model, q, u, p, L, direction, max_iter: int = MAX_ITER, grou
     if not res.ok or not np.all(np.isfinite(res.x)):
         return None
     return qx, u0 + s * d, s
+
+
+def on_step(found) -> bool:
+    """Whether a singular position `found` by `locate_singular` along a step, (q*, u*, s*),
+    lies on that step: s* in [0, 1] to rounding (STEP_SLACK: a position located exactly at
+    either end pose is on it). False for None (nothing found).
+
+    >>> on_step((None, None, 1.0 + 1e-12)), on_step((None, None, -1e-3)), on_step(None)
+    (True, False, False)
+    """
+    return found is not None and -STEP_SLACK <= found[2] <= 1 + STEP_SLACK
