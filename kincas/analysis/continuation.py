@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.assembly import NEAR, assemble, modes, polish_singular
+from ..core.assembly import NEAR, assemble, modes
 # the first pose of a sweep (its home is the core: `kincas modes` and `range` start there too)
 from ..core.assembly import ambiguous as _ambiguous, first_pose as _first, no_assembly as _no_assembly  # noqa: F401
 from ..core import branch
 from ..core.numeric import Model, Solution
-from ..core.limits import on_step
+from ..core.limits import on_step, polish_singular
 from ..core.tolerances import BRANCH, STRAIGHT, WATCH
 from ..model.mechanism import Mechanism
 from .resume import carry_groups, larger_groups, resume_label

@@ -34,9 +34,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..core import branch
-from ..core.assembly import NEAR, group_links, modes, polish_singular, refine
+from ..core.assembly import NEAR, group_links, modes, refine
 from ..core.symbolic import parse_quantity
-from ..core.limits import on_step
+from ..core.limits import on_step, polish_singular
 from ..core.tolerances import CLASSIFY, REACHED, SAME_INPUT
 from .singular import FLAG_SIGMA, classify, locate_singular, scaled_jacobians
 

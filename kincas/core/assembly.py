@@ -16,9 +16,10 @@ is 2 x 2); the equations of block i involve only the unknowns of blocks 0..i. So
   wanted mode (default +1: the mode whose block determinant is positive) nearest a reference
   pose. A group with no solution from any start has no assembly there: that is decided in a
   few block Newton steps, without an optimiser.
-- at a pose at (or within rounding of) a singular position, `polish_singular` puts the
-  unknowns exactly on it: Gauss-Newton on g = 0, g_q[rows, cols] v = 0, v0.v = 1 at fixed
-  inputs, which converges quadratically where plain Newton crawls (g_q singular).
+- at a pose at (or within rounding of) a singular position, `polish_singular`
+  (kincas/core/limits.py) puts the unknowns exactly on it: the extended system g = 0,
+  g_q[rows, cols] v = 0, v0.v = 1 at fixed inputs, which converges quadratically where
+  plain Newton crawls (g_q singular).
 
 >>> import numpy as np, kincas
 >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
@@ -31,14 +32,12 @@ is 2 x 2); the equations of block i involve only the unknowns of blocks 0..i. So
 """
 from __future__ import annotations
 
-import casadi as ca
 import numpy as np
 
 from .newton import newton
 from .joints import settle_first
-from .numeric import Solution, _Call
-from .tolerances import (ACCEPT, NEAR_SINGULAR as NEAR, NULL_RESIDUAL, ROUNDING, ROUNDING_REL,  # noqa: F401
-                         SIGN_TOL, SINGULAR_RESIDUAL, TOL)
+from .numeric import Solution
+from .tolerances import ACCEPT, NEAR_SINGULAR as NEAR, ROUNDING_REL, SIGN_TOL, TOL  # noqa: F401
 
 
 # --- the groups: blocks of g_q ---
@@ -329,67 +328,6 @@ def refine(model, q, u, p, L):
     eq, qs = model.scales(u, p)
     res = newton(lambda x: model.resjac(x, u, p), np.array(q, float), qs, eq, tol=0.0, max_iter=8)
     return res.x if res.ok else np.array(q, float)
-
-
-def _jv_function(model):
-    """f(q, u, p, v) -> (g, g_q v, d[g; g_q v]/dq, g_q): the singular-pose system's parts."""
-    def build():
-        sym = model.sym
-        v = ca.SX.sym("v", sym.nq)
-        Jv = ca.mtimes(sym.Jq, v)
-        F = ca.vertcat(sym.g, Jv)
-        return _Call(ca.Function("jv", [sym.q, sym.u, sym.p, v], [sym.g, Jv, ca.jacobian(F, sym.q), sym.Jq]))
-    return model.memo("assembly.jv", build)
-
-
-def polish_singular(model, q, u, p, L, groups, max_iter: int = 30):
-    """The pose at inputs u where each group in `groups` (indices) is exactly singular,
-    from q nearby: Gauss-Newton on g(q) = 0 and, per group, g_q[rows, cols] v = 0 with
-    v0.v = 1. Returns q there, or None where no such pose lies within rounding of q (then
-    q is only near a singular position, and an ordinary pose)."""
-    f, bl = _jv_function(model), blocks(model)
-    nq, ng = model.nq, model.ng
-    c = model.column_scale(L)
-    vs, v0s = [], []
-    J = model.jac(q, u, p)
-    for i in groups:
-        rows, cols = bl[i]
-        v = np.linalg.svd(J[np.ix_(rows, cols)] * c[cols])[2][-1] * c[cols]
-        vs.append(v)
-        v0s.append(v / (v @ v))
-    q = np.array(q, float)
-    for it in range(max_iter + 1):
-        F, A = [], []
-        for k, i in enumerate(groups):
-            rows, cols = bl[i]
-            v = np.zeros(nq)
-            v[cols] = vs[k]
-            g, Jv, D, Jq = (np.asarray(a) for a in f(q, u, p, v))
-            if k == 0:
-                F.append(g.ravel() / L)
-                A.append(np.hstack([Jq / L, np.zeros((ng, sum(len(bl[j][1]) for j in groups)))]))
-            row = np.zeros((len(rows) + 1, nq + sum(len(bl[j][1]) for j in groups)))
-            row[:len(rows), :nq] = D[ng + rows]
-            off = nq + sum(len(bl[j][1]) for j in groups[:k])
-            row[:len(rows), off:off + len(cols)] = Jq[np.ix_(rows, cols)]
-            row[len(rows), off:off + len(cols)] = v0s[k]
-            A.append(row)
-            F.append(np.r_[Jv.ravel()[rows], v0s[k] @ vs[k] - 1])
-        F, A = np.concatenate(F), np.vstack(A)
-        if np.abs(F).max() <= SINGULAR_RESIDUAL or it == max_iter:
-            break
-        step = np.linalg.lstsq(A, -F, rcond=None)[0]
-        if not np.all(np.isfinite(step)):
-            return None
-        q = q + step[:nq]
-        off = nq
-        for k, i in enumerate(groups):
-            n = len(bl[i][1])
-            vs[k] = vs[k] + step[off:off + n]
-            off += n
-    if np.abs(F[:ng]).max() > ROUNDING or np.abs(F[ng:]).max() > NULL_RESIDUAL:
-        return None
-    return q
 
 
 # --- the first pose: from the guess, or group by group ---

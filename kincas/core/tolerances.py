@@ -39,8 +39,7 @@ NEAR_SINGULAR = 1e-5
 # A pose is *at* a singular position when one satisfies g = 0 there to rounding: a pose 1e-12
 # of the input away from a limit is 1e-6 of the size away from the limit's positions.
 ROUNDING = 1e-15
-SINGULAR_RESIDUAL = 1e-14  # polish_singular stops at this max |residual| (scaled)
-NULL_RESIDUAL = 1e-10  # ... and accepts a null vector whose equations are below this
+NULL_RESIDUAL = 1e-10  # polish_singular accepts null directions whose equations are below this
 FLAG_SIGMA = 1e-7  # relative smallest singular value at which a pose *is* singular
 CLASSIFY = 1e-6  # relative singular value below which a singular position's kind is decided
 REACHED = 1e-3  # a located position this fraction of a step away from a pose: the pose all but reached it

@@ -1,0 +1,84 @@
+"""One singular-position locator and one Newton (issue [15]): `polish_singular` (the pose at
+fixed inputs where a group is singular) solves the same extended system as `locate_singular`
+(kincas/core/limits.py), with the same null-direction routine and kincas/core/newton.py's
+stopping rule. Answers against closed forms in mpmath.
+
+The four-bar crank a = 1, coupler b = 1.9, rocker c = 3, ground d = 4 is singular where
+coupler and rocker are in line: C = D + c (B - D) / |B - D|, at crank angle t* with
+cos t* = (a^2 + d^2 - (b + c)^2) / (2 a d).
+"""
+from __future__ import annotations
+
+import mpmath as mp
+import numpy as np
+
+from kincas import Input, Link, Mechanism
+from kincas.core.limits import locate_singular, null_direction, polish_singular, scaled_jacobians
+from kincas.core.numeric import compile
+
+mp.mp.dps = 40
+A_, B_, C_, D_ = 1.0, 1.9, 3.0, 4.0
+FOURBAR = Mechanism(ground={"A": (0, 0), "D": (D_, 0)},
+                    links=[Link.bar("crank", "A", "B", A_), Link.bar("coupler", "B", "C", B_),
+                           Link.bar("rocker", "D", "C", C_)],
+                    inputs=[Input.angle("crank")], guess={"C": (3.2, 2.5)})
+L = FOURBAR.size()
+T_LIM = mp.acos((mp.mpf(A_) ** 2 + mp.mpf(D_) ** 2 - (mp.mpf(B_) + mp.mpf(C_)) ** 2) / (2 * mp.mpf(A_) * mp.mpf(D_)))
+P = np.zeros(0)
+
+
+def in_line(t):
+    """C with coupler and rocker in line, the crank at t (float t, exactly, in mpmath)."""
+    t = mp.mpf(t)
+    bx, by = mp.cos(t), mp.sin(t)
+    r = mp.sqrt((bx - D_) ** 2 + by ** 2)
+    return D_ + C_ * (bx - D_) / r, C_ * by / r
+
+
+def point_c(model, q, u):
+    return model.points(q, u, P)[:, FOURBAR.moving_points.index("C")]
+
+
+def solved(model, t):
+    u = np.array([t])
+    return model.newton(model.initial_q(u, P, dict(FOURBAR.guess), L), u, P, L).q, u
+
+
+def test_polish_onto_the_singular_position_at_fixed_inputs():
+    model = compile(FOURBAR)
+    t = float(T_LIM)
+    q, u = solved(model, t - 1e-4)  # an ordinary pose nearby, then the input at the limit
+    got = polish_singular(model, q, u + 1e-4, P, L, [0])
+    assert got is not None
+    cx, cy = in_line(t)
+    c = point_c(model, got, u + 1e-4)
+    assert abs(c[0] - float(cx)) <= 1e-13 * L and abs(c[1] - float(cy)) <= 1e-13 * L
+    assert np.abs(model.residual(got, u + 1e-4, P)).max() <= 1e-15 * L * 4
+
+
+def test_polish_refuses_a_pose_only_near_one():
+    model = compile(FOURBAR)
+    for delta in (1e-3, 1e-6, 1e-9):
+        q, u = solved(model, float(T_LIM) - delta)
+        assert polish_singular(model, q, u, P, L, [0]) is None, delta
+
+
+def test_locate_and_polish_agree():
+    """locate_singular moves the input to t*, polish_singular then stays there."""
+    model = compile(FOURBAR)
+    q, u = solved(model, 2.6)
+    q1, u1, s = locate_singular(model, q, u, P, L, [1.0])
+    assert abs(u1[0] - float(T_LIM)) <= 1e-14
+    q2 = polish_singular(model, q1, u1, P, L, [0])
+    assert q2 is not None and np.abs(q2 - q1).max() <= 1e-12
+
+
+def test_null_direction_is_the_null_vector():
+    model = compile(FOURBAR)
+    q1, u1, _ = locate_singular(model, *solved(model, 2.6), P, L, [1.0])
+    J, _ = scaled_jacobians(model, q1, u1, P, L)
+    cq = model.column_scale(L)
+    rows, cols = np.arange(model.ng), np.arange(model.nq)
+    v = null_direction(J, rows, cols, cq)
+    assert np.abs(model.jac(q1, u1, P) @ v).max() <= 1e-12 * np.abs(v).max() * L
+
