@@ -48,10 +48,12 @@ from typing import Mapping
 import numpy as np
 
 from ..errors import ModelError
+from ..core import branch
 from ..core.batch import BatchEvaluator
 from ..core.compiled import ptr, rows
 from ..core.designs_kernel import MAX_STEPS, NEWTON, STEP, designs_loop_for
 from ..core.fast import FastRun
+from ..core.newton import stop_rule
 from ..core.numeric import ACCEPT, compile as compile_model
 from ..core.symbolic import default_report
 from ..model.mechanism import Mechanism, as_param
@@ -381,9 +383,18 @@ class _Job:
             pt = p0 + dP[a] * (i / steps[a])[:, None]
             _, J, _, Gp = ev.derivatives(qa, ua, pc[a])
             qa = qa - _solve(J, np.einsum("dij,dj->di", Gp, pt - pc[a]))
+            # Newton (undamped: the predictor starts it close), each design stopping by the
+            # one rule of kincas/core/newton.py
+            D, live, last = np.where(model.sym.is_length[None, :], La[:, None], 1.0), np.ones(len(a), bool), np.inf
             for _ in range(NEWTON):
                 gv, J, _, _ = ev.derivatives(qa, ua, pt)
-                qa = qa - _solve(J, gv)
+                dq = _solve(J, gv)
+                size = np.abs(dq / D).max(axis=1, initial=0.0)
+                converged, stalled = stop_rule(np.abs(gv).max(axis=1) / La, size, last)
+                qa = np.where((live & ~stalled)[:, None], qa - dq, qa)
+                live, last = live & ~(converged | stalled), size
+                if not live.any():
+                    break
             gv, J, _, _ = ev.derivatives(qa, ua, pt)
             r = np.abs(gv).max(axis=1) / La
             with np.errstate(all="ignore"):
@@ -455,12 +466,14 @@ class _Job:
             for it in range(fast.MAX_EVALS):
                 g, Jk, Juk, _ = ev.derivatives(x, uk, pk)
                 dx = _solve(Jk, g)
-                now = ((np.abs(g).max(axis=1) / Lk <= fast.RESIDUAL)
-                       & (np.abs(dx / Dl).sum(axis=1) <= fast.STEP))
+                # the one stopping rule (kincas/core/newton.py), with the kernel's thresholds:
+                # solved and the next step negligible, which is applied
+                now = stop_rule(np.abs(g).max(axis=1) / Lk, np.abs(dx / Dl).max(axis=1),
+                                accept=fast.RESIDUAL, tol=fast.STEP)[0] & ~conv
+                x = np.where(conv[:, None], x, x - dx)
                 conv |= now
                 if conv.all() or it == fast.MAX_EVALS - 1:
                     break
-                x = np.where(conv[:, None], x, x - dx)
             with np.errstate(all="ignore"):
                 M = (_solve(J, Jk) - np.eye(model.nq)) * Dl[:, None, :] / Dl[:, :, None]
                 good = (conv & (np.abs(M).sum(axis=(1, 2)) <= fast.JAC_CHANGE)
@@ -587,7 +600,7 @@ def _same_modes(sign0, s) -> np.ndarray:
     s = np.asarray(s)
     if sign0 is None or s.shape[-1] != len(sign0):
         return np.ones(s.shape[:-1], dtype=bool)
-    return np.all((s == sign0) | (sign0 == 0) | (s == 0), axis=-1)
+    return ~branch.changed(s, sign0).any(axis=-1)
 
 
 def _thresholds() -> np.ndarray:
