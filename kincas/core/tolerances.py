@@ -17,3 +17,7 @@ BACKTRACK = 1 / 32  # shortest fraction of a Newton step tried while backtrackin
 DECREASE = 1e-4  # a backtracked step must lower the residual by this times its fraction
 BRANCH = 1e-8  # |det| of the column-scaled g_q below this: too close to singular to tell a branch
 RANK = 1e-8  # a scaled singular value below this times the largest counts as zero
+FREE_LINKS = 6  # links left free by a guess that are tried in several turns (core/guessed.py), at most
+NEARER = 1e-9  # another start's assembly is nearer the guessed points when its cost is below (1 - this) times
+CHOICE_STARTS = 128  # scattered starts finding a guessless sweep's other assemblies (analysis/choice.py)
+CHOICE_TRIES = 8  # of which at most this many are swept
