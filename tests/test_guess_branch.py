@@ -56,7 +56,7 @@ def wrapped(a):
 # (a, b, e, x): the first six gave the mirror assembly before the fix
 SLIDE_CASES = [(1.0, 1.780, 0.450, 0.662), (1.0, 1.258, -0.047, -1.711), (1.0, 0.902, 0.470, 0.172),
                (1.0, 2.114, 0.220, -2.528), (1.0, 2.083, -0.120, -1.609), (1.0, 1.210, -0.186, -0.573),
-               (1.0, 2.0, 0.0, 2.0), (1.0, 1.5, 0.3, 0.4)]
+               (1.0, 2.0, 0.0, 2.0), (1.0, 1.5, 0.3, 1.2)]
 
 
 @pytest.mark.parametrize("a, b, e, x", SLIDE_CASES)
@@ -165,7 +165,8 @@ def test_whitworth_without_guess_runs_all_73_poses():
     sw = sc.run()
     assert len(sw) == 73 and sw.ok.all()
     th = sw.inputs["crank.angle"]
-    D, E = (np.stack([sw[f"{p}.x"], sw[f"{p}.y"]], 1) for p in "DE")
+    D = np.stack([sw["D.x"], sw["D.y"]], 1)
+    E = np.stack([sw["E.x"], np.full(73, -20.0)], 1)  # the ram line
     far = lambda k, w: max(np.abs(D[k] - w["D"]).max(), np.abs(E[k] - w["E"]).max())
     # one assembly all the way round, one of the two with the lever pointing towards the pin
     # (pointing away, D rises out of the rod's reach: both of those fail 11 poses)
@@ -211,3 +212,31 @@ def test_a_sweep_that_no_assembly_runs_keeps_the_default():
     sw = kincas.sweep(m, {"crank.angle": np.linspace(0, 2 * np.pi, 37)}, report=["C.y"])
     assert not sw.ok.all() and not chosen(sw)
     assert sw["C.y"][0] > 0  # the default mode: B, D, C counter-clockwise
+
+
+@pytest.mark.parametrize("th_deg", [75.0, 90.0, 105.0])
+def test_without_guess_a_group_falls_back_to_its_other_mode(th_deg):
+    """At these crank angles the lever pointing away from the pin (its default mode) leaves D
+    out of the rod's reach: the documented rule takes the lever's other mode. (The group's
+    search used to offer its first mode twice, so no assembly was found at all.)"""
+    sc = whitworth_without_guess()
+    th = math.radians(th_deg)
+    pose = kincas.solve(sc.mechanism, {"crank.angle": th}, report=["D.x", "D.y", "E.x"])
+    assert pose.status == "ok"
+    got = np.array([pose["D.x"], pose["D.y"], pose["E.x"]])
+    assert min(np.abs(got - [*w["D"], w["E"][0]]).max() for w in whitworth_assemblies(th)[:2]) <= 1e-9 * 150
+
+
+def test_cli_modes_without_guess_marks_the_assembly_solve_takes(capsys, tmp_path):
+    doc = tomllib.loads(WHITWORTH.read_text())
+    del doc["guess"]
+    path = write_scene(tmp_path, dump_toml(doc))
+    code, out, err = run_cli(capsys, "modes", path, "--json", "--starts", "64")
+    assert code == 0, err
+    marked = [md for md in out["modes"] if md["from_guess"]]
+    assert len(out["modes"]) == 4 and len(marked) == 1
+    toward = [w["D"] for w in whitworth_assemblies(0.0)[:2]]
+    assert min(np.abs(np.array(marked[0]["points"]["D"]) - D).max() for D in toward) <= 1e-9 * 150
+    code, out, err = run_cli(capsys, "modes", path, "--starts", "64")
+    assert out.count("<- `kincas solve` starts on this one (no [guess])") == 1
+    assert "the scene's [guess]" not in out
