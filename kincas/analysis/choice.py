@@ -3,11 +3,12 @@
 With no `[guess]`, the first pose is assembled in the default modes (kincas/core/assembly.py).
 That assembly may lose poses another one keeps: the Whitworth quick return's lever pointing
 away from its fixed pin lifts D out of the rod's reach for 11 of 73 poses, while with the
-lever towards the pin every pose assembles. So where the default fails poses, and every
-failing pose has some assembly (for dyads and small groups `assemble` decides that without
-doubt; where it cannot, the search goes ahead), the first pose's other assemblies are found
-(`find_modes`) and swept from their points, fewest groups changed first, until one solves
-every pose. That one is returned with an `"assembly"` event naming it (its points, ready as a
+lever towards the pin every pose assembles. So where the default fails poses, and each of
+them has some assembly (asked of `first_pose` without a guess: for dyads and small groups at
+every lost pose, which group by group assembly decides without doubt; for larger groups, whose
+search may end in IPOPT, at the first and the middle pose of each gap), the first pose's other
+assemblies are found (`find_modes`) and swept from their points, fewest groups changed first,
+until one solves every pose. That one is returned with an `"assembly"` event naming it (its points, ready as a
 `[guess]`; the groups whose mode differs from the default) and why; where none does, the
 default stands. A user's guess is never overridden: this runs only without one.
 
@@ -26,8 +27,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.assembly import ambiguous, assemble, group_links, modes
+from ..core.assembly import ambiguous, first_pose, group_links, modes
 from ..core.tolerances import CHOICE_STARTS, CHOICE_TRIES
+from ..errors import ModelError
+
+
+def _unreachable(model, U, p, L, ok) -> bool:
+    """Whether some pose the default lost has no assembly in any mode. For dyads and small
+    groups every lost pose is asked (group by group assembly decides it, cheaply); where a
+    larger group makes that a search (with IPOPT), the first and the middle pose of each gap."""
+    bad = np.flatnonzero(~ok)
+    if ambiguous(model):
+        gaps = np.split(bad, np.flatnonzero(np.diff(bad) > 1) + 1)
+        bad = sorted({int(g[0]) for g in gaps} | {int(g[len(g) // 2]) for g in gaps})
+    return any(not first_pose(model, U[k], p, L, {}).ok for k in bad)
 
 
 def choose_assembly(model, m, U, p, L, default, rerun):
@@ -37,11 +50,14 @@ def choose_assembly(model, m, U, p, L, default, rerun):
     ok, n = np.asarray(default.ok), len(default)
     if ok.all() or not ok[0] or model.nq == 0:
         return None
-    if not ambiguous(model) and any(assemble(model, U[k], p, L) is None for k in np.flatnonzero(~ok)):
+    if _unreachable(model, U, p, L, ok):
         return None  # some pose has no assembly at all: none runs the whole sweep
     from .modes import find_modes
     u0 = U[0]
-    found = find_modes(m, {i.key: float(v) for i, v in zip(m.inputs, u0)}, starts=CHOICE_STARTS)
+    try:
+        found = find_modes(m, {i.key: float(v) for i, v in zip(m.inputs, u0)}, starts=CHOICE_STARTS)
+    except ModelError:  # the search is a courtesy: where it cannot be posed, the default stands
+        return None
     sign0 = modes(model, model.jac(default.q[0], u0, p), L)[0]
     pts0 = model.points(default.q[0], u0, p).T.ravel()
     names = group_links(model)
