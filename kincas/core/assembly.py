@@ -247,7 +247,7 @@ def _candidates(model, q, u, p, L, i, target, near, starts):
         found = [(modes(model, model.jac(qs, u, p), L)[0][i], far(qs), qs) for qs in closed]
         yield from ((t[0], t[2]) for t in sorted(found, key=lambda t: (target != 0 and t[0] != target, t[1])))
         return
-    other = None
+    other, taken = None, None
     for s in _starts(model, cols, L, near, starts if len(cols) <= 2 else 4 * starts):
         q0 = q.copy()
         q0[cols] = s
@@ -257,8 +257,8 @@ def _candidates(model, q, u, p, L, i, target, near, starts):
         mode = modes(model, model.jac(qs, u, p), L)[0][i]
         if mode == target:
             yield mode, qs
-            target = None  # one per mode
-        elif other is None and mode != 0:
+            taken, target = mode, None  # one per mode
+        elif other is None and mode != 0 and mode != taken:
             other = mode, qs
         if target is None and other is not None:
             break
@@ -428,8 +428,8 @@ def ambiguous(model) -> bool:
 
 def first_pose(model, u, p, L, guess) -> Solution:
     """The first pose of a sweep (and where `kincas modes` and `kincas range` start): from
-    the guessed points (the nearest assembly), or without a guess group by group in the
-    default modes (above)."""
+    the guessed points (the assembly nearest them, kincas/core/guessed.py), or without a
+    guess group by group in the default modes (above)."""
     return settle_first(model, _assembled(model, u, p, L, guess), u, p, L)  # gears: angles in (-pi, pi]
 
 
@@ -440,7 +440,8 @@ def _assembled(model, u, p, L, guess) -> Solution:
         sol = assemble(model, u, p, L)
         if sol is not None or not ambiguous(model):
             return sol if sol is not None else no_assembly(model, np.zeros(model.nq))
-    q0 = model.initial_q(u, p, guess, L)
+    from .guessed import guessed_start  # it builds on this module
+    q0 = guessed_start(model, u, p, L, guess) if guess else model.initial_q(u, p, guess, L)
     sol = model.newton(q0, u, p, L)
     if not sol.ok and guess:  # group by group from the guessed pose, then IPOPT if in doubt
         sol = assemble(model, u, p, L, near=q0) or sol
