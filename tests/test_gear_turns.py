@@ -69,7 +69,8 @@ def rack_mechanism(alpha=ALPHA, guess=None):
                      links=[Link.bar("pinion", "G", "T", "rp"), Link("rack", {"R1": (-150, 0), "R2": (100, 0)})],
                      slides=[Slide("R1", "ground", through=tuple(P0), angle=alpha, name="guide"),
                              Slide("G", "rack", through=(0, 20), angle=0, name="travel")],
-                     racks=[Rack("pinion", "rp", "travel")], inputs=[Input.angle("pinion")], guess=guess)
+                     racks=[Rack("pinion", "rp", "travel")], inputs=[Input.angle("pinion")],
+                     guess=guess or {"R1": (-150, 0), "R2": (100, 0)})
 
 
 def drawn_guess(th, tp):
@@ -197,3 +198,15 @@ def test_resolve_from_a_sweeps_pose_returns_it(case):
         assert pose.status == "ok", k
         for P in pts:
             assert math.hypot(pose[f"{P}.x"] - guess[P][0], pose[f"{P}.y"] - guess[P][1]) < 1e-9 * L, (k, P)
+
+
+def test_modes_of_a_rack_are_closed_form_roots():
+    """`find_modes` starts every scattered guess at the turns the rack relation wants: each
+    mode found is a closed-form assembly, and the two nearest rack angle 0 are among them."""
+    from kincas.analysis.modes import find_modes
+    alpha = ALPHA
+    roots = rack_roots(3.0, alpha)
+    found = [md.q[md.unknowns.index("rack.angle")] for md in find_modes(rack_mechanism(alpha), {"pinion.angle": 3.0}, starts=64)]
+    assert all(np.abs(roots - t).min() < 1e-9 for t in found)
+    near = roots[np.argsort(np.abs(roots))[:2]]
+    assert all(np.abs(np.array(found) - t).min() < 1e-9 for t in near)
