@@ -210,3 +210,20 @@ def test_modes_of_a_rack_are_closed_form_roots():
     assert all(np.abs(roots - t).min() < 1e-9 for t in found)
     near = roots[np.argsort(np.abs(roots))[:2]]
     assert all(np.abs(np.array(found) - t).min() < 1e-9 for t in near)
+
+
+def test_assembly_near_a_solved_pose_keeps_its_turns():
+    """Group by group from a solved pose (how a sweep resumes after a gap), a group with a
+    rack keeps the free angles' turns of that pose: a sweep's angles stay continuous."""
+    from kincas.cli.scene import load
+    from kincas.core.assembly import assemble
+    from conftest import EXAMPLES
+    m = load(EXAMPLES / "rack_fourbar.toml").mechanism
+    model, p, L = kincas.compile(m), np.array([v for _, v in m.parameters]), m.size()
+    sw = kincas.sweep(m, {"pinion.angle": [0.3]})
+    near = sw.q[0].copy()
+    j = sw.unknowns.index("coupler.angle")
+    near[j] += 2 * TURN
+    sol = assemble(model, np.array([0.3]), p, L, want=[0] * len(model.blocks), near=near)
+    assert sol is not None and abs(sol.q[j] - near[j]) < 1e-6
+    np.testing.assert_allclose(np.delete(sol.q, j), np.delete(sw.q[0], j), rtol=0, atol=1e-9 * L)

@@ -243,14 +243,15 @@ def _candidates(model, q, u, p, L, i, target, near, starts):
         return
     # a gear's or rack's angle: its assemblies lie about a turn apart (kincas/core/turns.py),
     # each start may land on another: every start is run and the nearest of each mode kept
-    every = near is not None and bool(tied(model)[cols].any())
+    ties = bool(tied(model)[cols].any())
+    every = near is not None and ties
     other, found = None, {}
     before = np.concatenate([c for _, c in blocks(model)[:i]] + [np.zeros(0, int)])
     for s in _starts(model, cols, L, near, starts if len(cols) <= 2 else 4 * starts):
         q0 = q.copy()
         q0[cols] = s
-        # the turns that gears and racks want, from the groups before (kincas/core/turns.py)
-        q0 = turns(model, q0, u, p, cols=cols, known=set(before.tolist()))
+        if ties:  # the turns that gears and racks want, from the groups before (core/turns.py)
+            q0 = turns(model, q0, u, p, cols=cols, known=set(before.tolist()), start=near is None)
         qs, r = _block_newton(model, q0, u, p, L, i)
         if r > ACCEPT:
             continue

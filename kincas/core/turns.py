@@ -100,9 +100,9 @@ def free(model) -> np.ndarray:
     return ~model.sym.is_length & ~tied(model)
 
 
-def turns(model, q, u, p, cols=None, known=()) -> np.ndarray:
+def turns(model, q, u, p, cols=None, known=(), start=True) -> np.ndarray:
     """q with the whole turns of its tied angles chosen so that each relation holds as
-    nearly as turns can make it, and its free angles in (-pi, pi].
+    nearly as turns can make it, and (`start`: a first pose) its free angles in (-pi, pi].
 
     An angle is set from a relation whose other angles are known: the inputs, the angles in
     `known`, and those set before it (so the turns propagate from the inputs, through a
@@ -110,14 +110,17 @@ def turns(model, q, u, p, cols=None, known=()) -> np.ndarray:
     turn nearest the relation's value. A component of relations tied to no known angle
     gets its first angle in (-pi, pi], or the turn within ROOT_TURNS of it whose relations
     then hold best. Only the angles among `cols` (default: every unknown) change; a
-    relation with an angle outside `cols` and `known` is left alone (not solved yet)."""
+    relation with an angle outside `cols` and `known` is left alone (not solved yet).
+    Without `start` (a start near a solved pose), free angles and a component's first
+    angle keep their turns: a sweep's angles stay continuous."""
     q = np.array(q, dtype=float)
     slots, f = _relations(model)
     angle = ~model.sym.is_length
     change = np.zeros(model.nq, dtype=bool)
     change[np.arange(model.nq) if cols is None else np.asarray(cols, int)] = True
     change &= angle
-    q[change & free(model)] = wrap(q[change & free(model)])
+    if start:
+        q[change & free(model)] = wrap(q[change & free(model)])
     if not slots:
         return q
     vals = np.asarray(f(q, u, p)).ravel()
@@ -132,7 +135,8 @@ def turns(model, q, u, p, cols=None, known=()) -> np.ndarray:
     fixed = {j for j in known}
     pending = sorted({s[1] for r in usable for s in r[0] if s is not None and s[0] == "q" and change[s[1]]}
                      - fixed)
-    q[pending] = wrap(q[pending])
+    if start:
+        q[pending] = wrap(q[pending])
     q, fixed = _propagate(q, u, usable, fixed)
     while True:
         left = [j for j in pending if j not in fixed]
