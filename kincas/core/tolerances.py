@@ -68,3 +68,7 @@ MESH = 1e-9  # gears whose centre distance misses r1 +- r2 by this times the siz
 IPOPT_TOL = 1e-12
 REGULARIZE = 1e-6  # weight of ||x - x0||^2 in the assembly NLP: the nearest assembly among equals
 TRANSLATION_RTOL, TRANSLATION_ATOL = 1e-12, 1e-14  # JAX against casadi on random arguments
+FREE_LINKS = 6  # links left free by a guess that are tried in several turns (core/guessed.py), at most
+NEARER = 1e-9  # another start's assembly is nearer the guessed points when its cost is below (1 - this) times
+CHOICE_STARTS = 128  # scattered starts finding a guessless sweep's other assemblies (analysis/choice.py)
+CHOICE_TRIES = 8  # of which at most this many are swept
