@@ -67,3 +67,25 @@ class BatchEvaluator:
             return np.zeros((len(names), n))
         f = self.model.quantity_function(tuple(names))
         return np.asarray(self._mapped(f, n)(Q.T, U.T, P.T, Ud.T, Udd.T))
+
+
+def batched_solve(J, b):
+    """Batched J^-1 b (J: a stack of square matrices; b: a vector or a matrix per J); NaN
+    where J is singular.
+
+    >>> J = np.array([[[2.0, 0.0], [0.0, 4.0]], [[1.0, 1.0], [1.0, 1.0]]])
+    >>> batched_solve(J, np.ones((2, 2))).tolist()
+    [[0.5, 0.25], [nan, nan]]
+    """
+    vec = b.ndim == J.ndim - 1
+    B = b[..., None] if vec else b
+    try:
+        X = np.linalg.solve(J, B)
+    except np.linalg.LinAlgError:
+        X = np.full(B.shape, np.nan)
+        for i in range(len(B)):
+            try:
+                X[i] = np.linalg.solve(J[i], B[i])
+            except np.linalg.LinAlgError:
+                pass
+    return X[..., 0] if vec else X

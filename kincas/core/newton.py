@@ -58,7 +58,7 @@ def stop_rule(r, size, last=np.inf, *, accept: float = ACCEPT, tol: float = TOL)
     compiled kernel does (kincas/core/kernel.py). stalled: solved and the step no longer
     shrinks (not below SHRINK times the last one): rounding, magnified by 1 / sigma_min next
     to a singular position; stop without it. `newton` below, `scatter.newton_starts` and
-    the designs' batched loop (kincas/analysis/designs.py) all stop by it.
+    the designs' batched loops (kincas/analysis/design_job.py) all stop by it.
 
     >>> [bool(b) for b in stop_rule(1e-12, 1e-14)], [bool(b) for b in stop_rule(1e-12, 1e-9, 1e-9)]
     ([True, False], [False, True])
