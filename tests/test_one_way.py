@@ -53,10 +53,15 @@ BRANCH_TEST = re.compile(r"\((\w[\w\[\]:\-+ ]*?) != (\w[\w\[\]:\-+ ]*?)\) & \(\1
 WINDOW = re.compile(r"-\s*(1e-9|STEP_SLACK)\s*<=.*<=\s*1\s*\+\s*(1e-9|STEP_SLACK)")
 
 
+def matching_lines(pattern) -> list[str]:
+    """path:line of every line of kincas/core and kincas/analysis that `pattern` matches."""
+    return [f"{p.relative_to(ROOT)}:{i}" for p in sources("core", "analysis")
+            for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1) if pattern.search(line)]
+
+
 def test_one_branch_test():
     """Written once, in kincas/core/branch.py (it was written 7 times in continuation, resume, events)."""
-    hits = [f"{p.relative_to(ROOT)}:{i}" for p in sources("core", "analysis")
-            for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1) if BRANCH_TEST.search(line)]
+    hits = matching_lines(BRANCH_TEST)
     assert len(hits) == 1 and hits[0].startswith("kincas/core/branch.py:"), "the branch test written out instead of core.branch.changed:\n" + "\n".join(hits)
     assert BRANCH_TEST.search("np.any((s0 != s1) & (s0 != 0) & (s1 != 0))")
     assert BRANCH_TEST.search("(signs[:-1] != signs[1:]) & (signs[:-1] != 0) & (signs[1:] != 0)")
@@ -64,8 +69,7 @@ def test_one_branch_test():
 
 def test_one_step_window():
     """Written once, in kincas/core/limits.on_step (it was written 5 times in continuation, events, resume)."""
-    hits = [f"{p.relative_to(ROOT)}:{i}" for p in sources("core", "analysis")
-            for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1) if WINDOW.search(line)]
+    hits = matching_lines(WINDOW)
     assert len(hits) == 1 and hits[0].startswith("kincas/core/limits.py:"), "the window of a located position written out instead of core.limits.on_step:\n" + "\n".join(hits)
     assert WINDOW.search("if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:")
     assert WINDOW.search("if found is None or not -STEP_SLACK <= found[2] <= 1 + STEP_SLACK:")

@@ -16,15 +16,8 @@ import numpy as np
 from kincas import Input, Link, Mechanism
 from kincas.core.limits import locate_singular, null_direction, polish_singular, scaled_jacobians
 from kincas.core.numeric import compile
+from test_near_limits import B_, C_, D_, FOURBAR, L, T_LIM  # the same four-bar
 
-mp.mp.dps = 40
-A_, B_, C_, D_ = 1.0, 1.9, 3.0, 4.0
-FOURBAR = Mechanism(ground={"A": (0, 0), "D": (D_, 0)},
-                    links=[Link.bar("crank", "A", "B", A_), Link.bar("coupler", "B", "C", B_),
-                           Link.bar("rocker", "D", "C", C_)],
-                    inputs=[Input.angle("crank")], guess={"C": (3.2, 2.5)})
-L = FOURBAR.size()
-T_LIM = mp.acos((mp.mpf(A_) ** 2 + mp.mpf(D_) ** 2 - (mp.mpf(B_) + mp.mpf(C_)) ** 2) / (2 * mp.mpf(A_) * mp.mpf(D_)))
 P = np.zeros(0)
 
 

@@ -20,6 +20,11 @@ kept.
 >>> q, u, s = locate_singular(model, q, np.array([2.6]), np.zeros(0), m.size(), [1.0])
 >>> round(math.degrees(u[0]), 9)  # |BD| = 1.9 + 3: the law of cosines
 151.193259668
+>>> p = np.zeros(0)
+>>> polish_singular(model, q + 1e-9, u, p, m.size(), [0]) is not None  # at the limit: onto it
+True
+>>> polish_singular(model, q, u - 1e-6, p, m.size(), [0]) is None  # 1e-6 rad before it: not at one
+True
 """
 from __future__ import annotations
 
@@ -230,19 +235,8 @@ def polish_singular(model, q, u, p, L, groups, max_iter: int = 30):
     near a singular position, and an ordinary pose): g / L below ROUNDING, the null
     directions' equations below NULL_RESIDUAL.
 
-    >>> import math, numpy as np, kincas
-    >>> from kincas.core.numeric import compile
-    >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
-    ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 1.9),
-    ...            kincas.Link.bar("rocker", "D", "C", 3)],
-    ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.2, 2.5)})
-    >>> model, L, p = compile(m), m.size(), np.zeros(0)
-    >>> q = model.newton(model.initial_q(np.array([2.6]), [], dict(m.guess), 4), np.array([2.6]), p, L).q
-    >>> q, u, s = locate_singular(model, q, np.array([2.6]), p, L, [1.0])
-    >>> polish_singular(model, q + 1e-9, u, p, L, [0]) is not None  # at the limit: onto it
-    True
-    >>> polish_singular(model, q, u - 1e-6, p, L, [0]) is None  # 1e-6 rad before it: not at one
-    True
+    See the module's example: from next to the limit it located, polish_singular reaches
+    it; 1e-6 rad of the crank before it, there is none.
     """
     if model.nq == 0 or not len(groups):
         return None
