@@ -202,7 +202,7 @@ class _Filling:
 
 @pytest.mark.parametrize("flag,name", [("--csv", "out.csv"), ("--html", "out.html"),
                                         ("--svg", "out.svg"), ("--dxf", "out.dxf"),
-                                        ("--plot", "out.png"), ("--plot-quantities", "q.png"),
+                                        ("--plot", "out.png"),
                                         ("--animate", "out.gif")])
 def test_a_full_disk_leaves_no_partial_file(capsys, tmp_path, monkeypatch, flag, name):
     scene = write_scene(tmp_path, SMALL)

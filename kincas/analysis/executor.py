@@ -20,9 +20,7 @@ from __future__ import annotations
 import os
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 
-from ..core.cancel import Token, cancelling, checkpoint, current
-
-WAIT = 0.1  # seconds the main thread waits for a chunk before it looks for Ctrl-C again
+from ..core.cancel import WAIT, Token, cancelling, checkpoint, current
 
 
 def default_workers() -> int:

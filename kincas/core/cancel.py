@@ -68,6 +68,20 @@ def cancelling(token: Token | None):
         _CURRENT.reset(mark)
 
 
+WAIT = 0.1  # seconds a thread waits for a lock or a process before it looks for a cancellation
+
+
+@contextlib.contextmanager
+def held(lock):
+    """`with lock:`, but a thread waiting for it stops when its work is cancelled."""
+    while not lock.acquire(timeout=WAIT):
+        checkpoint()
+    try:
+        yield lock
+    finally:
+        lock.release()
+
+
 def checkpoint() -> None:
     """Raise `Cancelled` when this thread's work was cancelled."""
     t = _CURRENT.get()
