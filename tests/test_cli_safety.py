@@ -53,8 +53,8 @@ def kincas(*args, **kw) -> subprocess.Popen:
 # --- item 9: Ctrl-C stops every long command within a second ---
 
 
-def interrupt(proc: subprocess.Popen, after: float = 2.5) -> tuple[float, str]:
-    """SIGINT after `after` s (the work under way); (seconds from the signal to the exit, stderr)."""
+def interrupt(proc: subprocess.Popen, after: float = 3.5) -> tuple[float, str]:
+    """SIGINT after `after` s (imports done, the work under way); (seconds from the signal to the exit, stderr)."""
     time.sleep(after)
     assert proc.poll() is None, proc.communicate()  # still working: the scene is long enough
     proc.send_signal(signal.SIGINT)

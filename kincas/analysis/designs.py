@@ -462,6 +462,7 @@ class _Job:
         _, J, Ju, _ = ev.derivatives(q, np.repeat(U[:1], len(d), 0), self.P[d])
         T = -_solve(J, Ju)
         for k in range(1, n):
+            checkpoint()  # Ctrl-C, when this runs on a worker thread
             if not len(live):
                 break
             d, Dl = todo[live], D[live]

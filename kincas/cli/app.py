@@ -56,7 +56,11 @@ def _parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
-    ap = _parser(argv)
+    try:
+        ap = _parser(argv)  # imports the command's module: Ctrl-C may come while it does
+    except KeyboardInterrupt:
+        print("\nkincas: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     args = ap.parse_args(argv)
     if args.version:
         print(f"kincas {__version__}")
