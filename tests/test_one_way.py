@@ -35,9 +35,16 @@ def tolerance_literals(path):
     return sorted(set(out))
 
 
+# Small numbers that are not numerical thresholds: times in seconds, with the reason
+NOT_TOLERANCES = {
+    ("kincas/core/cancel.py", 0.1): "WAIT, seconds between looks for a cancellation",
+    ("kincas/analysis/design_job.py", 1e-6): "a floor of a call's measured time in seconds",
+}
+
+
 def test_every_threshold_in_tolerances():
     bad = [f"{p.relative_to(ROOT)}:{line}: {v!r}" for p in sources("core", "analysis") if p != HOME
-           for line, v in tolerance_literals(p)]
+           for line, v in tolerance_literals(p) if (str(p.relative_to(ROOT)), v) not in NOT_TOLERANCES]
     assert not bad, "thresholds outside kincas/core/tolerances.py:\n" + "\n".join(bad)
 
 

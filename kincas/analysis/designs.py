@@ -48,8 +48,9 @@ from ..core.numeric import compile as compile_model
 from ..core.symbolic import default_report
 from ..model.mechanism import Mechanism, as_param
 from .continuation import _first
-from .design_job import (BLOCK, BRANCH_LOST, FULL_BLOCK, NO_ASSEMBLY, NO_MESH, NOT_SOLVED, OK,  # noqa: F401
-                         STATUS, _Job, _lock)
+from .design_job import (BLOCK, BLOCK_POSES, BRANCH_LOST, CALL_SECONDS, FIRST_CALL, FULL_BLOCK,  # noqa: F401
+                         NO_ASSEMBLY, NO_MESH, NOT_SOLVED, OK, STATUS, _Job)
+from ..core.batch import model_lock as _lock
 from .sweeps import _input_table
 
 

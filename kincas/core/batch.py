@@ -18,6 +18,9 @@ in kincas/core/designs_kernel.py.
 """
 from __future__ import annotations
 
+import threading
+import weakref
+
 import casadi as ca
 import numpy as np
 
@@ -89,3 +92,15 @@ def batched_solve(J, b):
             except np.linalg.LinAlgError:
                 pass
     return X[..., 0] if vec else X
+
+
+# --- one lock per compiled model for the Python-side numerics (Model keeps work buffers) ---
+
+_LOCKS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_LOCKS_LOCK = threading.Lock()
+
+
+def model_lock(model) -> threading.RLock:
+    """The one lock of `model` (reentrant), for the callers of its numerics on threads."""
+    with _LOCKS_LOCK:
+        return _LOCKS.setdefault(model, threading.RLock())

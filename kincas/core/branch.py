@@ -30,3 +30,16 @@ def changed(a, b) -> np.ndarray:
     """
     a, b = np.asarray(a), np.asarray(b)
     return (a != b) & (a != 0) & (b != 0)
+
+
+def kept(sign0, s) -> np.ndarray:
+    """Whether the modes s (one row per pose or design, or one) kept sign0 in every group
+    where both are defined (sign0 None, or of another length: no mode to keep).
+
+    >>> kept(np.array([1, -1]), np.array([[1, -1], [1, 0], [-1, -1]])).tolist()
+    [True, True, False]
+    """
+    s = np.asarray(s)
+    if sign0 is None or s.shape[-1] != len(sign0):
+        return np.ones(s.shape[:-1], dtype=bool)
+    return ~changed(s, sign0).any(axis=-1)
