@@ -89,8 +89,8 @@ class Load:
         >>> Load.force("C", (0, -9.81)).value
         (0, -9.81)
         """
-        fx, fy = force
-        return cls("force", at=point, value=(fx, fy))
+        from .parts import _pair  # (parts imports this module)
+        return cls("force", at=point, value=_pair(force, f"[[loads]] force at {point}: force"))
 
     @classmethod
     def torque(cls, link: str, torque) -> "Load":
@@ -110,7 +110,8 @@ class Load:
         >>> Load.torque("rocker", "T").at
         'rocker'
         """
-        return cls("torque", at=link, value=torque)
+        from .parts import as_number
+        return cls("torque", at=link, value=as_number(torque))
 
     @classmethod
     def spring(cls, a: str, b: str, stiffness, free_length) -> "Load":
@@ -130,7 +131,9 @@ class Load:
         >>> Load.spring("A", "P", 200, 40).stiffness
         200
         """
-        return cls("spring", points=(a, b), stiffness=stiffness, free_length=free_length)
+        from .parts import as_number
+        return cls("spring", points=(a, b), stiffness=as_number(stiffness),
+                   free_length=as_number(free_length))
 
     @property
     def link(self) -> str:

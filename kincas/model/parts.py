@@ -8,9 +8,11 @@
 """
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 from typing import Mapping, Union
 
+from ..errors import ModelError
 from .loads import Inertia
 
 # --- numbers that may name a parameter ---
@@ -52,9 +54,57 @@ def as_param(v: Num) -> Param | None:
     return None
 
 
-def _pair(v) -> tuple[Num, Num]:
-    x, y = v
-    return (x, y)
+def as_number(v):
+    """A numpy scalar (np.int64, np.float32, ...) as a Python float; anything else unchanged
+    (a Python number, a parameter's name, a `Param`, or a mistake for the checks to name).
+
+    >>> import numpy as np
+    >>> as_number(np.int64(3)), as_number(np.float32(0.5)), as_number(2), as_number("r")
+    (3.0, 0.5, 2, 'r')
+    """
+    if isinstance(v, numbers.Real) and not isinstance(v, (bool, int, float)):
+        return float(v)
+    return v
+
+
+def is_number(v) -> bool:
+    """Whether v is a real number (numpy's too), not a bool.
+
+    >>> import numpy as np
+    >>> is_number(np.int64(1)), is_number(1.5), is_number(True), is_number("1")
+    (True, True, False, False)
+    """
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)  # (numpy's bool is no Real)
+
+
+def _pair(v, where: str = "") -> tuple[Num, Num]:
+    """(x, y) from a pair of numbers or parameter names; ModelError naming `where` for
+    anything else (a number alone, three values, a string)."""
+    try:
+        if isinstance(v, (str, bytes, Mapping)):
+            raise TypeError
+        items = tuple(v)
+    except TypeError:
+        items = None
+    if items is None or len(items) != 2:
+        raise ModelError(f"{where or 'point'}: expected a pair (x, y), got {v!r}")
+    return (as_number(items[0]), as_number(items[1]))
+
+
+def _table(v, where: str, what: str = "(x, y)") -> tuple:
+    """The (name, value) items of a mapping (or of a sequence of pairs); ModelError naming
+    `where` otherwise (a list of values, a string)."""
+    if isinstance(v, Mapping):
+        return tuple(v.items())
+    try:
+        if isinstance(v, (str, bytes)):
+            raise TypeError
+        items = tuple(v)
+        if all(isinstance(kv, tuple) and len(kv) == 2 and isinstance(kv[0], str) for kv in items):
+            return items
+    except TypeError:
+        pass
+    raise ModelError(f"{where}: expected a dict of name -> {what}, got {v!r:.80}")
 
 
 # --- bodies, slides, inputs ---
@@ -98,11 +148,13 @@ class Link:
 
     def __init__(self, name: str, points, two_point: bool = False, *, mass: Num = 0.0,
                  inertia: Num = 0.0, cg=None):
-        items = points.items() if isinstance(points, Mapping) else points
+        where = f"[links] {name}"
+        items = _table(points, f"{where}: points")
         object.__setattr__(self, "name", name)
-        object.__setattr__(self, "points", tuple((p, _pair(xy)) for p, xy in items))
+        object.__setattr__(self, "points", tuple((p, _pair(xy, f"{where}: points.{p}")) for p, xy in items))
         object.__setattr__(self, "two_point", two_point)
-        object.__setattr__(self, "inertial", Inertia(mass, inertia, None if cg is None else _pair(cg)))
+        object.__setattr__(self, "inertial", Inertia(as_number(mass), as_number(inertia),
+                                                     None if cg is None else _pair(cg, f"{where}: cg")))
 
     @classmethod
     def bar(cls, name: str, p: str, q: str, length: Num, **inertia) -> "Link":
@@ -195,7 +247,8 @@ class Slide:
     name: str = ""
 
     def __post_init__(self):
-        object.__setattr__(self, "through", _pair(self.through))
+        object.__setattr__(self, "through", _pair(self.through, f"[[slides]] {self.name or self.point}: line.through"))
+        object.__setattr__(self, "angle", as_number(self.angle))
         if not self.name:
             object.__setattr__(self, "name", self.point)
 
