@@ -141,7 +141,7 @@ def cli_run(args) -> int:
     if args.plot:
         from .mapplot import plot_map
         plot_map(r, args.plot, title=st.title)
-    _summary(st.title, r, args.out)
+    _summary(st.title, r, args.out, args.plot)
     return 0 if all(s == "ok" for s in r.status) else 3
 
 
@@ -155,7 +155,7 @@ def _client(address):
         raise OutputError(f"--scheduler: cannot connect to {address!r}: {e}") from None
 
 
-def _summary(title, r: StudyResult, out):
+def _summary(title, r: StudyResult, out, plot=None):
     ok = int(r.ok.sum())
     print(f"{title or 'kincas'}: study of {len(r.status)} designs over {', '.join(r.names)}: "
           f"{ok} solved at every pose, {len(r.status) - ok} not")
@@ -165,8 +165,9 @@ def _summary(title, r: StudyResult, out):
             print(f"  {t}: from {np.nanmin(v):.6g} to {np.nanmax(v):.6g}")
         else:
             print(f"  {t}: no value (no design solved)")
-    if out:
-        print(f"wrote {out}")
+    for path in (out, plot):
+        if path:
+            print(f"wrote {path}")
 
 
 # --- writing the rows ---
