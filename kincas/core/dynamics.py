@@ -15,14 +15,27 @@ everything vanish:
 Shaking force and moment on the ground (about the origin): -sum m a_G, -sum (r_G x m a_G + J alpha).
 
 Joint reactions, by Newton-Euler per link: each moving link has three equations
-    sum F = m a_G,   sum (r x F) + sum tau = r_G x m a_G + J alpha
-with unknowns the pin forces (at a point shared by bodies b0, b1, ..., one unknown force on each
-of b1, ... and their opposite sum on b0: the pin carries nothing itself), one normal force per
-slide, the torque of each angle input (from the ground on its link) and the force of each slide
-input (along its line). A parameter input (an actuator's length) is held rigid at its value:
-its force is internal to its link. The system is square for a mechanism without redundant
-joints, and its solution is the g_q^T lambda of the same constraints; it is solved exactly
-(symbolic LU) only when a report asks for a reaction.
+    sum F = m a_G,   sum (r - c) x F + sum tau = (r_G - c) x m a_G + J alpha
+with moments about c, a point of the link itself (the mean of its points), and unknowns the
+pin forces (at a point shared by bodies b0, b1, ..., one unknown force on each of b1, ... and
+their opposite sum on b0: the pin carries nothing itself), one normal force per slide, the
+torque of each angle input (from the ground on its link) and the force of each slide input
+(along its line). A parameter input (an actuator's length) is held rigid at its value: its
+force is internal to its link. The system is square for a mechanism without redundant joints,
+and its solution is the g_q^T lambda of the same constraints; it is solved exactly
+(symbolic QR) only when a report asks for a reaction.
+
+Conditioning. Moments about the origin would be sums of terms |r| |F| that cancel down to
+|r - c| |F|: 1e4 lengths away, four digits are gone before the solve, and the solve mixes
+force rows (entries 1) with moment rows (entries |r|), a matrix whose condition grows like
+|r|^2. So each lever arm r - c is taken from the link's own coordinates, R(theta) (l_P - l_c),
+as accurate wherever the link is; only a point that is not the link's (a slide's point on the body
+carrying its line) takes the difference of its position and c's, as exact as those positions.
+And the system is made dimensionless: with L the mechanism's size (the RMS distance of the
+links' points from their links' means), moment rows are divided by L and torque unknowns
+are L times a force, so every entry is a ratio of lengths of the same mechanism, whatever
+its unit. A force scale would change nothing: the system is linear, so scaling all its
+right-hand side scales the solution and its rounding alike.
 
 A point load, a spring's end, and a slide's point act on the first body (in declaration order,
 the ground first) that carries the point.
@@ -79,21 +92,25 @@ def _to_global(sym, body, lx, ly):
     return ox + c * lx - s * ly, oy + s * lx + c * ly
 
 
+def _mean_point(sym, lk):
+    """The mean of a link's points, in its frame."""
+    n = len(lk.points)
+    return (sum((sym.val(x) for _, (x, _y) in lk.points), ca.SX(0)) / n,
+            sum((sym.val(y) for _, (_x, y) in lk.points), ca.SX(0)) / n)
+
+
 def _masses(sym):
-    """(link, m, J, (x_G, y_G), theta) for each link with a mass or an inertia."""
+    """(link, m, J, (x_G, y_G), theta, (lx, ly)) for each link with a mass or an inertia:
+    its centre of gravity in the plane and in the link's frame."""
     out = []
     for lk in sym.mech.links:
         i = lk.inertial
         m, J = sym.val(i.mass), sym.val(i.inertia)
         if ca.is_equal(m, 0) and ca.is_equal(J, 0):
             continue
-        if i.cg is not None:
-            lx, ly = sym.val(i.cg[0]), sym.val(i.cg[1])
-        else:  # the mean of the link's points
-            n = len(lk.points)
-            lx = sum((sym.val(x) for _, (x, _y) in lk.points), ca.SX(0)) / n
-            ly = sum((sym.val(y) for _, (_x, y) in lk.points), ca.SX(0)) / n
-        out.append((lk.name, m, J, _to_global(sym, lk.name, lx, ly), sym.frames[lk.name][2]))
+        lx, ly = (sym.val(i.cg[0]), sym.val(i.cg[1])) if i.cg is not None else _mean_point(sym, lk)
+        th = sym.frames[lk.name][2]
+        out.append((lk.name, m, J, _to_global(sym, lk.name, lx, ly), th, (lx, ly)))
     return out
 
 
@@ -103,11 +120,11 @@ def _gravity(sym):
 
 
 def _applied(sym):
-    """Applied loads as (body, kind, data): ("force", (x, y), (fx, fy)) or ("torque", tau)."""
+    """Applied loads as (body, kind, data): ("force", point, (fx, fy)) or ("torque", tau)."""
     mech, out = sym.mech, []
     for ld in mech.loads:
         if ld.kind == "force":
-            out.append((bodies_at(mech, ld.at)[0], "force", sym.points[ld.at],
+            out.append((bodies_at(mech, ld.at)[0], "force", ld.at,
                         (sym.val(ld.value[0]), sym.val(ld.value[1]))))
         elif ld.kind == "torque":
             out.append((ld.at, "torque", sym.val(ld.value)))
@@ -116,8 +133,8 @@ def _applied(sym):
             (px, py), (qx, qy) = sym.points[p], sym.points[q]
             d = ca.sqrt((px - qx) ** 2 + (py - qy) ** 2)
             f = -k * (d - d0) / d
-            out.append((bodies_at(mech, p)[0], "force", (px, py), (f * (px - qx), f * (py - qy))))
-            out.append((bodies_at(mech, q)[0], "force", (qx, qy), (-f * (px - qx), -f * (py - qy))))
+            out.append((bodies_at(mech, p)[0], "force", p, (f * (px - qx), f * (py - qy))))
+            out.append((bodies_at(mech, q)[0], "force", q, (-f * (px - qx), -f * (py - qy))))
     return out
 
 
@@ -145,7 +162,7 @@ def _efforts(sym, t):
 
     gx, gy = _gravity(sym)
     Q = ca.SX.zeros(1, sym.nu)
-    for _, m, J, (x, y), th in _masses(sym):
+    for _, m, J, (x, y), th, _ in _masses(sym):
         Q += m * (t.d(x, 2) - gx) * du(x) + m * (t.d(y, 2) - gy) * du(y) + J * t.d(th, 2) * du(th)
     for lk in sym.mech.loads:
         if lk.kind == "spring":  # potential k/2 (d - d0)^2: the input must supply its gradient
@@ -162,7 +179,7 @@ def _efforts(sym, t):
 
 def _shaking(sym, t):
     fx = fy = mz = ca.SX(0)
-    for _, m, J, (x, y), th in _masses(sym):
+    for _, m, J, (x, y), th, _ in _masses(sym):
         ax, ay = t.d(x, 2), t.d(y, 2)
         fx, fy = fx - m * ax, fy - m * ay
         mz -= m * (x * ay - y * ax) + J * t.d(th, 2)
@@ -184,33 +201,38 @@ def _newton_euler(sym, t):
         return ["joint reactions are not available yet with gears, racks or cams "
                 "(efforts and shaking forces are)"], None
     unknowns = {}  # (kind, names...) -> symbol(s)
-    forces = []  # (body, (x, y), (fx, fy)) and torques (body, None, tau)
+    forces = []  # (body, point, (fx, fy)) and torques (body, None, tau)
     for p in list(mech.ground_points) + list(mech.moving_points):
         at = bodies_at(mech, p)
         if len(at) < 2:
             continue
-        xy = sym.points[p]
         total = [ca.SX(0), ca.SX(0)]
         for b in at[1:]:
             f = ca.SX.sym(f"R_{p}_{b}", 2)
             unknowns[("pin", p, b)] = f
-            forces.append((b, xy, (f[0], f[1])))
+            forces.append((b, p, (f[0], f[1])))
             total = [total[0] + f[0], total[1] + f[1]]
-        forces.append((at[0], xy, (-total[0], -total[1])))
+        forces.append((at[0], p, (-total[0], -total[1])))
     for sl in mech.slides:
         a = sym.frames[sl.along][2] + sym.val(sl.angle)
-        n, d, xy = (-ca.sin(a), ca.cos(a)), (ca.cos(a), ca.sin(a)), sym.points[sl.point]
+        n, d = (-ca.sin(a), ca.cos(a)), (ca.cos(a), ca.sin(a))
         lam = unknowns[("slide", sl.name)] = ca.SX.sym(f"N_{sl.name}")
         F = ca.SX(0)
         if any(i.kind == "slide" and i.target == sl.name for i in mech.inputs):
             F = unknowns[("input", sl.name)] = ca.SX.sym(f"F_{sl.name}")
         fx, fy = lam * n[0] + F * d[0], lam * n[1] + F * d[1]
-        forces += [(bodies_at(mech, sl.point)[0], xy, (fx, fy)), (sl.along, xy, (-fx, -fy))]
+        forces += [(bodies_at(mech, sl.point)[0], sl.point, (fx, fy)),
+                   (sl.along, sl.point, (-fx, -fy))]
+    lever, motors = _Lever(sym), set()
     for i in mech.inputs:
         if i.kind == "angle":  # a motor on the ground, or on body B for a relative angle A/B
+            # the unknown is the torque over the mechanism's size: a force, like the others
+            motors.add(("input", i.target))
             T = unknowns[("input", i.target)] = ca.SX.sym(f"T_{i.target}")
             a, _, b = i.target.partition("/")
-            forces += [(a, None, T)] + ([(b, None, -T)] if b and b != GROUND else [])
+            forces.append((a, None, lever.size * T))
+            if b and b != GROUND:
+                forces.append((b, None, -lever.size * T))
     x = ca.vertcat(*unknowns.values()) if unknowns else ca.SX(0, 1)
     n_links = len(mech.links)
     if x.numel() != 3 * n_links:
@@ -222,24 +244,59 @@ def _newton_euler(sym, t):
     forces += [(b, None, data[0]) for b, kind, *data in _applied(sym) if kind == "torque"]
     gx, gy = _gravity(sym)
     eqs = {lk.name: [ca.SX(0), ca.SX(0), ca.SX(0)] for lk in mech.links}
-    for name, m, J, (x_, y_), th in _masses(sym):  # gravity minus d'Alembert's inertia force
+    for name, m, J, (x_, y_), th, cg in _masses(sym):  # gravity minus d'Alembert's inertia force
         ax, ay = t.d(x_, 2), t.d(y_, 2)
         fx, fy = m * (gx - ax), m * (gy - ay)
+        rx, ry = lever.local(name, *cg)
         e = eqs[name]
-        e[0], e[1], e[2] = e[0] + fx, e[1] + fy, e[2] + x_ * fy - y_ * fx - J * t.d(th, 2)
-    for body, xy, f in forces:
+        e[0], e[1], e[2] = e[0] + fx, e[1] + fy, e[2] + rx * fy - ry * fx - J * t.d(th, 2)
+    for body, point, f in forces:
         if body == GROUND:
             continue
         e = eqs[body]
-        if xy is None:  # a torque
+        if point is None:  # a torque
             e[2] += f
         else:
-            e[0], e[1], e[2] = e[0] + f[0], e[1] + f[1], e[2] + xy[0] * f[1] - xy[1] * f[0]
-    E = ca.vertcat(*[c for lk in mech.links for c in eqs[lk.name]])
+            rx, ry = lever.arm(body, point)
+            e[0], e[1], e[2] = e[0] + f[0], e[1] + f[1], e[2] + rx * f[1] - ry * f[0]
+    # moment rows over the size: every entry of the matrix is a ratio of lengths
+    E = ca.vertcat(*[c for lk in mech.links
+                     for c in (eqs[lk.name][0], eqs[lk.name][1], eqs[lk.name][2] / lever.size)])
     A = ca.jacobian(E, x)
     sol = -ca.solve(A, ca.substitute(E, x, ca.SX.zeros(x.numel())))
-    values = {k: ca.substitute(v, x, sol) for k, v in unknowns.items()}
+    values = {k: ca.substitute(v, x, sol) * (lever.size if k in motors else 1)
+              for k, v in unknowns.items()}
     return [], values
+
+
+class _Lever:
+    """Lever arms r - c about each link's mean point c, and the mechanism's size."""
+
+    def __init__(self, sym):
+        self.sym, self.mean, self.loc = sym, {}, {}
+        total, n = ca.SX(0), 0
+        for lk in sym.mech.links:
+            self.mean[lk.name] = cx, cy = _mean_point(sym, lk)
+            self.loc[lk.name] = loc = {p: (sym.val(x), sym.val(y)) for p, (x, y) in lk.points}
+            for lx, ly in loc.values():
+                total, n = total + (lx - cx) ** 2 + (ly - cy) ** 2, n + 1
+        # the RMS distance of the points from their link's mean: 1 for a mechanism of points
+        ms = total / max(n, 1)
+        self.size = ca.sqrt(ca.if_else(ms > 0, ms, 1))
+
+    def local(self, body, lx, ly):
+        """r - c for the point (lx, ly) of the link's frame: R(theta) (l - l_c), whatever r is."""
+        (cx, cy), th = self.mean[body], self.sym.frames[body][2]
+        c, s = ca.cos(th), ca.sin(th)
+        return c * (lx - cx) - s * (ly - cy), s * (lx - cx) + c * (ly - cy)
+
+    def arm(self, body, point):
+        """r - c for a named point: from the link's frame if the link carries it, else (a
+        slide's point on the body carrying its line) the difference of the positions."""
+        if point in self.loc[body]:
+            return self.local(body, *self.loc[body][point])
+        (x, y), (cx, cy) = self.sym.points[point], _to_global(self.sym, body, *self.mean[body])
+        return x - cx, y - cy
 
 
 def _reaction(sym, t, a, b, attr):
