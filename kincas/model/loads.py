@@ -18,6 +18,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from .values import _pair, as_number
+
 # --- declarations ---
 
 
@@ -89,7 +91,6 @@ class Load:
         >>> Load.force("C", (0, -9.81)).value
         (0, -9.81)
         """
-        from .parts import _pair  # (parts imports this module)
         return cls("force", at=point, value=_pair(force, f"[[loads]] force at {point}: force"))
 
     @classmethod
@@ -110,7 +111,6 @@ class Load:
         >>> Load.torque("rocker", "T").at
         'rocker'
         """
-        from .parts import as_number
         return cls("torque", at=link, value=as_number(torque))
 
     @classmethod
@@ -131,7 +131,6 @@ class Load:
         >>> Load.spring("A", "P", 200, 40).stiffness
         200
         """
-        from .parts import as_number
         return cls("spring", points=(a, b), stiffness=as_number(stiffness),
                    free_length=as_number(free_length))
 
