@@ -58,8 +58,8 @@ def _table(v, where: str, what: str = "(x, y)") -> tuple:
         if isinstance(v, (str, bytes)):
             raise TypeError
         items = tuple(v)
-        if all(isinstance(kv, tuple) and len(kv) == 2 and isinstance(kv[0], str) for kv in items):
-            return items
+        if all(isinstance(kv, (tuple, list)) and len(kv) == 2 and isinstance(kv[0], str) for kv in items):
+            return tuple((k, v) for k, v in items)
     except TypeError:
         pass
     raise ModelError(f"{where}: expected a dict of name -> {what}, got {v!r:.80}")
