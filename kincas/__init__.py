@@ -19,10 +19,12 @@ from .model import Input, Link, Load, Mechanism, Param, Slide
 from .results import Pose, Sweep
 from .core.numeric import compile, model_of
 from .analysis.sweeps import solve, sweep
+from . import views
 # sweep_designs and study are loaded on first use (kincas._aliases): `kincas solve` and
 # plain sweeps do not pay for their imports (thread pools, logging, dask hooks)
 
 _aliases.install()  # `import kincas.modes` and other paths of the flat 0.1 layout
+views.register()  # Jupyter's displays of Mechanism and Sweep (the model does not import its views)
 
 
 def __getattr__(name):

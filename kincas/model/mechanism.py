@@ -353,15 +353,6 @@ class Mechanism:
             extent = max(extent, math.hypot(max(xs) - min(xs), max(ys) - min(ys)))
         return extent if extent > 0 else 1.0
 
-    def _repr_svg_(self) -> str | None:
-        """Jupyter's display: the mechanism drawn at its first pose (`kincas.notebook`; the
-        drawing solves it, so it is built only when a notebook asks)."""
-        try:
-            from ..notebook import mechanism_svg
-            return mechanism_svg(self)
-        except Exception:  # a display must never raise: Jupyter falls back to repr
-            return None
-
     # --- new values ---
     def with_parameters(self, **values: float) -> "Mechanism":
         """A new mechanism with some parameters changed.
