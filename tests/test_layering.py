@@ -217,3 +217,36 @@ def test_reading_a_scene_builds_no_model(monkeypatch):
             plain += 1
             assert len(built) == before, f"{path.name}: a model was built while reading it"
     assert plain >= 10
+
+
+def test_old_paths_import_the_moved_modules_with_a_warning(monkeypatch):
+    """The presentation modules left kincas/cli for kincas/views: their old paths give the
+    same module for one release, with a DeprecationWarning naming the new path."""
+    import importlib
+    import sys
+    import warnings
+
+    import kincas
+    from kincas._aliases import MOVED
+    assert set(MOVED) >= {"cli.plot", "cli.svg", "cli.html", "cli.dxf", "notebook"}
+    for old, new in MOVED.items():
+        monkeypatch.delitem(sys.modules, f"kincas.{old}", raising=False)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            mod = importlib.import_module(f"kincas.{old}")
+        assert mod is importlib.import_module(f"kincas.{new}") and mod.__name__ == f"kincas.{new}"
+        assert mod.__spec__.name == f"kincas.{new}"  # the alias does not rename the module
+        assert [w.category for w in caught] == [DeprecationWarning], old
+        assert f"kincas.{new}" in str(caught[0].message)
+    with warnings.catch_warnings():  # the 0.1 layout's paths of the README: no warning
+        warnings.simplefilter("error")
+        assert kincas.plot.draw is importlib.import_module("kincas.views.plot").draw
+
+
+def test_the_displays_are_registered_from_the_face():
+    """`import kincas` gives Mechanism and Sweep their notebook displays without the model
+    importing the views."""
+    import kincas
+    import kincas.views
+    assert kincas.Mechanism._repr_svg_ is kincas.views._mechanism_svg
+    assert kincas.Sweep._repr_html_ is kincas.views._sweep_html

@@ -70,7 +70,7 @@ def test_dxf_read_back(capsys, tmp_path):
 
 def test_svg_and_dxf_from_python(tmp_path):
     import kincas
-    from kincas.cli.svg import svg_text
+    from kincas.views.svg import svg_text
     sc = kincas.scene.load(EXAMPLES / "slider_crank.toml")
     sw = sc.run()
     root = ET.fromstring(svg_text(sc.mechanism, sw, pose=0))

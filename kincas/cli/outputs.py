@@ -19,53 +19,16 @@ from __future__ import annotations
 
 import csv
 import math
-from types import SimpleNamespace
 
 import numpy as np
 
 from ..errors import OutputError
 from ..model.mechanism import Mechanism
 from ..results import Sweep
+from ..views.columns import _abscissa, heading, user_columns  # noqa: F401  (their old home)
 
 FLAG_STYLE = {"limit": ("#d62728", "limit of motion"), "change point": ("#9467bd", "change point"),
               "singular": ("#ff7f0e", "singular position")}
-
-
-# --- names, units and values in the scene's units ---
-
-
-def _units_of(scene):
-    """What `kincas.cli._unit` needs: the scene, or plain radians/seconds without one."""
-    if scene is not None:
-        return scene
-    return SimpleNamespace(study=SimpleNamespace(units={"length": "", "angle": "rad", "time": "s"}),
-                           mechanism=SimpleNamespace(param_values={}))
-
-
-def heading(name: str, scene=None) -> str:
-    """`name [unit]`, units as in the printed table (just `name` when it has none).
-
-    >>> heading("rocker.alpha")
-    'rocker.alpha [rad/s^2]'
-    """
-    from .common import _unit
-    u = _unit(_units_of(scene), name)
-    return f"{name} [{u}]" if u else name
-
-
-def user_columns(sweep: Sweep, scene=None, names=None):
-    """(inputs, values): name -> array in the scene's units (the sweep's own without one)."""
-    inputs = scene.user_inputs(sweep) if scene is not None else dict(sweep.inputs)
-    values = scene.user_values(sweep) if scene is not None else dict(sweep.values)
-    if scene is not None:  # zero to the solve's accuracy as 0, not as noise
-        from .numbers import clean
-        values = clean(values, scene, sweep)
-    if names is not None:
-        missing = [n for n in names if n not in values]
-        if missing:
-            raise KeyError(f"not reported: {missing} (reported: {list(values)})")
-        values = {n: values[n] for n in names}
-    return inputs, values
 
 
 # --- CSV ---
@@ -90,14 +53,6 @@ def write_csv(out, sweep: Sweep, scene=None) -> None:
 
 
 # --- quantities against the input ---
-
-
-def _abscissa(sweep: Sweep, inputs: dict) -> tuple[str | None, np.ndarray]:
-    """The first input that varies (inputs that sweep advance together), else the pose index."""
-    for k, v in inputs.items():
-        if len(v) > 1 and np.ptp(v) > 0:
-            return k, np.asarray(v, float)
-    return None, np.arange(len(sweep), dtype=float)
 
 
 def _runs(mask: np.ndarray):
@@ -148,7 +103,7 @@ def plot_quantities(sweep: Sweep, names=None, *, scene=None, fig=None):
     >>> len(plot_quantities(sw, fig=Figure()).axes)
     2
     """
-    from .plot import new_figure, require_matplotlib
+    from ..views.plot import new_figure, require_matplotlib
     require_matplotlib("kincas.outputs.plot_quantities")
     inputs, values = user_columns(sweep, scene, names)
     xkey, x = _abscissa(sweep, inputs)
@@ -222,7 +177,7 @@ def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, 
     ...     animate(m, sw, os.path.join(d, "slider.gif"), frames=4, size=(2, 1.5), dpi=40)
     4
     """
-    from .plot import (Drawing, caption, check_paths, geometry, new_figure, require_matplotlib,
+    from ..views.plot import (Drawing, caption, check_paths, geometry, new_figure, require_matplotlib,
                        smooth_paths)
     require_matplotlib("kincas.outputs.animate")
     from matplotlib.animation import PillowWriter
@@ -265,7 +220,7 @@ def check_outputs(args, mechanism=None, poses: int | None = None) -> None:
     """Fail early (one line, exit 2), before any solve: a picture asked for without matplotlib,
     a file type that cannot be written, a folder that does not exist or cannot be written,
     --paths naming a point that does not exist, --pose outside the sweep's `poses`."""
-    from .plot import require_matplotlib
+    from ..views.plot import require_matplotlib
     for flag, (attr, writer) in FILE_FLAGS.items():
         path = getattr(args, attr, None)
         if not path:
@@ -294,7 +249,7 @@ def check_outputs(args, mechanism=None, poses: int | None = None) -> None:
         if not getattr(args, "plot", None):
             _fail("--evolute, --centrodes: they draw on the picture of --plot OUT.png; give --plot")
         if mechanism is not None:
-            from .draw_geometry import check_geometry
+            from ..views.draw_geometry import check_geometry
             try:
                 check_geometry(mechanism, geo["evolute"], geo["centrodes"])
             except ValueError as e:
@@ -378,23 +333,23 @@ def _dense(sweep) -> int:
 
 
 def _html(path, m, sweep, scene, paths):
-    from .html import write_html
+    from ..views.html import write_html
     write_html(path, m, sweep, scene, paths, dense=_dense(sweep))
 
 
 def _svg(path, m, sweep, scene, pose, paths):
-    from .svg import write_svg
+    from ..views.svg import write_svg
     write_svg(path, m, sweep, pose, paths=paths, scene=scene, dense=_dense(sweep))
 
 
 def _dxf(path, m, sweep, scene, pose, paths):
-    from .dxf import write_dxf
+    from ..views.dxf import write_dxf
     write_dxf(path, m, sweep, pose, paths=paths, dense=_dense(sweep),
               units=scene.study.units.get("length", "") if scene is not None else "")
 
 
 def _caption(scene, sweep, inputs, i) -> str:
-    from .common import _unit
+    from ..views.columns import quantity_unit as _unit
     parts = []
     for k, v in inputs.items():
         u = _unit(scene, k)
@@ -404,12 +359,12 @@ def _caption(scene, sweep, inputs, i) -> str:
 
 
 def _save_drawing(path, m, sweep, pose, paths, captions, length, evolute=(), centrodes=()):
-    from .plot import default_pose, draw, new_figure
+    from ..views.plot import default_pose, draw, new_figure
     fig = new_figure()
     i = default_pose(sweep) if pose is None else pose % len(sweep)
     ax = draw(m, sweep, i, ax=fig.subplots(), paths=paths, title=captions[i], units=length)
-    if evolute or centrodes:  # kinematic geometry over the drawing (kincas/cli/draw_geometry.py)
-        from .draw_geometry import draw_geometry
+    if evolute or centrodes:  # kinematic geometry over the drawing (kincas/views/draw_geometry.py)
+        from ..views.draw_geometry import draw_geometry
         draw_geometry(ax, m, sweep, i, evolute, centrodes)
     fig.savefig(path, dpi=100)
 

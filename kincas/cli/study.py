@@ -119,7 +119,7 @@ def cli_run(args) -> int:
     if args.out:
         _check_writer(Path(args.out).suffix.lower())
     if args.plot:
-        from .mapplot import check_plot
+        from ..views.mapplot import check_plot
         check_plot(args.plot, kw["vary"])
     if args.workers is not None and args.workers < 1:
         raise OutputError(f"--workers: expected a whole number >= 1, got {args.workers}")
@@ -139,7 +139,7 @@ def cli_run(args) -> int:
     if args.out:
         write(r, args.out)
     if args.plot:
-        from .mapplot import plot_map
+        from ..views.mapplot import plot_map
         plot_map(r, args.plot, title=st.title)
     _summary(st.title, r, args.out)
     return 0 if all(s == "ok" for s in r.status) else 3

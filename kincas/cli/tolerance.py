@@ -39,7 +39,7 @@ def cli_run(args) -> int:
                 progress=progress_for(args), **kw)
     user = lambda n, v: np.degrees(v) if is_angular(n, sc.mechanism) and st.deg else np.asarray(v, float)
     inputs = {k: user(k, v) for k, v in r.inputs.items()}
-    from .numbers import snap  # a spread that is zero to rounding is printed as 0
+    from ..views.numbers import snap  # a spread that is zero to rounding is printed as 0
     fo = {n: snap(user(n, r.first_order[n]), 0.0) for n in r.names}
     mc = {n: snap(user(n, r.monte_carlo[n]), 0.0) for n in r.names}
     if args.json:
