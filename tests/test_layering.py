@@ -248,5 +248,40 @@ def test_the_displays_are_registered_from_the_face():
     importing the views."""
     import kincas
     import kincas.views
-    assert kincas.Mechanism._repr_svg_ is kincas.views._mechanism_svg
-    assert kincas.Sweep._repr_html_ is kincas.views._sweep_html
+    assert kincas.Mechanism._repr_svg_ is kincas.views.mechanism_svg_display
+    assert kincas.Sweep._repr_html_ is kincas.views.sweep_html_display
+
+
+def assigned_from_outside(name: str, path: Path, known: set[str]) -> list[str]:
+    """`X.attr = ...` (or setattr(X, ...)) in `name` where X is a kincas module it imported
+    or a name it imported from one: an edit of another module's objects."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    foreign = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            foreign |= {(a.asname or a.name).split(".")[0] for a in node.names if a.name.startswith("kincas")}
+        elif isinstance(node, ast.ImportFrom) and (node.level or (node.module or "").startswith("kincas")):
+            foreign |= {a.asname or a.name for a in node.names}
+    out = []
+    for node in ast.walk(tree):
+        targets = []
+        if isinstance(node, (ast.Assign, ast.AugAssign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+        elif isinstance(node, ast.Call) and ast.unparse(node.func) == "setattr" and node.args:
+            targets = [ast.Attribute(value=node.args[0], attr="?")]
+        for t in targets:
+            if isinstance(t, ast.Attribute) and isinstance(t.value, ast.Name) and t.value.id in foreign:
+                out.append(f"{name}:{t.lineno if hasattr(t, 'lineno') else node.lineno}: {ast.unparse(t)}")
+    return out
+
+
+def test_no_floor_edits_another_modules_objects(tmp_path):
+    """The core used to install its rank test into kincas/model by assignment, and the model
+    learnt its displays from a lazy import of the views: only the package's face wires the
+    floors together (and says so)."""
+    mods = modules()
+    bad = [hit for n, p in mods.items() if n not in FACE for hit in assigned_from_outside(n, p, set(mods))]
+    assert not bad, bad
+    src = tmp_path / "m.py"
+    src.write_text("from ..model import mechanism as _m\n_m._rank_decision = len\n", encoding="utf-8")
+    assert assigned_from_outside("kincas.core.x", src, set(mods)) == ["kincas.core.x:2: _m._rank_decision"]

@@ -29,7 +29,6 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from ..model import mechanism as _mechanism
 from ..model.mechanism import Mechanism, needs_rank_test
 from . import joints as _joints
 from .newton import lsolve as _lsolve, newton as _newton
@@ -99,11 +98,11 @@ def model_of(m: Mechanism, check: bool = True) -> "Model":
 compile = model_of  # its first name (kincas 0.1): it compiles nothing
 
 
-def _redundant(m: Mechanism) -> int:
+def redundant_equations(m: Mechanism) -> int:
+    """The number of equations of `m` implied by the others (kincas/core/redundant.py), on the
+    model of its structure; what `Mechanism.redundant` answers (the package's face hands it
+    to the model)."""
     return decide(m, model_of(m, check=False))
-
-
-_mechanism._rank_decision = _redundant  # `Mechanism.redundant` asks the core (kincas/model)
 
 
 class _Call:

@@ -30,8 +30,9 @@ from .loads import Load, check_loads
 from .parts import Input, Link, Num, Param, Slide, _pair, as_param  # noqa: F401  (the parts; their old home)
 
 GROUND = "ground"
-# How a mechanism whose count falls short learns its redundant equations: kincas.core
-# installs its rank test here when it is imported (declarations never import the solver).
+# How a mechanism whose count falls short learns its redundant equations: the rank test of
+# kincas.core, handed over by the package's face (`import kincas` calls use_rank_test);
+# declarations never import the solver, and the solver never edits the declarations.
 _rank_decision = None
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
 NAME_RULE = "a name starts with an ASCII letter or _, then ASCII letters, digits, _ or -"
@@ -189,7 +190,7 @@ class Mechanism:
         """
         if not needs_rank_test(self):
             return 0
-        if _rank_decision is None:  # pragma: no cover - kincas/__init__ installs it
+        if _rank_decision is None:  # pragma: no cover - kincas/__init__ hands it over
             raise ModelError("[inputs]: the rank test needs kincas.core (import kincas)")
         return _rank_decision(self)
 
@@ -508,6 +509,13 @@ def _check(m: Mechanism) -> list[str]:
 def counted_freedoms(m: Mechanism) -> int:
     """Degrees of freedom by counting: unknowns minus equations, plus driven parameters."""
     return m.structure.mobility + sum(inp.kind == "parameter" for inp in m.inputs)
+
+
+def use_rank_test(decide) -> None:
+    """Let `Mechanism.redundant` ask `decide(mechanism) -> int` (the core's rank test, given by
+    `import kincas`) where counting cannot tell the redundant equations."""
+    global _rank_decision
+    _rank_decision = decide
 
 
 def needs_rank_test(m: Mechanism) -> bool:

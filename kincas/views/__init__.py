@@ -3,19 +3,18 @@ page, the notebook's rich displays, and the columns and numbers of tables as a r
 them. A floor above the algorithms (it solves through `kincas.analysis`, never the other
 way) and below the command line, which writes these views to files.
 
-The declarations and results do not know how they are drawn: `register()`, called by
-`import kincas`, gives `Mechanism` and `Sweep` their Jupyter displays. It imports nothing
-itself (the displays load `kincas.views.notebook` when a notebook first asks), so
-`import kincas` stays cheap.
+The declarations and results do not know how they are drawn: `import kincas` gives
+`Mechanism` and `Sweep` the Jupyter displays below. They load `kincas.views.notebook` when a
+notebook first asks, so `import kincas` stays cheap.
 
 >>> import kincas
->>> kincas.Mechanism._repr_svg_ is _mechanism_svg, kincas.Sweep._repr_html_ is _sweep_html
+>>> kincas.Mechanism._repr_svg_ is mechanism_svg_display, kincas.Sweep._repr_html_ is sweep_html_display
 (True, True)
 """
 from __future__ import annotations
 
 
-def _mechanism_svg(self) -> str | None:
+def mechanism_svg_display(self) -> str | None:
     """Jupyter's display of a Mechanism: drawn at its first pose (`kincas.views.notebook`;
     the drawing solves it, so it is built only when a notebook asks)."""
     try:
@@ -25,15 +24,8 @@ def _mechanism_svg(self) -> str | None:
         return None
 
 
-def _sweep_html(self) -> str:
+def sweep_html_display(self) -> str:
     """Jupyter's display of a Sweep: the summary and small plots of the quantities."""
     from .notebook import sweep_html
     return sweep_html(self)
 
-
-def register() -> None:
-    """Give `Mechanism` and `Sweep` their notebook displays (idempotent)."""
-    from ..model.mechanism import Mechanism
-    from ..results import Sweep
-    Mechanism._repr_svg_ = _mechanism_svg
-    Sweep._repr_html_ = _sweep_html
