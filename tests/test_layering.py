@@ -285,3 +285,18 @@ def test_no_floor_edits_another_modules_objects(tmp_path):
     src = tmp_path / "m.py"
     src.write_text("from ..model import mechanism as _m\n_m._rank_decision = len\n", encoding="utf-8")
     assert assigned_from_outside("kincas.core.x", src, set(mods)) == ["kincas.core.x:2: _m._rank_decision"]
+
+
+def test_names_are_taken_from_their_home():
+    """A quantity's name is parsed by the model (kincas/model/names.py): printing a number or
+    reading a scene does not pass through the symbolic core, which only re-exports them."""
+    import kincas.model.names as names
+    home = {k for k in vars(names) if not k.startswith("__")}
+    bad = []
+    for n, p in modules().items():
+        if layer(n) == 1:
+            continue
+        for node in ast.walk(ast.parse(p.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").endswith("core.symbolic"):
+                bad += [f"{n}: {a.name}" for a in node.names if a.name in home]
+    assert not bad, bad

@@ -53,7 +53,7 @@ from ..core.compiled import ptr, rows
 from ..core.designs_kernel import MAX_STEPS, NEWTON, STEP, designs_loop_for
 from ..core.fast import FastRun
 from ..core.numeric import ACCEPT, compile as compile_model
-from ..core.symbolic import default_report
+from ..model.names import default_report
 from ..model.mechanism import Mechanism, as_param
 from ..core.assembly import modes
 from ..core.blocks import numeric_signs

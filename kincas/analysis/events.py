@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.assembly import NEAR, group_links, modes, polish_singular, refine
-from ..core.symbolic import parse_quantity
+from ..model.names import parse_quantity
 from .singular import FLAG_SIGMA, classify, locate_singular, scaled_jacobians
 
 MAX_GROUPS_AT_GAP = 8  # groups tried for a limit next to a gap (the worst conditioned first)

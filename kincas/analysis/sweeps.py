@@ -24,7 +24,8 @@ from ..core.fast import sweeper_for
 from ..model.mechanism import Mechanism
 from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
-from ..core.symbolic import default_report, needs_jerk
+from ..core.symbolic import needs_jerk
+from ..model.names import default_report
 from .continuation import careful_pose
 from .resume import unlabelled_resumes
 from .events import null_derivatives

@@ -158,7 +158,7 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
     True
     """
     from .sensitivity import sensitivities
-    from ..core.symbolic import default_report, parse_quantity
+    from ..model.names import default_report, parse_quantity
 
     report = list(default_report(m) if report is None else report)
     problems = _check_std(m, std, "std")
@@ -321,7 +321,7 @@ class _Samples:
 
 def read_section(sc) -> dict:
     """The `[tolerance]` section as analyse()'s keywords; SceneError naming the field."""
-    from ..core.symbolic import parse_quantity
+    from ..model.names import parse_quantity
 
     t = sc.study.raw.get("tolerance")
     if not isinstance(t, dict):

@@ -219,7 +219,7 @@ class _Chunk:
     def __call__(self, part):
         """(design indices, failure code and pose per design, values (n, len(report)))."""
         from ..analysis.designs import sweep_designs
-        from ..core.symbolic import is_angular
+        from ..model.names import is_angular
 
         idx, X = part
         exprs = [parse(t, "report") for t in self.report]
