@@ -95,12 +95,13 @@ def _check_args(args) -> None:
     if not (starts or args.command in ("tolerance", "range")):
         return
     from .scene import load
-    from ..core.numeric import compile
     sc = load(args.scene)
     if args.command == "range" and not sc.study.inputs:
         raise OutputError("[[inputs]]: none declared, so there is no range of motion to find "
                           "(kincas range ranges an input; kincas solve solves a structure)")
-    nq, nrep = compile(sc.mechanism).sym.nq, len(sc.quantities)
+    # the declarations' count of unknowns (the model's, plus one per driven angle: a bound
+    # from above), so that a size check builds no model
+    nq, nrep = sc.mechanism.structure.n_unknowns, len(sc.quantities)
     try:
         if starts:
             bounds.check("--starts", starts, bounds.per_sample(nq, 0, 0))
