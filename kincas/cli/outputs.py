@@ -162,10 +162,12 @@ def plot_quantities(sweep: Sweep, names=None, *, scene=None, fig=None):
 
 
 def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, fps: int = 20,
-            captions=None, units: str = "", dpi: int = 80, size=(6.4, 4.8), progress=None) -> int:
+            captions=None, units: str = "", dpi: int = 80, size=(6.4, 4.8), progress=None,
+            path_xy=None) -> int:
     """Write an animated GIF of the sweep's solved poses (at most `frames` of them, evenly
     spread); returns the number of frames written. `captions[i]` titles pose i;
-    `progress(done, total)` is called after each frame (a progress bar, say).
+    `progress(done, total)` is called after each frame (a progress bar, say); `path_xy`: the
+    paths already solved (point -> M x 2, `kincas.views.plot.smooth_paths`), else solved here.
 
     >>> import os, tempfile, numpy as np, kincas
     >>> m = kincas.Mechanism(ground={"O": (0, 0)},
@@ -185,7 +187,8 @@ def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, 
     pick = ok[np.unique(np.round(np.linspace(0, ok.size - 1, min(frames, ok.size))).astype(int))]
     fig = new_figure(size)
     chosen = check_paths(m, paths)
-    d = Drawing(fig.subplots(), m, geometry(m, sweep), chosen, True, units, smooth_paths(m, sweep, chosen))
+    smooth = smooth_paths(m, sweep, chosen) if path_xy is None else {p: path_xy[p] for p in chosen}
+    d = Drawing(fig.subplots(), m, geometry(m, sweep), chosen, True, units, smooth)
     cap = captions if captions is not None else [caption(sweep, i) for i in range(len(sweep))]
     d.update(int(pick[0]), cap[pick[0]])
     fig.canvas.draw()  # lay the figure out once; every frame keeps that layout
@@ -305,15 +308,17 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
     length = scene.study.units.get("length", "")
     inputs = scene.user_inputs(sweep)
     captions = [_caption(scene, sweep, inputs, i) for i in range(len(sweep))]
+    solved = _SharedPaths(m, sweep, paths, [a for a in ("plot", "animate", "html", "svg", "dxf")
+                                            if getattr(args, a, None)])
     jobs = [("csv", lambda p: write_csv(p, sweep, scene)),
             ("plot", lambda p: _save_drawing(p, m, sweep, pose, paths, captions, length,
                                              _names(getattr(args, "evolute", None) or ""),
-                                             _names(getattr(args, "centrodes", None) or ""))),
-            ("animate", lambda p: _animate(p, m, sweep, paths, captions, length, _rendering(args))),
+                                             _names(getattr(args, "centrodes", None) or ""), solved())),
+            ("animate", lambda p: _animate(p, m, sweep, paths, captions, length, _rendering(args), solved())),
             ("plot_quantities", lambda p: plot_quantities(sweep, scene=scene).savefig(p, dpi=100)),
-            ("html", lambda p: _html(p, m, sweep, scene, paths)),
-            ("svg", lambda p: _svg(p, m, sweep, scene, pose, paths)),
-            ("dxf", lambda p: _dxf(p, m, sweep, scene, pose, paths))]
+            ("html", lambda p: _html(p, m, sweep, scene, paths, solved.dense())),
+            ("svg", lambda p: _svg(p, m, sweep, scene, pose, paths, solved.dense())),
+            ("dxf", lambda p: _dxf(p, m, sweep, scene, pose, paths, solved.dense()))]
     for attr, job in jobs:
         path = getattr(args, attr, None)
         if path:
@@ -328,23 +333,48 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
 DENSE = 4  # solved poses between two of the sweep's, for the paths of vector pictures
 
 
-def _dense(sweep) -> int:
-    return DENSE if len(sweep) <= 2000 else 0
+class _SharedPaths:
+    """The paths every picture of one run draws, solved once for all of them, when the first
+    asks: through extra poses solved between the sweep's, as many as the most demanding
+    picture asked for needs (a drawing or an animation: paths through about 360 points,
+    `kincas.views.picture.smooth_steps`; a vector picture: DENSE, for sweeps of up to 2,000
+    poses); None (the sweep's own poses) when none needs more."""
+
+    def __init__(self, m, sweep, paths, pictures):
+        from ..views.picture import smooth_steps
+        n = len(sweep)
+        need = [smooth_steps(n) if p in ("plot", "animate") else DENSE if n <= 2000 else 0 for p in pictures]
+        self.m, self.sweep, self.paths, self.steps = m, sweep, paths, max(need, default=0)
+        self.xy, self.done = None, False
+
+    def __call__(self) -> dict | None:
+        if not self.done:
+            from ..views.picture import dense_paths
+            from ..views.poses import check_paths
+            chosen = check_paths(self.m, self.paths)
+            self.xy = dense_paths(self.m, self.sweep, chosen, self.steps) if self.steps and chosen else None
+            self.done = True
+        return self.xy
+
+    def dense(self) -> int | dict:
+        """What the vector pictures take as `dense`: the paths solved, or 0 (none to add)."""
+        xy = self()
+        return 0 if xy is None else xy
 
 
-def _html(path, m, sweep, scene, paths):
+def _html(path, m, sweep, scene, paths, dense=0):
     from ..views.html import write_html
-    write_html(path, m, sweep, scene, paths, dense=_dense(sweep))
+    write_html(path, m, sweep, scene, paths, dense=dense)
 
 
-def _svg(path, m, sweep, scene, pose, paths):
+def _svg(path, m, sweep, scene, pose, paths, dense=0):
     from ..views.svg import write_svg
-    write_svg(path, m, sweep, pose, paths=paths, scene=scene, dense=_dense(sweep))
+    write_svg(path, m, sweep, pose, paths=paths, scene=scene, dense=dense)
 
 
-def _dxf(path, m, sweep, scene, pose, paths):
+def _dxf(path, m, sweep, scene, pose, paths, dense=0):
     from ..views.dxf import write_dxf
-    write_dxf(path, m, sweep, pose, paths=paths, dense=_dense(sweep),
+    write_dxf(path, m, sweep, pose, paths=paths, dense=dense,
               units=scene.study.units.get("length", "") if scene is not None else "")
 
 
@@ -358,11 +388,11 @@ def _caption(scene, sweep, inputs, i) -> str:
     return head + ", ".join(parts) + ("" if sweep.status[i] == "ok" else f" ({sweep.status[i]})")
 
 
-def _save_drawing(path, m, sweep, pose, paths, captions, length, evolute=(), centrodes=()):
+def _save_drawing(path, m, sweep, pose, paths, captions, length, evolute=(), centrodes=(), path_xy=None):
     from ..views.plot import default_pose, draw, new_figure
     fig = new_figure()
     i = default_pose(sweep) if pose is None else pose % len(sweep)
-    ax = draw(m, sweep, i, ax=fig.subplots(), paths=paths, title=captions[i], units=length)
+    ax = draw(m, sweep, i, ax=fig.subplots(), paths=paths, title=captions[i], units=length, path_xy=path_xy)
     if evolute or centrodes:  # kinematic geometry over the drawing (kincas/views/draw_geometry.py)
         from ..views.draw_geometry import draw_geometry
         draw_geometry(ax, m, sweep, i, evolute, centrodes)
@@ -378,5 +408,5 @@ def _rendering(args):
     return bar
 
 
-def _animate(path, m, sweep, paths, captions, length, progress=None):
-    animate(m, sweep, path, paths=paths, captions=captions, units=length, progress=progress)
+def _animate(path, m, sweep, paths, captions, length, progress=None, path_xy=None):
+    animate(m, sweep, path, paths=paths, captions=captions, units=length, progress=progress, path_xy=path_xy)

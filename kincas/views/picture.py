@@ -81,10 +81,11 @@ class Picture:
         return np.array([pts.min(axis=0) - 5 * self.r, pts.max(axis=0) + 5 * self.r])
 
 
-def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int = 0) -> Picture:
+def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0) -> Picture:
     """The Picture of `sweep`; `paths` names the points whose paths are drawn (default: every
     moving point); `dense` > 0 solves that many extra poses between each two of the sweep's
-    for smooth paths."""
+    for smooth paths, or is those paths already solved (point -> M x 2, from `dense_paths`:
+    several pictures of one sweep share one solve)."""
     geo = geometry(m, sweep)
     names, xy = geo.names, geo.xy
     i0 = default_pose(geo.ok)
@@ -114,7 +115,10 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int = 0) -> Picture:
                             float(sv.max() + 4 * r), sl.along == GROUND,
                             INK if sl.along == GROUND else colour[sl.along]))
     chosen = check_paths(m, paths)
-    path_xy = dense_paths(m, sweep, chosen, dense) if dense > 0 else {p: geo.point(p) for p in chosen}
+    if isinstance(dense, dict):
+        path_xy = {p: dense[p] for p in chosen}
+    else:
+        path_xy = dense_paths(m, sweep, chosen, dense) if dense > 0 else {p: geo.point(p) for p in chosen}
     return Picture(names, xy, geo.ok, [names.index(g) for g in m.ground_points], bodies, guides,
                    path_xy, r, i0, _joint_curves(m, geo, r))
 
@@ -123,6 +127,18 @@ def _joint_curves(m: Mechanism, geo, r: float):
     from .draw_joints import curves
     return lambda i, fine=121: (curves(m, geo, i, r, fine) if geo.joints is not None and 0 <= i < len(geo.ok)
                                 else [])
+
+
+def smooth_steps(n: int) -> int:
+    """The extra poses to solve between two of a sweep of `n` poses for paths through about
+    360 points (at most 16); 0 for more than 60 poses, which are dense enough as they are.
+
+    >>> smooth_steps(13), smooth_steps(60), smooth_steps(361)
+    (16, 6, 0)
+    """
+    if n < 2 or n > 60:
+        return 0
+    return int(min(16, max(0, -(-360 // (n - 1)) - 1)))
 
 
 def dense_paths(m: Mechanism, sweep: Sweep, points: list[str], per_step: int) -> dict[str, np.ndarray]:

@@ -284,9 +284,10 @@ def caption(sweep: Sweep, i: int) -> str:
 
 
 def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=None,
-         labels: bool = True, title: str | None = None, units: str = ""):
+         labels: bool = True, title: str | None = None, units: str = "", path_xy=None):
     """Draw `m` at pose `pose` of `sweep` (default: the first solved) with the paths of
     `paths` (default: every moving point) over the sweep; returns the matplotlib Axes.
+    `path_xy`: those paths already solved (point -> M x 2, `smooth_paths`), else solved here.
 
     Links with two points are bars, links with three or more are filled polygons, ground
     pivots stand on hatched bases, slides show their guide and block; axes have equal scales.
@@ -297,7 +298,8 @@ def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=
         ax = plt.subplots(figsize=(6.4, 4.8))[1]
     paths = check_paths(m, paths)
     i = default_pose(sweep) if pose is None else int(pose) % max(len(sweep), 1)  # -1: the last
-    d = Drawing(ax, m, geometry(m, sweep), paths, labels, units, smooth_paths(m, sweep, paths))
+    smooth = smooth_paths(m, sweep, paths) if path_xy is None else {p: path_xy[p] for p in paths}
+    d = Drawing(ax, m, geometry(m, sweep), paths, labels, units, smooth)
     d.update(i, caption(sweep, i) if title is None else title)
     return ax
 
@@ -306,13 +308,10 @@ def smooth_paths(m: Mechanism, sweep: Sweep, paths: list[str]) -> dict | None:
     """Paths through about 360 poses, the extra ones SOLVED between the sweep's (see
     `kincas.views.picture.dense_paths`), so that a 12-pose sweep does not draw a 12-gon; None
     for sweeps of more than 60 poses (their poses are dense enough)."""
-    n = len(sweep)
-    if n < 2 or n > 60 or not paths:
+    from .picture import dense_paths, smooth_steps
+    per_step = smooth_steps(len(sweep))
+    if per_step == 0 or not paths:
         return None
-    per_step = int(min(16, max(0, -(-360 // (n - 1)) - 1)))
-    if per_step == 0:
-        return None
-    from .picture import dense_paths
     return dense_paths(m, sweep, paths, per_step)
 
 
