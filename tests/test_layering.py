@@ -300,3 +300,20 @@ def test_names_are_taken_from_their_home():
             if isinstance(node, ast.ImportFrom) and (node.module or "").endswith("core.symbolic"):
                 bad += [f"{n}: {a.name}" for a in node.names if a.name in home]
     assert not bad, bad
+
+
+def test_algorithms_read_no_scene():
+    """The model, the core, the analyses and the synthesis take mechanisms and plain values:
+    none parses TOML or reaches into a scene (`sc.study`, its raw sections); the command line
+    reads the sections (cli/tolerance.py, cli/scene_optimize.py, cli/scene_guess.py)."""
+    bad = []
+    for n, p in modules().items():
+        if layer(n) not in (0, 1, 2, 3):
+            continue
+        for node in ast.walk(ast.parse(p.read_text(encoding="utf-8"))):
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                names = [a.name for a in node.names] + [getattr(node, "module", None) or ""]
+                bad += [f"{n}: imports {x}" for x in names if x.split(".")[0] == "tomllib"]
+            elif isinstance(node, ast.Attribute) and node.attr in ("study", "raw", "refuse_jerks"):
+                bad.append(f"{n}:{node.lineno}: .{node.attr}")
+    assert not bad, bad

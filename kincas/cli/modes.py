@@ -7,9 +7,10 @@ import math
 import sys
 from pathlib import Path
 
-from ..analysis.modes import find_modes, scene_with_guess
+from ..analysis.modes import find_modes
 from ..errors import SceneError
 from .scene import load
+from .scene_guess import scene_with_guess
 
 
 def cli_arguments(parser) -> None:
