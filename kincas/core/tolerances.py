@@ -17,3 +17,5 @@ BACKTRACK = 1 / 32  # shortest fraction of a Newton step tried while backtrackin
 DECREASE = 1e-4  # a backtracked step must lower the residual by this times its fraction
 BRANCH = 1e-8  # |det| of the column-scaled g_q below this: too close to singular to tell a branch
 RANK = 1e-8  # a scaled singular value below this times the largest counts as zero
+RANK_GAP = 1e-4  # g_q's smallest scaled singular value above this times the largest: a regular assembly
+SAME_ASSEMBLY = 1e-6  # assemblies closer than this (scaled) are one (the redundant-joint test)

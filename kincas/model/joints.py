@@ -236,8 +236,9 @@ def _polar_problems(where: str, pr: Polar, num) -> list[str]:
 
 
 def value_problems(m: "Mechanism") -> list[str]:
-    """Problems with the numbers once every name resolves: positive radii, and a roller that
-    fits the profile's concave parts (its radius below their radius of curvature)."""
+    """Problems with the numbers once every name resolves: positive radii, a roller that
+    fits the profile's concave parts (its radius below their radius of curvature), and no
+    flat face on a profile with concave parts."""
     out = []
     for i, g in enumerate(m.gears):
         where = f"[[gears]] {g.name or i + 1}"
@@ -266,19 +267,44 @@ def value_problems(m: "Mechanism") -> list[str]:
         if np.any(radii <= 0):
             out.append(f"{where}: profile.polar.radii: must be positive")
             continue
-        smallest = concave_radius(c.profile.angles, radii)
+        smallest, at = most_concave(c.profile.angles, radii)
         if c.roller and rho >= smallest:
             out.append(f"{where}: roller.radius: {rho:.6g} is not below the smallest radius of "
                        f"curvature of the profile's concave parts ({smallest:.6g}): the roller "
                        f"cannot follow it (undercut)")
+        if c.flat and smallest < math.inf:
+            # a flat face touches where its line is tangent to the profile; only on a convex
+            # profile is every tangent line a supporting line (the cam on one side of it): at
+            # a concave part the face would cut through the cam, and the true contact would
+            # bridge the hollow, jumping from one side of it to the other
+            r = float(spline.evaluate(c.profile.angles, radii, np.array([at]), 0)[0, 0])
+            x, y = (_num(r * f(at), radii.max()) for f in (math.cos, math.sin))
+            out.append(f"{where}: flat: the profile is not convex everywhere (most concave at "
+                       f"({x}, {y}) in the frame of {c.body!r}, radius of curvature {smallest:.6g}): "
+                       f"a flat face would cut through the cam there; use a convex profile, or "
+                       f"a knife edge or a roller")
     return out
+
+
+def _num(v: float, size: float) -> str:
+    """v to 6 significant digits, 0 where it is rounding next to `size`."""
+    return f"{v:.6g}" if abs(v) > 1e-12 * size else "0"
+
+
+def most_concave(angles, radii, samples: int = 2048) -> tuple[float, float]:
+    """(radius of curvature, angle phi) where a polar profile is most concave, from the
+    spline at `samples` angles and at its knots; (inf, nan) where it is convex everywhere.
+    The polar curve r(phi) is convex where r^2 + 2 r'^2 - r r'' > 0 (`spline.curvature`)."""
+    phi = np.concatenate([np.linspace(angles[0], angles[0] + spline.TURN, samples, endpoint=False),
+                          np.asarray(angles, float)])
+    k = spline.curvature(*spline.evaluate(angles, radii, phi))
+    if not (k < 0).any():
+        return math.inf, math.nan
+    j = int(np.argmin(k))
+    return float(-1 / k[j]), float(phi[j])
 
 
 def concave_radius(angles, radii, samples: int = 2048) -> float:
     """The smallest radius of curvature over the concave parts of a polar profile (inf when
     it is convex everywhere), from the spline at `samples` angles and at its knots."""
-    phi = np.concatenate([np.linspace(angles[0], angles[0] + spline.TURN, samples, endpoint=False),
-                          np.asarray(angles, float)])
-    k = spline.curvature(*spline.evaluate(angles, radii, phi))
-    concave = k < 0
-    return float(1 / np.max(-k[concave])) if concave.any() else math.inf
+    return most_concave(angles, radii, samples)[0]

@@ -177,8 +177,8 @@ class Mechanism:
     @property
     def redundant(self) -> int:
         """Equations implied by the others (redundant joints): 0 where counting gives as many
-        freedoms as inputs; otherwise decided by the constraint Jacobian's rank at an
-        assembly near the guess (kincas.core.redundant, run once per mechanism), which
+        freedoms as inputs; otherwise decided by the constraint Jacobian's rank at generic
+        assemblies, whatever the guess (kincas.core.redundant, run once per mechanism), which
         raises `ModelError` if the inputs are genuinely wrong in number.
 
         Examples
@@ -527,7 +527,7 @@ def needs_rank_test(m: Mechanism) -> bool:
 
 def mobility_problem(m: Mechanism, free: int | None = None, tested: bool = False) -> str:
     """The message for a wrong number of inputs; `tested`: the rank test ran and found
-    `free` freedoms (None: no assembly near the guess to test)."""
+    `free` freedoms (None: no assembly found from the guess to test)."""
     st, dof = m.structure, counted_freedoms(m)
     n_param = dof - st.mobility
     detail = (f"{st.n_unknowns} unknown coordinates, {st.n_equations} equations"
@@ -535,8 +535,8 @@ def mobility_problem(m: Mechanism, free: int | None = None, tested: bool = False
     hint = ""
     if tested:
         hint = ("; a redundant joint would add freedoms to this count, but "
-                + ("no assembly was found near the guess to test for one" if free is None else
-                   f"the constraint Jacobian at an assembly near the guess gives it "
+                + ("no assembly was found from the guess to test for one" if free is None else
+                   f"the constraint Jacobian at generic points of the assemblies found gives it "
                    f"{free + n_param} degree(s) of freedom"))
     return (f"[inputs]: the mechanism has {dof} degree(s) of freedom ({detail}) "
             f"but {len(m.inputs)} input(s) drive it; give one input per degree of freedom{hint}")
