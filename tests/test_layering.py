@@ -317,3 +317,17 @@ def test_algorithms_read_no_scene():
             elif isinstance(node, ast.Attribute) and node.attr in ("study", "raw", "refuse_jerks"):
                 bad.append(f"{n}:{node.lineno}: .{node.attr}")
     assert not bad, bad
+
+
+def test_the_symbolic_model_stays_in_the_core():
+    """Outside kincas/core the compiled model is asked for plain values (names of unknowns,
+    which are lengths, checks of names, vectorised quantities): nothing reaches its CasADi
+    expressions through `model.sym`."""
+    bad = []
+    for n, p in modules().items():
+        if layer(n) == 1:
+            continue
+        for node in ast.walk(ast.parse(p.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Attribute) and node.attr == "sym":
+                bad.append(f"{n}:{node.lineno}: {ast.unparse(node)}")
+    assert not bad, bad

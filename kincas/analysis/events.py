@@ -198,7 +198,7 @@ def null_derivatives(model, report, values, Q, U, p, at) -> None:
     plain = []
     for r, name in enumerate(report):
         kind, obj, attr = parse_quantity(name)
-        _, order = model.sym.position_expr(obj, attr) if kind == "plain" else (None, None)
+        order = model.derivative_order(obj, attr) if kind == "plain" else None
         plain.append(order == 0)
     plain = np.array(plain)
     if plain.any():

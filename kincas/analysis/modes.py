@@ -155,7 +155,7 @@ def _scatter(m: Mechanism, model, n: int, L: float, seed: int) -> np.ndarray:
     """n starts over the reachable workspace: angles uniform in (-pi, pi]; the origin of a
     floating link uniform in a square of half-side L around a randomly chosen ground point."""
     rng = np.random.default_rng(seed)
-    names = [nm for nm, _ in model.sym.unknowns]
+    names = model.unknown_names
     Q = rng.uniform(-math.pi, math.pi, size=(n, len(names)))
     ground = np.array([(m.value(x), m.value(y)) for _, (x, y) in m.ground]).reshape(-1, 2)
     if len(ground) == 0:
@@ -173,12 +173,7 @@ def _scatter(m: Mechanism, model, n: int, L: float, seed: int) -> np.ndarray:
 
 def _point_rows(model, Q, u, p) -> np.ndarray:
     """The moving points of every row of Q, one row (x1, y1, x2, y2, ...) per start."""
-    n = Q.shape[0]
-    if n == 0:
-        return np.zeros((0, 0))
-    f = model.sym.f_points.map(n)
-    pts = np.asarray(f(Q.T, np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)))
-    return pts.reshape(2, -1, n, order="F").transpose(2, 1, 0).reshape(n, -1)
+    return model.points_many(Q, u, p)
 
 
 def _unique(rows: np.ndarray, tol: float) -> list[int]:
@@ -193,7 +188,7 @@ def _unique(rows: np.ndarray, tol: float) -> list[int]:
 def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
     """One Mode per distinct assembly: two solutions are the same mode when all their moving
     points agree to SAME * L (the points fix every link's angle modulo 2 pi)."""
-    sym, names = model.sym, m.moving_points
+    names = m.moving_points
     picked = None if picked_q is None else model.points(picked_q, u, p).T.ravel()
     Q = np.array(found).reshape(len(found), model.nq)
     rows = _point_rows(model, Q, u, p)
@@ -207,7 +202,7 @@ def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
                                np.ones((1, len(u))), np.zeros((1, len(u))))[:, 0]
         det = np.linalg.det(model.jac(q, u, p) * s) if model.nq else 1.0
         res = float(np.abs(model.residual(q, u, p)).max(initial=0.0) / L)
-        out.append(Mode(q=np.array(q), unknowns=tuple(nm for nm, _ in sym.unknowns),
+        out.append(Mode(q=np.array(q), unknowns=tuple(model.unknown_names),
                         points={nm: (float(pts[2 * j]), float(pts[2 * j + 1]))
                                 for j, nm in enumerate(names)},
                         angles={lk: float(wrap_angle(a)) for lk, a in zip(links, ang)},

@@ -224,7 +224,7 @@ def _carry(model, U, p, L, j, qj, k, i, memo):
     bl = blocks(model)
     R = np.concatenate([bl[b][0] for b in range(i + 1)])
     C = np.concatenate([bl[b][1] for b in range(i + 1)])
-    scale = np.where(model.sym.is_length, L, 1.0)[C]
+    scale = np.where(model.is_length, L, 1.0)[C]
     signs = modes(model, model.jac(qj, U[j], p), L)[0][:i + 1]
     if np.any(signs == 0):
         return None
@@ -274,7 +274,7 @@ def _same(model, qa, qb, L, i) -> bool:
     """Whether groups 0..i have the same assembly in qa and qb (angles modulo a turn)."""
     cols = np.concatenate([blocks(model)[b][1] for b in range(i + 1)])
     d = (np.asarray(qa) - np.asarray(qb))[cols]
-    is_len = model.sym.is_length[cols]
+    is_len = model.is_length[cols]
     d = np.where(is_len, d / L, np.angle(np.exp(1j * d)))
     return bool(np.abs(d).max(initial=0.0) <= SAME)
 

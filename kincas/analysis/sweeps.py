@@ -147,9 +147,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         Uddd = np.broadcast_to(_input_table(m, jerks, "jerks", 0.0), U.shape)
         third = [i for i, nm in enumerate(report) if needs_jerk(nm)]
         if third and ok.any():
-            f = model.sym.quantity_function([report[i] for i in third], jerk=True).map(int(ok.sum()))
-            rep = np.repeat(p.reshape(-1, 1), int(ok.sum()), axis=1)
-            got = np.asarray(f(Q[ok].T, U[ok].T, rep, Ud[ok].T, Udd[ok].T, Uddd[ok].T))
+            got = model.third_derivatives([report[i] for i in third], Q[ok], U[ok], p, Ud[ok], Udd[ok], Uddd[ok])
             values = np.array(values, dtype=float)
             values[np.ix_(third, np.flatnonzero(ok))] = got
     null_derivatives(model, report, values, Q, U, p, at)  # no wrong number at a singular pose
@@ -163,7 +161,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
                  status=status, flags=flags,
                  values={nm: values[i] for i, nm in enumerate(report)},
                  q=Q, residual=res, iterations=its,
-                 unknowns=[nm for nm, _ in model.sym.unknowns], size=L, events=events)
+                 unknowns=model.unknown_names, size=L, events=events)
 
 
 class _CarefulRun:

@@ -399,7 +399,7 @@ class _Reader:
         if all(plain_quantity(m, n) for n in [*report, *sens]):
             return
         from ..core.numeric import model_of
-        sym = model_of(m, check=False).sym
+        sym = model_of(m, check=False)
         bad = sym.check_names(report)
         # each `of` name and each `to` name once, under the field they were written in
         of = list(dict.fromkeys(parse_quantity(n)[1] for n in sens))

@@ -102,7 +102,7 @@ def read_section(sc) -> dict:
     if not isinstance(report, list) or not all(isinstance(n, str) for n in report):
         problems.append("[tolerance] report: expected a list of quantity names")
     else:
-        problems += model_of(sc.mechanism, check=False).sym.check_names(report, "[tolerance] report")
+        problems += model_of(sc.mechanism, check=False).check_names(report, "[tolerance] report")
         problems += [f"[tolerance] report: {n!r}: a sensitivity has no spread to analyse"
                      for n in report if parse_quantity(n)[0] == "sens"]
     if problems:

@@ -29,10 +29,16 @@ from .symbolic import is_angular
 class SampledNLP:
     """The symbolic NLP of `kincas.synthesis.simultaneous.Problem` (a base class of it).
 
-    It needs of the problem: m, model, sym, L, p0, vary, pscale, data, deg, qs, K, U, Ud,
+    It needs of the problem: m, model, L, p0, vary, pscale, data, deg, qs, K, U, Ud,
     Udd, D, path, ref, Q0, us, ulo, uhi, urows, u_at(k), sign(q, u, p), dense(mech) and the
     evaluator class (`evaluator`) of the expression language.
     """
+
+    @property
+    def sym(self):
+        """The model's symbolic form: the NLP is built here, in the core; the synthesis holds
+        only the model."""
+        return self.model.sym
 
     # --- the variables ---
     def make_symbols(self):

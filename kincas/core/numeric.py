@@ -384,3 +384,46 @@ class Model:
         f = self.quantity_function(tuple(names)).map(n)
         rep = lambda a: np.repeat(np.reshape(a, (-1, 1)), n, axis=1)
         return np.asarray(f(Q.T, U.T, rep(P), Ud.T, Udd.T))
+
+    def third_derivatives(self, names, Q, U, P, Ud, Udd, Uddd) -> np.ndarray:
+        """Quantities that need the inputs' jerks (len(names) x N) at N solved poses."""
+        n = Q.shape[0]
+        if n == 0 or not names:
+            return np.zeros((len(names), n))
+        f = self.memo(("jerk", tuple(names)), lambda: self.sym.quantity_function(list(names), jerk=True)).map(n)
+        rep = lambda a: np.repeat(np.reshape(a, (-1, 1)), n, axis=1)
+        return np.asarray(f(Q.T, U.T, rep(P), Ud.T, Udd.T, Uddd.T))
+
+    # --- the structure as plain values: the other floors never hold a CasADi object ---
+    @property
+    def mech(self) -> Mechanism:
+        """The mechanism the model was built from (its structure; values may differ)."""
+        return self.sym.mech
+
+    @property
+    def unknown_names(self) -> list[str]:
+        """The names of the unknowns, in the order of q (`crank.angle`, `L.x`, ...)."""
+        return [nm for nm, _ in self.sym.unknowns]
+
+    @property
+    def is_length(self) -> np.ndarray:
+        """Per unknown: True for a length (a floating link's origin), False for an angle."""
+        return self.sym.is_length
+
+    def check_names(self, names, where: str = "[output] report") -> list[str]:
+        """Problems with quantity names this model cannot give, each naming `where`."""
+        return self.sym.check_names(names, where)
+
+    def derivative_order(self, obj: str, attr: str) -> int:
+        """The time derivative a plain quantity `obj.attr` is of a position (0: a position)."""
+        return self.sym.position_expr(obj, attr)[1]
+
+    def points_many(self, Q, u, p) -> np.ndarray:
+        """The moving points at each row of Q (one input u, parameters p), one row
+        (x1, y1, x2, y2, ...) per row of Q."""
+        n = Q.shape[0]
+        if n == 0:
+            return np.zeros((0, 0))
+        f = self.sym.f_points.map(n)
+        pts = np.asarray(f(Q.T, np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)))
+        return pts.reshape(2, -1, n, order="F").transpose(2, 1, 0).reshape(n, -1)

@@ -31,7 +31,7 @@ class Checks:
                                accelerations={k: self.Udd[:, j] for j, k in enumerate(self.keys)},
                                report=list(self.used))
             at = np.arange(self.K)
-        angle = ~self.sym.is_length
+        angle = ~self.model.is_length
         for k in range(self.K):
             if not check_path and not sw.ok[at[k]]:
                 continue  # reported by the polishing already

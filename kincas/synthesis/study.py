@@ -135,7 +135,7 @@ def parse_report(m: Mechanism, report, where: str = "report") -> list:
     out, problems = [], []
     if isinstance(report, str) or not isinstance(report, (list, tuple)) or not report:
         raise ModelError(f"{where}: expected a list of expressions")
-    sym = compile(m).sym
+    sym = compile(m)
     for text in report:
         try:
             e = parse(text, f"{where}: {text!r}")

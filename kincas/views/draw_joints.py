@@ -45,7 +45,7 @@ class JointGeometry:
 
 def joint_geometry(model, Q, U, p, ok) -> JointGeometry | None:
     """Frames and contact points at every pose (Q, U: N rows; p: parameter values)."""
-    m = model.sym.mech
+    m = model.mech
     if not (m.gears or m.racks or m.cams):
         return None
     raw, nums = joint_values(model, Q, U, p)
