@@ -26,6 +26,7 @@ from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
 from ..core.symbolic import needs_jerk
 from ..model.names import default_report
+from .choice import choose_assembly
 from .continuation import careful_pose
 from .resume import unlabelled_resumes
 from .events import null_derivatives
@@ -64,6 +65,9 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     Each solved pose gets a flag where it sits at or next to a singular position ("limit",
     "change point", "singular"); `Sweep.events` lists those positions with their input values
     located exactly, and where a sweep resumed after poses with no assembly, on which branch.
+    Without any guess, where the default assembly loses poses that another assembly of the
+    first pose keeps, the sweep runs on that one and an "assembly" event says which and why
+    (kincas/analysis/choice.py); a guess is always obeyed.
 
     Parameters
     ----------
@@ -140,7 +144,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         status = ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
     events += unlabelled_resumes(model, U, p, L, Q, ok, events)  # after gaps the fast pass crossed
-    found, at = _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma)
+    found, at = _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma,
+                                 getattr(run, "crossed", ()))
     events += found
     values = run.values
     if jerks is not None:  # the inputs' jerks enter only the third derivatives
@@ -155,13 +160,20 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     events.sort(key=lambda e: e["pose"])
     for e in events:
         e.setdefault("inputs", {kk: float(U[e["pose"], j]) for j, kk in enumerate(keys)})
-    return Sweep(inputs={k: U[:, j].copy() for j, k in enumerate(keys)},
+    out = Sweep(inputs={k: U[:, j].copy() for j, k in enumerate(keys)},
                  rates={k: Ud[:, j].copy() for j, k in enumerate(keys)},
                  accelerations={k: Udd[:, j].copy() for j, k in enumerate(keys)},
                  status=status, flags=flags,
                  values={nm: values[i] for i, nm in enumerate(report)},
                  q=Q, residual=res, iterations=its,
                  unknowns=model.unknown_names, size=L, events=events)
+    if g:
+        return out  # the guess picks the assembly, whatever poses its branch loses
+    # no guess: where the default assembly loses poses, one of the first pose's others that
+    # runs them all (kincas/analysis/choice.py), said in an "assembly" event
+    rerun = lambda guess: sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
+                                guess=guess, progress=progress, method=method, compile=compile, jerks=jerks)
+    return choose_assembly(model, m, U, p, L, out, rerun) or out
 
 
 class _CarefulRun:
@@ -268,7 +280,7 @@ def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 # --- singular positions met by a sweep ---
 
 
-def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, signs, sigma):
+def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
     """Flag solved poses at or next to a singular position and locate it exactly, one event
     per Assur group (kincas/analysis/events.py). Returns (events, at: the poses exactly at a
     singular position, which it moved onto it).
@@ -279,4 +291,4 @@ def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, signs, s
     change of a group's sign, get exact per-group measures.
     """
     from .events import sweep_events
-    return sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma)
+    return sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed)

@@ -83,7 +83,8 @@ def modes(model, J, L) -> tuple[np.ndarray, np.ndarray]:
         (groups,) or (n, groups): the sign of each block's determinant, 0 where the block is
         within SIGN_TOL of singular (or tall: redundant joints).
     conditioning : numpy.ndarray
-        Same shape: sigma_min / sigma_max of each column-scaled block.
+        Same shape: sigma_min / sigma_max of each column-scaled block (a 1 x 1 block:
+        its entry's magnitude, at most 1).
 
     Examples
     --------
@@ -111,7 +112,12 @@ def modes(model, J, L) -> tuple[np.ndarray, np.ndarray]:
             continue
         s = np.linalg.svd(B[good], compute_uv=False)
         ni = np.nonzero(good)
-        cond[ni[0], idx[ni[1]]] = s[:, -1] / np.maximum(s[:, 0], np.finfo(float).tiny)
+        # a 1 x 1 block's sigma_min / sigma_max is always 1: its entry (columns scaled to
+        # O(1)) is measured against 1 instead, as the kernel measures every block (a slider
+        # crank's rod, whose block is l cos(phi) / L, is singular where the rod is square
+        # to the slide)
+        top = s[:, 0] if B.shape[2] > 1 or B.shape[3] > 1 else np.maximum(s[:, 0], 1.0)
+        cond[ni[0], idx[ni[1]]] = s[:, -1] / np.maximum(top, np.finfo(float).tiny)
         if B.shape[2] == B.shape[3]:
             sign[ni[0], idx[ni[1]]] = np.sign(np.linalg.det(B[good])) * (cond[ni[0], idx[ni[1]]] >= SIGN_TOL)
     return (sign[0], cond[0]) if one else (sign, cond)
@@ -241,7 +247,7 @@ def _candidates(model, q, u, p, L, i, target, near, starts):
         found = [(modes(model, model.jac(qs, u, p), L)[0][i], far(qs), qs) for qs in closed]
         yield from ((t[0], t[2]) for t in sorted(found, key=lambda t: (target != 0 and t[0] != target, t[1])))
         return
-    other = None
+    other, taken = None, None
     for s in _starts(model, cols, L, near, starts if len(cols) <= 2 else 4 * starts):
         q0 = q.copy()
         q0[cols] = s
@@ -251,8 +257,8 @@ def _candidates(model, q, u, p, L, i, target, near, starts):
         mode = modes(model, model.jac(qs, u, p), L)[0][i]
         if mode == target:
             yield mode, qs
-            target = None  # one per mode
-        elif other is None and mode != 0:
+            taken, target = mode, None  # one per mode
+        elif other is None and mode != 0 and mode != taken:
             other = mode, qs
         if target is None and other is not None:
             break
@@ -422,8 +428,8 @@ def ambiguous(model) -> bool:
 
 def first_pose(model, u, p, L, guess) -> Solution:
     """The first pose of a sweep (and where `kincas modes` and `kincas range` start): from
-    the guessed points (the nearest assembly), or without a guess group by group in the
-    default modes (above)."""
+    the guessed points (the assembly nearest them, kincas/core/guessed.py), or without a
+    guess group by group in the default modes (above)."""
     return settle_first(model, _assembled(model, u, p, L, guess), u, p, L)  # gears: angles in (-pi, pi]
 
 
@@ -434,7 +440,8 @@ def _assembled(model, u, p, L, guess) -> Solution:
         sol = assemble(model, u, p, L)
         if sol is not None or not ambiguous(model):
             return sol if sol is not None else no_assembly(model, np.zeros(model.nq))
-    q0 = model.initial_q(u, p, guess, L)
+    from .guessed import guessed_start  # it builds on this module
+    q0 = guessed_start(model, u, p, L, guess) if guess else model.initial_q(u, p, guess, L)
     sol = model.newton(q0, u, p, L)
     if not sol.ok and guess:  # group by group from the guessed pose, then IPOPT if in doubt
         sol = assemble(model, u, p, L, near=q0) or sol
