@@ -4,18 +4,10 @@ writers of kincas/views (CSV tables and quantity plots in views/quantities.py, a
 in views/animation.py, drawings in views/plot.py, svg.py, dxf.py, html.py), which are
 still importable from here.
 
-Values are written in the scene's units (degrees where the scene says so); without a scene,
-as the sweep holds them (radians). A pose that was not solved has empty cells.
+Values are written in the scene's units (degrees where the scene says so).
 
->>> import io, numpy as np, kincas
->>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
-...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
-...            kincas.Link.bar("rocker", "D", "C", 3)],
-...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
->>> sw = kincas.sweep(m, {"crank.angle": [0.0, 0.5]}, report=["C.x", "rocker.omega"])
->>> out = io.StringIO(); write_csv(out, sw)
->>> print(out.getvalue().splitlines()[0])
-crank.angle [rad],C.x,rocker.omega [rad/s],status,flag
+>>> sorted(FILE_FLAGS)[:3]
+['--animate', '--csv', '--dxf']
 """
 from __future__ import annotations
 
