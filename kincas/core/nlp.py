@@ -146,6 +146,15 @@ class SampledNLP:
                                   sign=self.sign(d0.q[i], U[i], self.p0))
         return value
 
+    def extreme_values(self, e, Q, U, p, Ud, Udd) -> np.ndarray:
+        """The expression a max()/min() tracks (`e`, from `extreme`), at N poses: rows of Q,
+        U, Ud, Udd, parameters p; numbers for the checks, which hold no CasADi object."""
+        Q, U, Ud, Udd = (np.atleast_2d(np.asarray(a, float)) for a in (Q, U, Ud, Udd))
+        n = len(Q)
+        f = e["F"].map(n)
+        return np.asarray(f(Q.T, U.T, np.repeat(np.reshape(p, (-1, 1)), n, 1), Ud.T, Udd.T,
+                            np.zeros((len(self.data), n)))).ravel()
+
     def squared_distances(self, point, targets):
         """sum_k |P(q_k, u_k) - T_k|^2 of a point P and targets T (K x 2): a curve's objective."""
         F = self.model.quantity_function((f"{point}.x", f"{point}.y"))
