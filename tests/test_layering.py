@@ -1,8 +1,9 @@
 """The architecture, checked from the source: the import graph of kincas/ (every import
 statement of every module, also those inside functions; not those for type annotations only)
 has no cycle, the layers depend one way (model <- core <- analysis <- synthesis <- views <-
-cli), every module has a place, and CasADi is imported only in kincas/core.
-Reading a scene builds no model, and declaring a mechanism runs no solver.
+cli), every module has a place, only the package's face wires the floors together, the
+algorithms read no scene, and CasADi (its imports and the symbolic model) stays in
+kincas/core. Reading a scene builds no model, and declaring a mechanism runs no solver.
 """
 from __future__ import annotations
 
