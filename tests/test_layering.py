@@ -8,6 +8,7 @@ kincas/core. Reading a scene builds no model, and declaring a mechanism runs no 
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 from conftest import ROOT
@@ -80,6 +81,7 @@ def _walk(node, toplevel=False):
         yield from _walk(child, toplevel)
 
 
+@functools.lru_cache(maxsize=None)  # read once for all the checks (none changes it)
 def graph(toplevel: bool = False) -> dict[str, set[str]]:
     mods = modules()
     return {n: imports(n, p, set(mods), toplevel) for n, p in mods.items()}
