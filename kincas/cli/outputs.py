@@ -16,6 +16,7 @@ from ..results import Sweep
 from ..views.animation import animate  # noqa: F401  (its old home)
 from ..views.columns import _abscissa, heading, user_columns  # noqa: F401  (their old home)
 from ..views.quantities import FLAG_STYLE, _break_wraps, _flat, _runs, plot_quantities, write_csv  # noqa: F401
+from .atomic import savefig
 
 # --- the command line's output flags ---
 
@@ -127,7 +128,7 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
                                              _names(getattr(args, "evolute", None) or ""),
                                              _names(getattr(args, "centrodes", None) or ""), solved())),
             ("animate", lambda p: _animate(p, m, sweep, paths, captions, length, _rendering(args), solved())),
-            ("plot_quantities", lambda p: plot_quantities(sweep, scene=scene).savefig(p, dpi=100)),
+            ("plot_quantities", lambda p: savefig(plot_quantities(sweep, scene=scene), p, dpi=100)),
             ("html", lambda p: _html(p, m, sweep, scene, paths, solved.dense())),
             ("svg", lambda p: _svg(p, m, sweep, scene, pose, paths, solved.dense())),
             ("dxf", lambda p: _dxf(p, m, sweep, scene, pose, paths, solved.dense()))]
@@ -208,7 +209,7 @@ def _save_drawing(path, m, sweep, pose, paths, captions, length, evolute=(), cen
     if evolute or centrodes:  # kinematic geometry over the drawing (kincas/views/draw_geometry.py)
         from ..views.draw_geometry import draw_geometry
         draw_geometry(ax, m, sweep, i, evolute, centrodes)
-    fig.savefig(path, dpi=100)
+    savefig(fig, path, dpi=100)
 
 
 def _rendering(args):

@@ -42,7 +42,8 @@ def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, 
     fig.canvas.draw()  # lay the figure out once; every frame keeps that layout
     fig.set_layout_engine("none")
     writer = PillowWriter(fps=fps)
-    with writer.saving(fig, str(path), dpi):
+    from .atomic import replacing
+    with replacing(path) as tmp, writer.saving(fig, tmp, dpi):  # no half animation left
         if progress is not None:
             progress(0, len(pick))
         for k, i in enumerate(pick):  # one drawing per frame

@@ -38,7 +38,8 @@ def write_csv(out, sweep: Sweep, scene=None) -> None:
     Numbers are written with all their digits (shortest text that reads back the same float).
     """
     if isinstance(out, (str, bytes)) or hasattr(out, "__fspath__"):
-        with open(out, "w", newline="", encoding="utf-8") as f:
+        from .atomic import open_replacing
+        with open_replacing(out, "w", newline="", encoding="utf-8") as f:  # whole or not at all
             return write_csv(f, sweep, scene)
     inputs, values = user_columns(sweep, scene)
     values = {k: v for k, v in values.items() if k not in inputs}  # an input reported: once
