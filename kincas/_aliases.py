@@ -27,7 +27,8 @@ OLD = {
 }
 # paths of this release's predecessor: warned (DeprecationWarning), removed in the next release
 MOVED = {f"cli.{m}": f"views.{m}" for m in ("plot", "svg", "picture", "draw_joints",
-                                           "draw_geometry", "dxf", "html", "mapplot", "numbers")}
+                                           "draw_geometry", "dxf", "html", "mapplot", "numbers",
+                                           "atomic")}
 MOVED["notebook"] = "views.notebook"
 
 

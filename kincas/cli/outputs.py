@@ -16,7 +16,7 @@ from ..results import Sweep
 from ..views.animation import animate  # noqa: F401  (its old home)
 from ..views.columns import _abscissa, heading, user_columns  # noqa: F401  (their old home)
 from ..views.quantities import FLAG_STYLE, _break_wraps, _flat, _runs, plot_quantities, write_csv  # noqa: F401
-from .atomic import savefig
+from ..views.atomic import savefig  # noqa: F401  (also its old home)
 
 # --- the command line's output flags ---
 

@@ -188,13 +188,13 @@ def _has(mod) -> bool:
 
 def write(r: StudyResult, path) -> None:
     """Write the study's rows to .nc, .csv or .parquet (chosen by the suffix)."""
-    from .atomic import replacing
+    from ..views.atomic import replacing
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise OutputError(f"--out: {str(path)!r}: expected a file ending in {', '.join(FORMATS)}")
     try:
-        with replacing(path) as tmp:  # whole or not at all (kincas/cli/atomic.py)
+        with replacing(path) as tmp:  # whole or not at all (kincas/views/atomic.py)
             if suffix == ".csv":
                 _write_csv(r, tmp)
             elif suffix == ".parquet":

@@ -511,6 +511,20 @@ def counted_freedoms(m: Mechanism) -> int:
     return m.structure.mobility + sum(inp.kind == "parameter" for inp in m.inputs)
 
 
+def solved_unknowns(m: Mechanism) -> int:
+    """The unknowns the solver finds at each pose: the structure's coordinates less the link
+    angles that inputs drive (a driven angle is given, not solved for); the size of q.
+
+    >>> m = Mechanism(ground={"O": (0, 0)}, links=[Link.bar("crank", "O", "A", 1)],
+    ...               inputs=[Input.angle("crank")])
+    >>> m.structure.n_unknowns, solved_unknowns(m)
+    (1, 0)
+    """
+    links = {lk.name for lk in m.links}
+    driven = {i.target for i in m.inputs if i.kind == "angle" and i.target in links}
+    return m.structure.n_unknowns - len(driven)
+
+
 def use_rank_test(decide) -> None:
     """Let `Mechanism.redundant` ask `decide(mechanism) -> int` (the core's rank test, given by
     `import kincas`) where counting cannot tell the redundant equations."""

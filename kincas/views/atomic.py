@@ -1,4 +1,5 @@
-"""Files written whole or not at all: every file the command line writes goes through here.
+"""Files written whole or not at all: every file kincas writes (the views' writers, the
+command line's outputs and scenes) goes through here.
 
 `replacing(path)` gives a temporary name in the same folder (so that the final rename stays
 on one file system, where it is atomic); the writer writes there; when it returns, the
