@@ -151,14 +151,14 @@ def _check_size(sc, kw, workers) -> None:
     naming the grid or the samples, the memory, and the ways round)."""
     from . import bounds
     from ..analysis.executor import default_workers
-    from ..core.numeric import compile
+    from ..model.mechanism import solved_unknowns
     from ..synthesis.expressions import parse
     grid, n = kw["grid"], kw["samples"]
     designs = math.prod(grid) if grid is not None else n
     field = f"[study] grid = {grid}" if grid is not None else f"[study] samples = {n}"
     poses = max((len(v) for v in sc.study.inputs.values()), default=1)
     wanted = {q for t in kw["report"] for q in parse(t, "report").quantities}
-    need = bounds.study_bytes(designs, poses, compile(sc.mechanism).sym.nq, len(wanted),
+    need = bounds.study_bytes(designs, poses, solved_unknowns(sc.mechanism), len(wanted),
                               len(kw["vary"]), len(kw["report"]), workers or default_workers())
     try:
         bounds.check_total(f"{field} ({designs:,} designs x {poses} poses)", need,
