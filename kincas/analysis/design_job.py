@@ -152,7 +152,7 @@ class _Job:
         model, P, Ls = self.model, self.P[idx], self.Ls[idx]
         nd, u = P.shape[0], np.repeat(self.U[:1], P.shape[0], axis=0)
         ev = BatchEvaluator(model)
-        scale = np.where(model.sym.is_length[None, :], 1.0, 1.0 / Ls[:, None])
+        scale = np.where(model.is_length[None, :], 1.0, 1.0 / Ls[:, None])
         dP = P - p0
         # Steps of at most STEP * size in every parameter, counted per design, so that a
         # design's numbers do not depend on the others computed with it (chunks on a cluster).
@@ -167,7 +167,7 @@ class _Job:
             qa = qa - _solve(J, np.einsum("dij,dj->di", Gp, pt - pc[a]))
             # Newton (undamped: the predictor starts it close), each design stopping by the
             # one rule of kincas/core/newton.py
-            D, live, last = np.where(model.sym.is_length[None, :], La[:, None], 1.0), np.ones(len(a), bool), np.inf
+            D, live, last = np.where(model.is_length[None, :], La[:, None], 1.0), np.ones(len(a), bool), np.inf
             for _ in range(NEWTON):
                 gv, J, _, _ = ev.derivatives(qa, ua, pt)
                 dq = _solve(J, gv)
@@ -235,7 +235,7 @@ class _Job:
         stops = np.full(len(todo), n)
         live = np.arange(len(todo))  # positions in todo still advancing
         d = todo
-        D = np.where(model.sym.is_length[None, :], self.Ls[d][:, None], 1.0)
+        D = np.where(model.is_length[None, :], self.Ls[d][:, None], 1.0)
         q = self.Q[d, 0]
         _, J, Ju, _ = ev.derivatives(q, np.repeat(U[:1], len(d), 0), self.P[d])
         T = -_solve(J, Ju)

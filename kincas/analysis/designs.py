@@ -45,7 +45,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..core.numeric import compile as compile_model
-from ..core.symbolic import default_report
+from ..model.names import default_report
 from ..model.mechanism import Mechanism, as_param
 from .continuation import _first
 from .design_job import (BLOCK, BLOCK_POSES, BRANCH_LOST, CALL_SECONDS, FIRST_CALL, FULL_BLOCK,  # noqa: F401
