@@ -19,6 +19,7 @@ from .resume import carry_groups, larger_groups, resume_label
 
 
 WATCH = 0.5  # a group conditioned below this at either end of a step is checked for a crossing
+MAX_GROUPS = 8  # groups searched for a limit where continuation of a step failed (the worst conditioned first)
 
 # --- a pose of a sweep on the careful path ---
 
@@ -45,12 +46,18 @@ def careful_pose(model: Model, m: Mechanism, U, p, L, guess, k: int, j: int | No
     for q in (q for q in carried.values() if q is not None):  # a group carried through the
         sol = assemble(model, u, p, L, want=modes(model, model.jac(run.Q[j], U[j], p), L)[0], near=q)
         break  # gap is in the mode it left: first that, the later groups in theirs
+    reach = []  # how far continuation got from pose j (the furthest pose it solved)
     if sol is None:
         prev = (run.Q[j - 1], U[j - 1]) if fresh and j >= 1 and run.solved[j - 1] else None
-        sol = _continue(model, run.Q[j], U[j], u, p, L, depth=8 if fresh else 0, prev=prev)
+        sol = _continue(model, run.Q[j], U[j], u, p, L, depth=8 if fresh else 0, prev=prev, reach=reach)
     recovered = sol is None
     if sol is None:
         sol = _recover(model, m, (run.Q[j], U[j]), u, p, L)
+        if sol.ok and fresh and _gap_inside(model, run, U, p, L, j, k, sol, reach):
+            # the branch of pose j ends inside the step: pose k resumes after a gap
+            events.append({"kind": "resume", "pose": int(k)}
+                          | resume_label(model, U, p, L, j, run.Q[j], k, sol.q))
+            return sol
     if sol.ok and not fresh:  # back in range: in the modes it left where they assemble
         before = modes(model, model.jac(run.Q[j], U[j], p), L)[0]
         after = modes(model, sol.J, L)[0]
@@ -124,7 +131,7 @@ def _scaled_norm(model: Model, dq, L) -> float:
     return float(np.abs(dq / np.where(model.sym.is_length, L, 1.0)).max(initial=0.0))
 
 
-def _continue(model: Model, q0, u0, u1, p, L, depth: int, prev=None) -> Solution | None:
+def _continue(model: Model, q0, u0, u1, p, L, depth: int, prev=None, reach=None) -> Solution | None:
     """Predict, correct with Newton. The step is halved when the corrector fails or needs
     many iterations, lands far from the prediction, or the sign of det(g_q) flips (the sign
     tells the assembly branch apart).
@@ -132,6 +139,9 @@ def _continue(model: Model, q0, u0, u1, p, L, depth: int, prev=None) -> Solution
     The predictor is the exact tangent dq/du, except where g_q is nearly singular: there the
     tangent is undefined (at a change point two branches cross), and the secant through
     the previous pose `prev` = (q, u) carries the branch straight through.
+
+    `reach`, a list, receives (q, u) of every intermediate pose solved, in order: where
+    the step fails, its last entry is as far as the branch was followed.
     """
     J0 = model.jac(q0, u0, p)
     pred = _secant(q0, u0, u1, prev) if prev is not None and _ill(model, J0, L) else None
@@ -150,8 +160,38 @@ def _continue(model: Model, q0, u0, u1, p, L, depth: int, prev=None) -> Solution
     if depth == 0:
         return None
     um = 0.5 * (u0 + u1)
-    mid = _continue(model, q0, u0, um, p, L, depth - 1, prev)
-    return None if mid is None else _continue(model, mid.q, um, u1, p, L, depth - 1, (q0, u0))
+    mid = _continue(model, q0, u0, um, p, L, depth - 1, prev, reach)
+    if mid is None:
+        return None
+    if reach is not None:
+        reach.append((mid.q, um))
+    return _continue(model, mid.q, um, u1, p, L, depth - 1, (q0, u0), reach)
+
+
+def _gap_inside(model: Model, run, U, p, L, j, k, sol: Solution, reach) -> bool:
+    """Whether the branch of pose j ends at a limit inside the step to pose k, which was
+    solved only by Newton from pose j (`_recover`) after continuation failed: then pose k
+    lies beyond a stretch with no assembly on this branch (or on another branch), however
+    short, and the step is a gap. The limit is searched per group (the worst conditioned
+    first) from the furthest pose continuation reached, where it failed (within 1/256 of
+    the step of it). Found, (j, k, near j's end, near k's end) is recorded in `run.crossed`
+    (each end: the pose nearest the gap continuation reached from that side): the sweep's
+    events locate the limits at both ends, as next to poses with no assembly."""
+    from .singular import locate_singular
+    near_j = reach[-1] if reach else (run.Q[j], U[j])
+    d = U[k] - near_j[1]
+    if not np.any(d):
+        return False
+    cond = modes(model, model.jac(near_j[0], near_j[1], p), L)[1]
+    for i in np.argsort(cond, kind="stable")[:MAX_GROUPS]:
+        found = locate_singular(model, *near_j, p, L, d, group=int(i), window=(-0.5, 1.5))
+        if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
+            back = []  # and from pose k back towards pose j: the other end of the gap
+            _continue(model, sol.q, U[k], U[j], p, L, depth=8, reach=back)
+            near_k = back[-1] if back else (sol.q, U[k])
+            run.__dict__.setdefault("crossed", []).append((int(j), int(k), near_j, near_k))
+            return True
+    return False
 
 
 def _passes_singular(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:

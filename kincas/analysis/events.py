@@ -13,7 +13,9 @@ O(1): a pure number, the same at 1e-6 m and at 1e6 m); see kincas/core/assembly.
   are two events, although det g_q keeps its sign); a change that cannot be located is
   still an event (kind "singular");
 - a solved pose next to one with no assembly: the limit of each group that lies between
-  them is located;
+  them is located; the same where the stretch with no assembly lies inside one step
+  between two solved poses (the careful path finds it where continuation of the step
+  fails, kincas/analysis/continuation.py): both poses flagged, the pose after it a resume;
 - a pose whose whole g_q is numerically singular is flagged where it stands.
 
 Events carry "kind", "pose", "inputs" and "group" (the links of the group concerned).
@@ -41,7 +43,7 @@ MAX_GROUPS_AT_GAP = 8  # groups tried for a limit next to a gap (the worst condi
 # --- the events of a sweep ---
 
 
-def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma):
+def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
     """Events and flags of a sweep from the per-pose measures the solve gives.
 
     Parameters
@@ -61,6 +63,10 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma):
     sigma : numpy.ndarray
         (n,): a lower bound of the groups' conditioning; only poses where it is small, and
         the ends of a change, get the exact per-group measures (`modes`) here.
+    crossed : sequence of (j, k, (q, u), (q, u))
+        Steps between two solved poses j and k across which the branch did not go on (a
+        stretch with no assembly inside one step), each with the poses nearest the gap
+        that continuation reached from j's side and from k's (kincas/analysis/continuation.py).
 
     Returns
     -------
@@ -74,7 +80,7 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma):
     if model.nq == 0 or not m.inputs or n == 0:
         return events, at
     sigma = np.asarray(sigma, float)
-    if _nothing_met(ok, signs, sigma):
+    if not len(crossed) and _nothing_met(ok, signs, sigma):
         return events, at
     signs = np.nan_to_num(np.asarray(signs, float)).astype(int)
     names = group_links(model)
@@ -147,6 +153,21 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma):
                 found = locate_singular(model, Q[k], U[k], p, L, U[nb] - U[k], group=int(i))
                 if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
                     event(kind_at(found[0], found[1]), k, found[1], int(i))
+    # a gap inside one step between two solved poses: its limits, located from the poses
+    # nearest it on either side, flag the poses before and after it
+    for j, k, near_j, near_k in crossed:
+        seen = len(events)
+        for pose, (q, u), other in ((j, near_j, U[k]), (k, near_k, U[j])):
+            if not np.any(other - u):
+                continue
+            cond = modes(model, model.jac(q, u, p), L)[1]
+            for i in np.argsort(cond, kind="stable")[:MAX_GROUPS_AT_GAP]:
+                found = locate_singular(model, q, u, p, L, other - u, group=int(i))
+                if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
+                    event(kind_at(found[0], found[1]), pose, found[1], int(i))
+                    break
+        if len(events) == seen:  # crossed, but not located: said all the same
+            event("singular", k, U[k], int(np.argmin(measure(k)[1])))
     return _distinct(events), at
 
 

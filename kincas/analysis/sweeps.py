@@ -139,7 +139,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         status = ["ok" if s else NO_ASSEMBLY for s in ok]
     flags = [None] * n
     events += unlabelled_resumes(model, U, p, L, Q, ok, events)  # after gaps the fast pass crossed
-    found, at = _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma)
+    found, at = _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma,
+                                 getattr(run, "crossed", ()))
     events += found
     values = run.values
     if jerks is not None:  # the inputs' jerks enter only the third derivatives
@@ -269,7 +270,7 @@ def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 # --- singular positions met by a sweep ---
 
 
-def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, signs, sigma):
+def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
     """Flag solved poses at or next to a singular position and locate it exactly, one event
     per Assur group (kincas/analysis/events.py). Returns (events, at: the poses exactly at a
     singular position, which it moved onto it).
@@ -280,4 +281,4 @@ def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, signs, s
     change of a group's sign, get exact per-group measures.
     """
     from .events import sweep_events
-    return sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma)
+    return sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed)

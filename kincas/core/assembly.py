@@ -83,7 +83,8 @@ def modes(model, J, L) -> tuple[np.ndarray, np.ndarray]:
         (groups,) or (n, groups): the sign of each block's determinant, 0 where the block is
         within SIGN_TOL of singular (or tall: redundant joints).
     conditioning : numpy.ndarray
-        Same shape: sigma_min / sigma_max of each column-scaled block.
+        Same shape: sigma_min / sigma_max of each column-scaled block (a 1 x 1 block:
+        its entry's magnitude, at most 1).
 
     Examples
     --------
@@ -111,7 +112,12 @@ def modes(model, J, L) -> tuple[np.ndarray, np.ndarray]:
             continue
         s = np.linalg.svd(B[good], compute_uv=False)
         ni = np.nonzero(good)
-        cond[ni[0], idx[ni[1]]] = s[:, -1] / np.maximum(s[:, 0], np.finfo(float).tiny)
+        # a 1 x 1 block's sigma_min / sigma_max is always 1: its entry (columns scaled to
+        # O(1)) is measured against 1 instead, as the kernel measures every block (a slider
+        # crank's rod, whose block is l cos(phi) / L, is singular where the rod is square
+        # to the slide)
+        top = s[:, 0] if B.shape[2] > 1 or B.shape[3] > 1 else np.maximum(s[:, 0], 1.0)
+        cond[ni[0], idx[ni[1]]] = s[:, -1] / np.maximum(top, np.finfo(float).tiny)
         if B.shape[2] == B.shape[3]:
             sign[ni[0], idx[ni[1]]] = np.sign(np.linalg.det(B[good])) * (cond[ni[0], idx[ni[1]]] >= SIGN_TOL)
     return (sign[0], cond[0]) if one else (sign, cond)

@@ -20,7 +20,9 @@ pose ends where quadratic convergence puts it (rounding). kN iterates until its 
 below NEAR (quadratic convergence then makes the next one ~NEAR^2), and kF, which needs g
 and g_q at the final q anyway, gives that next step: a pose usually costs one or two kN and
 one kF. Where convergence is not quadratic (near a singular position) the next step stays
-above STEP and the pose goes to the careful path.
+above STEP and the pose goes to the careful path, whose Newton goes on while its steps
+shrink and stops at rounding there (kincas/core/newton.py): the kernel accepts only what
+both rules accept alike, a negligible next step.
 """
 from __future__ import annotations
 

@@ -9,9 +9,14 @@ limited to `MAX_STEP` per coordinate (a trust region that keeps a step on its br
 backtracked until the residual max |F / res_scale| decreases. It stops by the compiled
 kernel's rule (kincas/core/kernel.py): converged when the residual is below `ACCEPT` and
 the next step below `TOL` (scaled), and that negligible step is applied, so the careful and
-the fast paths both end at rounding. It also stops when the residual is below `TOL` but the
-step is not negligible (g_q nearly singular: the step would be magnified rounding), or when
-no step makes progress (a non-solution); a result counts as solved below `ACCEPT`
+the fast paths both end at rounding. Next to a singular position (g_q nearly singular) the
+steps may never get below TOL, rounding magnified by 1 / sigma_min: there it stops, solved,
+once the step no longer shrinks (by `SHRINK` at least: quadratically at a regular root, by
+half onto a double root), that is at rounding, whatever the residual; a small residual
+alone is no test there (an error e leaves a residual of only sigma_min e). It also stops
+where no step lowers the residual (a non-solution, or rounding), after trying the
+least-squares step that leaves a null direction of g_q alone (g_q singular to rounding: a
+change point met exactly); a result counts as solved below `ACCEPT`
 (kincas/core/tolerances.py).
 
 >>> import numpy as np
@@ -26,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .tolerances import ACCEPT, BACKTRACK, DECREASE, MAX_ITER, MAX_STEP, TOL
+from .tolerances import ACCEPT, BACKTRACK, DECREASE, MAX_ITER, MAX_STEP, RANK, SHRINK, TOL
 
 
 def lsolve(J, b):
@@ -95,32 +100,59 @@ def newton(F, x, step_scale, res_scale, *, tol: float = TOL, accept: float = ACC
     x = np.array(x, dtype=float)
     g, J = F(x)
     r = _size(g, res_scale)
+    last = np.inf  # the last full Newton step's size (scaled)
     for it in range(max_iter):
         dz = lsolve(J * step_scale, -g) if r > 0 else np.zeros_like(x)
         if not np.all(np.isfinite(dz)):
             break
-        if r <= accept and np.abs(dz).max(initial=0.0) <= tol:
+        size = np.abs(dz).max(initial=0.0)
+        if r <= accept and size <= tol:
             # the compiled kernel's rule (kincas/core/kernel.py): converged when the next
             # step is negligible; apply it, so a solve ends where quadratic convergence puts
             # it (rounding), not at the residual that passed the test
             return NewtonResult(x + dz * step_scale, r, it + 1, True, g, J)
-        if r <= tol:
-            # the residual is at its target but the step is not negligible: g_q is (nearly)
-            # singular, so the step is rounding magnified; stay where the residual is
+        if r <= accept and size > SHRINK * last:
+            # Solved, and the step no longer shrinks. Steps shrink quadratically at a
+            # regular root, by half per step onto a double root (a limit), and stop
+            # shrinking only once they are rounding magnified by 1 / sigma_min(g_q) (next
+            # to a singular position that is well above TOL): this is as close as rounding
+            # allows. (A small residual alone says little there: an error e in q leaves a
+            # residual of sigma_min e, so stopping at it left a pose 1e-8 from a limit
+            # 5e-10 off, where 3e-12 is the rounding limit.)
             return NewtonResult(x, r, it, True, g, J)
-        dx = dz * (step_scale / max(1.0, np.abs(dz).max() / max_step))  # the trust region
-        t = 1.0
-        while True:  # backtrack until the residual decreases
-            xn = x + t * dx
-            gn, Jn = F(xn)
-            rn = _size(gn, res_scale)
-            if rn < (1 - DECREASE * t) * r or rn <= tol or t < BACKTRACK:
+        t, xn, gn, Jn, rn = _search(F, x, dz, step_scale, r, res_scale, max_step)
+        if not rn < r:
+            # No progress. Where g_q is singular to rounding (a change point or a limit met
+            # exactly) the Newton step is rounding magnified along the null direction: the
+            # least-squares step that leaves that direction alone may still progress
+            dz, _, rank, _ = np.linalg.lstsq(J * step_scale, -g, rcond=RANK)
+            if rank == min(J.shape) or not np.all(np.isfinite(dz)):
+                break  # stagnation at a non-solution, or at rounding level
+            t, xn, gn, Jn, rn = _search(F, x, dz, step_scale, r, res_scale, max_step)
+            if not rn < r:
                 break
-            t /= 2
-        if not rn < r and rn > tol:
-            break  # no progress: stagnation at a non-solution (or at rounding level)
+            t = 0.0  # not a Newton step: the next is not expected to be smaller
+        # a full step is the one whose successor is expected to shrink (a damped step
+        # leaves part of itself for the next)
+        last = size if t == 1.0 else np.inf
         x, g, J, r = xn, gn, Jn, rn
     return NewtonResult(x, r, max_iter, r <= accept, g, J)
+
+
+def _search(F, x, dz, step_scale, r, res_scale, max_step):
+    """The step dz (scaled) within the trust region, halved until the residual decreases:
+    (its fraction t, 1 for the whole step; the point, g, J and residual there)."""
+    size = np.abs(dz).max(initial=0.0)
+    scale = max(1.0, size / max_step)  # the trust region
+    dx = dz * (step_scale / scale)
+    t = 1.0
+    while True:
+        xn = x + t * dx
+        gn, Jn = F(xn)
+        rn = _size(gn, res_scale)
+        if rn < (1 - DECREASE * t) * r or t < BACKTRACK:
+            return t / scale, xn, gn, Jn, rn
+        t /= 2
 
 
 def _size(g, res_scale) -> float:

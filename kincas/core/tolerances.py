@@ -12,6 +12,9 @@ True
 TOL = 1e-13  # Newton stops when its next step (radians, lengths over the group's length) is below this
 ACCEPT = 1e-10  # a pose whose relative residual is above this is not solved
 MAX_STEP = 0.5  # largest Newton step per iteration: radians, or this times the group's length
+# A solved Newton step that is not below SHRINK times the one before it is rounding (steps
+# shrink quadratically at a regular root, by 1/2 per step onto a double root): stop there
+SHRINK = 0.75
 MAX_ITER = 40  # Newton iterations per group before giving up
 BACKTRACK = 1 / 32  # shortest fraction of a Newton step tried while backtracking
 DECREASE = 1e-4  # a backtracked step must lower the residual by this times its fraction
