@@ -112,3 +112,27 @@ class _Recent:
 def prepared(model, m: Mechanism) -> Prepared:
     """The `Prepared` data of mechanism m, whose structure's model is `model`."""
     return model.memo("sweep.prepared", _Recent).get(m)
+
+
+# --- the mechanisms last swept, by identity: their model and prepared data in one look-up ---
+
+_SEEN: dict = {}  # id(m) -> (m, model, Prepared); each entry keeps its m, so its id is its own
+_SEEN_LOCK = threading.Lock()
+
+
+def model_and_prepared(m: Mechanism, model_of):
+    """(model_of(m), prepared(model, m)) for mechanism m, found by identity when m was swept
+    lately: a sweep of a mechanism already swept neither hashes its structure again (the
+    structure key is every link and joint) nor repeats the deferred mobility check, which
+    `model_of` runs (a mechanism is immutable: what was decided for it stays decided; a
+    mechanism refused raises every time, since nothing is kept for it)."""
+    hit = _SEEN.get(id(m))  # (a dict read is atomic: no lock)
+    if hit is not None and hit[0] is m:
+        return hit[1], hit[2]
+    model = model_of(m)
+    pm = prepared(model, m)
+    with _SEEN_LOCK:
+        _SEEN[id(m)] = (m, model, pm)
+        while len(_SEEN) > RECENT:
+            del _SEEN[next(iter(_SEEN))]
+    return model, pm

@@ -30,7 +30,7 @@ from .resume import unlabelled_resumes
 from .events import null_derivatives
 from ..core.joints import check_first_pose
 from .inputs import input_table as _input_table
-from .prepared import prepared
+from .prepared import model_and_prepared
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
 
@@ -59,6 +59,11 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     mechanism, a short sweep); True compiles it
     (unless the kernel is too large for the compiler to be worth waiting for), False runs it
     in CasADi's virtual machine.
+
+    One rule decides whether the fast pass runs compiled: unless `compile` is False, a compiled
+    library of its kernel is used as soon as it exists (in the cache, or loaded by this
+    process, whichever option built it); `Sweep.info["fast pass"]` says which ran: "compiled",
+    "virtual machine", or None where every pose was solved on the careful path.
 
     Each solved pose gets a flag where it sits at or next to a singular position ("limit",
     "change point", "singular"); `Sweep.events` lists those positions with their input values
@@ -99,10 +104,10 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     >>> sw.ok.all(), round(float(sw["C.x"][0]), 12), round(float(sw["C.x"][180]), 12)
     (np.True_, 3.041666666667, 1.825)
     """
-    model = _model_of(m)
+    # the model and the parameter values, size, guess, input keys: once per mechanism
+    model, pm = model_and_prepared(m, _model_of)
     report = list(default_report(m) if report is None else report)
     model.quantity_function(tuple(report))  # unknown names fail here, before any solving
-    pm = prepared(model, m)  # parameter values, size, guess, input keys: once per mechanism
     U = _input_table(m, inputs, "inputs", None, pm.keys)
     n = U.shape[0]
     Ud = np.broadcast_to(_input_table(m, rates, "rates", 1.0, pm.keys), U.shape)
@@ -130,15 +135,17 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     else:
         raise ModelError(f"method: {method!r} is neither \"fast\" nor \"careful\"")
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
-    if ok.any():  # gear centre distances at the first solved pose
+    every = bool(ok.all())
+    if m.gears and ok.any():  # gear centre distances at the first solved pose
         check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
-    if ok.all():
+    if every:
         status = np.empty(n, dtype=object)  # (np.full of an object is ten times slower)
         status.fill("ok")
     else:
-        status = ["ok" if s else NO_ASSEMBLY for s in ok]
+        status = np.array(["ok" if s else NO_ASSEMBLY for s in ok], dtype=object)
     flags = [None] * n
-    events += unlabelled_resumes(model, U, p, L, Q, ok, events)  # after gaps the fast pass crossed
+    if not every:  # after gaps the fast pass crossed (none where every pose is solved)
+        events += unlabelled_resumes(model, U, p, L, Q, ok, events)
     found, at = _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma,
                                  getattr(run, "crossed", ()))
     events += found
@@ -152,7 +159,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
             got = np.asarray(f(Q[ok].T, U[ok].T, rep, Ud[ok].T, Udd[ok].T, Uddd[ok].T))
             values = np.array(values, dtype=float)
             values[np.ix_(third, np.flatnonzero(ok))] = got
-    null_derivatives(model, report, values, Q, U, p, at)  # no wrong number at a singular pose
+    if at.any():  # no wrong number at a singular pose
+        null_derivatives(model, report, values, Q, U, p, at)
     keys = pm.keys
     events.sort(key=lambda e: e["pose"])
     for e in events:
@@ -163,7 +171,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
                  status=status, flags=flags,
                  values={nm: values[i] for i, nm in enumerate(report)},
                  q=Q, residual=res, iterations=its,
-                 unknowns=[nm for nm, _ in model.sym.unknowns], size=L, events=events)
+                 unknowns=[nm for nm, _ in model.sym.unknowns], size=L, events=events,
+                 info={"fast pass": getattr(run, "backend", None)})
 
 
 class _CarefulRun:

@@ -115,6 +115,7 @@ class FastRun:
         self.values, self.measures = block[o[4]:o[5]].reshape(no, n), block[o[5]:o[6]].reshape(nm, n)
         self.accepted, self.solved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
         self.first_bad, self._s, self._addr = 0, None, None
+        self.backend = None  # "compiled" or "virtual machine": what `advance` ran last
 
     residual = property(lambda self: self.info[0], doc="max |g| / L at each pose (L: each group's)")
     step = property(lambda self: self.info[1], doc="the last Newton step (negligible, applied)")
@@ -137,6 +138,7 @@ class FastRun:
             self._s = sw.state(q_last, u_last, self.p, out=self._state)
         s = self._s  # the C loop leaves the last accepted pose's state in it
         lib = sw.backend.compiled(self.n)
+        self.backend = "virtual machine" if lib is None else "compiled"
         if lib is not None:
             if self._addr is None:  # addresses of the run's block and of its inputs
                 self._addr = (ptr(self._block), ptr(self.U), ptr(self.p), ptr(self.Ud[0]), ptr(self.Udd[0]))
@@ -211,12 +213,13 @@ class FastSweeper:
 
     @property
     def functions(self) -> list[ca.Function]:
-        """kP, kN, kF (kincas/core/kernel.py), built when first needed."""
+        """kP, kN, kF, kL (kincas/core/kernel.py), built when first needed, once per model
+        and report: the sweepers of one kernel with different `compile` settings share them,
+        so they generate the same C code (the same library)."""
         if self._functions is None:
-            with self._lock:
-                if self._functions is None:
-                    self._functions = kernel_functions(self.sym, self.blocks, self.report,
-                                                       self.model.structure)
+            self._functions = self.model.memo(
+                ("kernel", self.report),
+                lambda: kernel_functions(self.sym, self.blocks, self.report, self.model.structure))
         return self._functions
 
     def _library(self) -> Library:
