@@ -16,6 +16,7 @@ one before along the exact tangent dq/du = -g_q^-1 g_u, so the branch is kept.
 """
 from __future__ import annotations
 
+import math
 
 import numpy as np
 
@@ -110,8 +111,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     model.quantity_function(tuple(report))  # unknown names fail here, before any solving
     U = _input_table(m, inputs, "inputs", None, pm.keys)
     n = U.shape[0]
-    Ud = np.broadcast_to(_input_table(m, rates, "rates", 1.0, pm.keys), U.shape)
-    Udd = np.broadcast_to(_input_table(m, accelerations, "accelerations", 0.0, pm.keys), U.shape)
+    Ud = _per_pose(m, rates, "rates", 1.0, n, pm.keys)
+    Udd = _per_pose(m, accelerations, "accelerations", 0.0, n, pm.keys)
     p, L = pm.p, pm.size
     g = pm.guess if not guess else {**pm.guess, **{k: (m.value(x), m.value(y)) for k, (x, y) in dict(guess).items()}}
     events = []
@@ -173,6 +174,25 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
                  q=Q, residual=res, iterations=its,
                  unknowns=[nm for nm, _ in model.sym.unknowns], size=L, events=events,
                  info={"fast pass": getattr(run, "backend", None)})
+
+
+def _per_pose(m, values, what: str, default: float, n: int, keys) -> np.ndarray:
+    """The (n, nu) table of the inputs' rates or accelerations (`input_table`), written out
+    (`np.broadcast_to` costs more than filling a few thousand numbers, and a short sweep
+    pays every microsecond): the usual cases, none given or one number for the one input,
+    without building a table first."""
+    if values is None:
+        return np.full((n, len(keys)), default)
+    if len(keys) == 1 and type(values) is dict and len(values) == 1:
+        v = values.get(keys[0])
+        if type(v) is float and math.isfinite(v) or type(v) is int:
+            return np.full((n, 1), float(v))
+    T = _input_table(m, values, what, default, keys)
+    if T.shape[0] == n:
+        return T
+    out = np.empty((n, T.shape[1]))
+    out[:] = T  # (ValueError for any other number of rows, as broadcasting gives)
+    return out
 
 
 class _CarefulRun:

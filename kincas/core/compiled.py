@@ -296,8 +296,9 @@ class Backend:
 
 
 def ptr(a: np.ndarray, offset: int = 0) -> int:
-    """The address of a float64 array's element `offset` (C order)."""
-    return a.ctypes.data + 8 * offset
+    """The address of a float64 array's element `offset` (C order). (From the array
+    interface: `a.ctypes.data` builds a ctypes object per call, about twice the time.)"""
+    return a.__array_interface__["data"][0] + 8 * offset
 
 
 def table(a, width: int) -> np.ndarray:

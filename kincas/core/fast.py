@@ -114,14 +114,14 @@ class FastRun:
         self.Q, self.info = block[o[2]:o[3]].reshape(n, nq), block[o[3]:o[4]].reshape(5, n)
         self.values, self.measures = block[o[4]:o[5]].reshape(no, n), block[o[5]:o[6]].reshape(nm, n)
         self.accepted, self.solved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
-        self.first_bad, self._s, self._addr = 0, None, None
+        self.first_bad, self._s, self._addr, self.recorded = 0, None, None, 0
         self.backend = None  # "compiled" or "virtual machine": what `advance` ran last
 
     residual = property(lambda self: self.info[0], doc="max |g| / L at each pose (L: each group's)")
     step = property(lambda self: self.info[1], doc="the last Newton step (negligible, applied)")
     jac_change = property(lambda self: self.info[2], doc="max per group of sum |D^-1 (A_prev^-1 A - I) D|")
     correction = property(lambda self: self.info[3], doc="max per group of ||D^-1 (q - q_pred)||_1")
-    iterations = property(lambda self: np.where(np.isnan(self.info[4]), 0.0, self.info[4]).astype(int),
+    iterations = property(lambda self: np.fmax(self.info[4], 0.0).astype(int),  # fmax: NaN -> 0
                           doc="Newton steps taken at each pose (0 where none was attempted)")
     signs = property(lambda self: self.measures[:-1].T, doc="(N, groups) signs of det per group")
     sigma = property(lambda self: self.measures[-1], doc="smallest relative singular value bound")
@@ -158,6 +158,7 @@ class FastRun:
 
     def record(self, k: int, sol) -> None:
         """Store a carefully solved pose (an object with q, residual, iterations, ok, J)."""
+        self.recorded += 1
         self.solved[k] = bool(sol.ok)
         self.Q[k], self.values[:, k] = (sol.q if sol.ok else np.nan), np.nan  # values: see sweep
         self.measures[:, k] = self.sweeper.measures(sol, self.U[k], self.p, self.L[0]) if sol.ok else np.nan
@@ -181,6 +182,10 @@ class FastSweeper:
         self.nq, self.nu, self.max_evals = model.sym.nq, model.sym.nu, int(max_evals)
         model.quantity_function(self.report)  # names checked here
         self.blocks = _model_blocks(model)
+        self._group_of = np.full(self.nq, len(self.blocks), dtype=np.intp)  # each unknown's group
+        for i, b in enumerate(self.blocks):
+            self._group_of[np.asarray(b.cols, dtype=np.intp)] = i
+        self._one_group = len(self.blocks) == 1 and not self._group_of.any()
         self.nj = diagonal_size(self.blocks)  # g_q's diagonal blocks, all the state keeps of it
         self.state_size = self.nq + self.nj + 2 * (self.nq * self.nu + self.nu)
         self._functions, self._size, self._poses = None, None, 0  # _poses: swept so far
@@ -322,8 +327,8 @@ class FastSweeper:
             else:
                 last, k, going = (k if sol.ok else last), k + 1, False
             tick(k - 1, k)
-        slow = np.flatnonzero(r.solved & ~r.accepted)
-        if self.report and slow.size:
+        slow = np.flatnonzero(r.solved & ~r.accepted) if r.recorded and self.report else ()
+        if len(slow):
             ev = evaluator_for(self.model, self.report)
             r.values[:, slow] = ev.evaluate(r.Q[slow], r.U[slow], r.p, _take(r.Ud, slow), _take(r.Udd, slow))
         if progress is not None:
@@ -349,16 +354,21 @@ class FastSweeper:
         if placed.kernel is None:  # the state at q0 and its groups' signs, once per placement
             s = self.state(q0, r.U[k], r.p)
             s.flags.writeable = False
-            placed.kernel = s, _diagonal_signs(s[self.nq:self.nq + self.nj], self.blocks)
-        s, before = placed.kernel
+            before = _diagonal_signs(s[self.nq:self.nq + self.nj], self.blocks)
+            placed.kernel = s, before.tolist(), bool((before != 0).all()), 1.0 / qs
+        s, before, regular, inv_qs = placed.kernel
+        if not regular:  # a group singular at q0: its mode is not the guess's to choose
+            r._s = None
+            return k
         r._state[:] = s
         r._s = r._state
         bad = r.advance(k, None, None, stop)
-        if bad > k:
-            after = r.measures[:len(self.blocks), k]
-            dq = np.abs(r.Q[k] - q0) / qs
-            moved = [float(dq[b.cols].sum()) for b in self.blocks]
-            if (before != 0).all() and (before == after).all() and max(moved, default=0.0) <= CORRECTION:
+        if bad > k and r.measures[:len(self.blocks), k].tolist() == before:
+            # each group's sum of |q - q0| / qs over its own unknowns
+            dq = np.abs(r.Q[k] - q0) * inv_qs
+            moved = (float(dq.sum()) if self._one_group else
+                     np.bincount(self._group_of, dq, len(self.blocks) + 1)[:-1].max(initial=0.0))
+            if moved <= CORRECTION:
                 return bad
         r._s = None  # nothing of this attempt is kept: the careful path starts afresh
         r.Q[k:bad + 1] = r.values[:, k:bad + 1] = r.measures[:, k:bad + 1] = np.nan
