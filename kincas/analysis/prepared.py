@@ -30,6 +30,7 @@ from collections import OrderedDict
 import numpy as np
 
 from ..core.assembly import Placement, ambiguous, assemble
+from ..core.fast import sweeper_for
 from ..model.mechanism import Mechanism
 
 RECENT = 32  # mechanisms kept per structure
@@ -55,6 +56,23 @@ class Prepared:
         self.plain = not (m.gears or m.racks)
         self._places: OrderedDict = OrderedDict()
         self._lock = threading.Lock()
+        self._sweepers: dict = {}  # (report, compile) -> FastSweeper
+        self._names: set = set()  # reports whose names were checked
+
+    def sweeper(self, model, report: tuple, compile):
+        """The model's `FastSweeper` for `report` and `compile` (`sweeper_for`), found here
+        without the model's lock once looked up (unknown names raise ModelError, every time)."""
+        fast = self._sweepers.get((report, compile))
+        if fast is None:
+            fast = self._sweepers[(report, compile)] = sweeper_for(model, report, compile)
+        return fast
+
+    def check_report(self, model, report: tuple) -> None:
+        """ModelError for a quantity name the model does not know (`Model.quantity_function`),
+        each list of names looked up once."""
+        if report not in self._names:
+            model.quantity_function(report)
+            self._names.add(report)
 
     def placement(self, model, u: np.ndarray, guess: dict):
         """A `Placement` (q0, qs): the first pose's unknowns placed at inputs u from `guess`
@@ -63,7 +81,8 @@ class Prepared:
         assembly found group by group). Computed once per inputs and guess."""
         if not self.plain or model.nq == 0:
             return None
-        key = (np.asarray(u, float).tobytes(), tuple(sorted(guess.items())))
+        key = (np.asarray(u, float).tobytes(),
+               None if guess is self.guess else tuple(sorted(guess.items())))  # (the usual case)
         with self._lock:
             if key in self._places:
                 self._places.move_to_end(key)

@@ -21,7 +21,6 @@ import math
 import numpy as np
 
 from ..errors import ModelError
-from ..core.fast import sweeper_for
 from ..model.mechanism import Mechanism
 from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
@@ -108,7 +107,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     # the model and the parameter values, size, guess, input keys: once per mechanism
     model, pm = model_and_prepared(m, _model_of)
     report = list(default_report(m) if report is None else report)
-    model.quantity_function(tuple(report))  # unknown names fail here, before any solving
+    names = tuple(report)
+    pm.check_report(model, names)  # unknown names fail here, before any solving
     U = _input_table(m, inputs, "inputs", None, pm.keys)
     n = U.shape[0]
     Ud = _per_pose(m, rates, "rates", 1.0, n, pm.keys)
@@ -128,7 +128,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     # The fast pass (compiled, checked pose by pose) solves what it can; every pose it does
     # not accept goes to the careful path above, and the fast pass restarts after it.
     # (a tall system, with redundant joints, has no compiled pass: its g_q is not square)
-    fast = sweeper_for(model, tuple(report), compile) if method == "fast" and model.square else None
+    fast = pm.sweeper(model, names, compile) if method == "fast" and model.square else None
     if fast is not None and (compile is False or fast.worth_it(n)):
         run = fast.sweep(U, p, L, careful, Ud=Ud, Udd=Udd, progress=progress, first=first)
     elif method in ("fast", "careful"):  # "fast" for a kernel too large to pay for itself
@@ -167,8 +167,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     for e in events:
         e.setdefault("inputs", {kk: float(U[e["pose"], j]) for j, kk in enumerate(keys)})
     return Sweep(inputs={k: U[:, j].copy() for j, k in enumerate(keys)},
-                 rates={k: Ud[:, j].copy() for j, k in enumerate(keys)},
-                 accelerations={k: Udd[:, j].copy() for j, k in enumerate(keys)},
+                 rates={k: Ud[:, j] for j, k in enumerate(keys)},  # (tables of this call's own)
+                 accelerations={k: Udd[:, j] for j, k in enumerate(keys)},
                  status=status, flags=flags,
                  values={nm: values[i] for i, nm in enumerate(report)},
                  q=Q, residual=res, iterations=its,
@@ -177,7 +177,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 
 
 def _per_pose(m, values, what: str, default: float, n: int, keys) -> np.ndarray:
-    """The (n, nu) table of the inputs' rates or accelerations (`input_table`), written out
+    """The (n, nu) table of the inputs' rates or accelerations (`input_table`), a new array
     (`np.broadcast_to` costs more than filling a few thousand numbers, and a short sweep
     pays every microsecond): the usual cases, none given or one number for the one input,
     without building a table first."""
@@ -189,7 +189,7 @@ def _per_pose(m, values, what: str, default: float, n: int, keys) -> np.ndarray:
             return np.full((n, 1), float(v))
     T = _input_table(m, values, what, default, keys)
     if T.shape[0] == n:
-        return T
+        return np.array(T, dtype=float)  # (a copy: the user's array stays theirs)
     out = np.empty((n, T.shape[1]))
     out[:] = T  # (ValueError for any other number of rows, as broadcasting gives)
     return out

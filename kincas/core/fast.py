@@ -74,6 +74,7 @@ VM_FLAT = 64
 BACKGROUND_POSES = 20_000
 INFO = ("residual", "step", "jac_change", "correction", "steps")
 BLOCK = 65536  # poses per call when a progress callback wants news
+_HEAD = np.array([np.nan, RESIDUAL, STEP, JAC_CHANGE, CORRECTION, NEAR])  # L, then thresholds
 _I, _V = ctypes.c_longlong, ctypes.c_void_p
 # kincas_sweep's C signature (SWEEP_C): every library that links the loop declares it so
 SWEEP_SIG = [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V, _V]
@@ -109,7 +110,8 @@ class FastRun:
         no, nm = len(sweeper.report), len(sweeper.blocks) + 1
         o = self._off = list(accumulate([0, 6, sweeper.state_size, n * nq, 5 * n, no * n, nm * n]))
         block = self._block = np.empty(o[-1])
-        block[:6] = float(L), RESIDUAL, STEP, JAC_CHANGE, CORRECTION, NEAR
+        block[:6] = _HEAD  # the thresholds, then L in its place
+        block[0] = L
         self.L, self.thr, self._state = block[0:1], block[1:6], block[o[1]:o[2]]
         self.Q, self.info = block[o[2]:o[3]].reshape(n, nq), block[o[3]:o[4]].reshape(5, n)
         self.values, self.measures = block[o[4]:o[5]].reshape(no, n), block[o[5]:o[6]].reshape(nm, n)
