@@ -39,6 +39,7 @@ import numpy as np
 from ..errors import ModelError, SceneError
 from ..model.mechanism import Mechanism
 from ..results import wrap_angle
+from ..core.turns import tied, turns
 from ..core.assembly import first_pose
 from ..core.scatter import newton_starts
 from ..core.numeric import model_of
@@ -134,6 +135,8 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
     # The mechanism's own guess is start 0, so the mode a sweep would take is always found.
     guess = {k: (m_at.value(x), m_at.value(y)) for k, (x, y) in m.guess}
     Q = np.vstack([model.initial_q(u, p, guess, L), _scatter(m_at, model, starts - 1, L, seed)])
+    if tied(model).any():  # gears, racks: each start at the turns their relations want
+        Q = np.array([turns(model, q, u, p) for q in Q])
     Q, r = newton_starts(model, Q, u, p, iterations)
     Q = Q[np.isfinite(r) & (r <= CONVERGED)]
     Q = Q[_unique(_point_rows(model, Q, u, p), 10 * SAME * L)]  # many starts, few modes

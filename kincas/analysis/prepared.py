@@ -2,7 +2,7 @@
 
 A `Mechanism` is an immutable value, so its parameter values, its size and its guessed
 points never change, and neither does the first pose's *placement*: the unknowns that
-`Model.initial_q` builds from the guessed points at given inputs (or, without a guess, the
+`guessed_start` builds from the guessed points at given inputs (or, without a guess, the
 pose assembled group by group in the default modes). Repeated sweeps of one mechanism (the
 usual case: a user, a benchmark or an optimiser calling `kincas.sweep` again) read them here
 instead of recomputing them. The table belongs to the structure's `Model` (`Model.memo`),
@@ -19,7 +19,7 @@ and is guarded by a lock: nothing here is global, and threads share only immutab
 >>> pm is prepared(model, m), pm.size, pm.keys
 (True, 4.0, ('crank.angle',))
 >>> q0 = pm.placement(model, np.array([0.0]), pm.guess).q0
->>> bool(np.allclose(q0, model.initial_q(np.array([0.0]), pm.p, pm.guess, 4.0)))
+>>> bool(np.allclose(q0, guessed_start(model, np.array([0.0]), pm.p, 4.0, pm.guess)))
 True
 """
 from __future__ import annotations
@@ -31,6 +31,7 @@ import numpy as np
 
 from ..core.assembly import Placement, ambiguous, assemble
 from ..core.fast import sweeper_for
+from ..core.guessed import guessed_start
 from ..model.mechanism import Mechanism
 
 RECENT = 32  # mechanisms kept per structure
@@ -51,8 +52,8 @@ class Prepared:
         self.size = m.size()
         self.keys = tuple(i.key for i in m.inputs)
         self.guess = {k: (m.value(x), m.value(y)) for k, (x, y) in dict(m.guess).items()}
-        # gears and racks wrap their angles at the first pose (core/joints.settle_first):
-        # that pose stays on the careful path
+        # gears and racks: the first pose's free angles are taken into (-pi, pi] after Newton
+        # (core/turns.settle): that pose stays on the careful path
         self.plain = not (m.gears or m.racks)
         self._places: OrderedDict = OrderedDict()
         self._lock = threading.Lock()
@@ -89,7 +90,7 @@ class Prepared:
                 return self._places[key]
         u = np.array(u, float)
         if guess:
-            q0 = model.initial_q(u, self.p, guess, self.size)
+            q0 = guessed_start(model, u, self.p, self.size, guess)
         elif not ambiguous(model):  # no guess: the careful path assembles group by group
             sol = assemble(model, u, self.p, self.size)
             q0 = None if sol is None else sol.q

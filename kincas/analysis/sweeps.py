@@ -25,6 +25,7 @@ from ..model.mechanism import Mechanism
 from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
 from ..core.symbolic import default_report, needs_jerk
+from .choice import choose_assembly
 from .continuation import careful_pose
 from .resume import unlabelled_resumes
 from .events import null_derivatives
@@ -68,6 +69,9 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     Each solved pose gets a flag where it sits at or next to a singular position ("limit",
     "change point", "singular"); `Sweep.events` lists those positions with their input values
     located exactly, and where a sweep resumed after poses with no assembly, on which branch.
+    Without any guess, where the default assembly loses poses that another assembly of the
+    first pose keeps, the sweep runs on that one and an "assembly" event says which and why
+    (kincas/analysis/choice.py); a guess is always obeyed.
 
     Parameters
     ----------
@@ -166,14 +170,21 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     events.sort(key=lambda e: e["pose"])
     for e in events:
         e.setdefault("inputs", {kk: float(U[e["pose"], j]) for j, kk in enumerate(keys)})
-    return Sweep(inputs={k: U[:, j].copy() for j, k in enumerate(keys)},
-                 rates={k: Ud[:, j] for j, k in enumerate(keys)},  # (tables of this call's own)
-                 accelerations={k: Udd[:, j] for j, k in enumerate(keys)},
-                 status=status, flags=flags,
-                 values={nm: values[i] for i, nm in enumerate(report)},
-                 q=Q, residual=res, iterations=its,
-                 unknowns=[nm for nm, _ in model.sym.unknowns], size=L, events=events,
-                 info={"fast pass": getattr(run, "backend", None)})
+    out = Sweep(inputs={k: U[:, j].copy() for j, k in enumerate(keys)},
+                rates={k: Ud[:, j] for j, k in enumerate(keys)},  # (tables of this call's own)
+                accelerations={k: Udd[:, j] for j, k in enumerate(keys)},
+                status=status, flags=flags,
+                values={nm: values[i] for i, nm in enumerate(report)},
+                q=Q, residual=res, iterations=its,
+                unknowns=[nm for nm, _ in model.sym.unknowns], size=L, events=events,
+                info={"fast pass": getattr(run, "backend", None)})
+    if g or every:
+        return out  # the guess picks the assembly, whatever poses its branch loses
+    # no guess: where the default assembly loses poses, one of the first pose's others that
+    # runs them all (kincas/analysis/choice.py), said in an "assembly" event
+    rerun = lambda guess: sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
+                                guess=guess, progress=progress, method=method, compile=compile, jerks=jerks)
+    return choose_assembly(model, m, U, p, L, out, rerun) or out
 
 
 def _per_pose(m, values, what: str, default: float, n: int, keys) -> np.ndarray:

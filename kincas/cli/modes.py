@@ -31,6 +31,8 @@ def cli_run(args) -> int:
     sc = load(args.scene)
     at = {k: float(v[0]) for k, v in sc.study.inputs.items()}
     modes = find_modes(sc.mechanism, at, starts=args.starts, seed=args.seed)
+    if not sc.mechanism.guess and modes:
+        modes = _solve_starts_on(sc, modes)
     deg = sc.study.deg
     user_in = {k: (math.degrees(v) if deg and k.endswith(".angle") else v) for k, v in at.items()}
     user_ang = [{lk: (math.degrees(a) if deg else a) for lk, a in md.angles.items()} for md in modes]
@@ -60,13 +62,29 @@ def _print_modes(sc, modes, user_in, user_ang, args):
     print(f"{n} assembly mode{'s' if n != 1 else ''}" + (f" at {at}" if at else "")
           + f" ({args.starts} starts, seed {args.seed})")
     for k, (md, ang) in enumerate(zip(modes, user_ang), 1):
-        mark = "  <- the scene's [guess] gives this one" if md.from_guess else ""
+        mark = "" if not md.from_guess else ("  <- the scene's [guess] gives this one" if sc.mechanism.guess
+                                             else "  <- `kincas solve` starts on this one (no [guess])")
         print(f"\nmode {k} of {n}: residual {md.residual:.1e}, orientation {md.orientation:+d}{mark}")
         print("  angles: " + ", ".join(f"{lk} {a:.6g}" for lk, a in ang.items())
               + f" {units.get('angle', 'deg')}")
         print(md.guess_block(), end="")
     if not modes:
         print("no assembly found: the mechanism cannot be put together at this input")
+
+
+def _solve_starts_on(sc, modes):
+    """Without [guess], the sweep may leave the default assembly for one that runs every
+    pose (an "assembly" event, kincas/analysis/choice.py): that one is marked instead."""
+    from dataclasses import replace
+
+    from ..frames import Modes
+    chosen = next((e for e in sc.run().events if e["kind"] == "assembly"), None)
+    if chosen is None:
+        return modes
+    size = sc.mechanism.size()
+    same = lambda md: all(max(abs(a - b) for a, b in zip(md.points[pt], xy)) <= 1e-6 * size
+                          for pt, xy in chosen["guess"].items())
+    return Modes(replace(md, from_guess=same(md)) for md in modes)
 
 
 def _write_scenes(path, directory, modes) -> list[Path]:

@@ -114,6 +114,10 @@ def _table(sc, sw, inputs, values):
         e = _user_event(sc, e)
         at = ", ".join(f"{k} = {v:.12g}" for k, v in e["inputs"].items())
         what = label_text(e) if e["kind"] == "resume" else e["kind"]
+        if e["kind"] == "assembly":  # the assembly a sweep without [guess] chose, and why
+            pts = ", ".join(f"{pt} = [{x:.12g}, {y:.12g}]" for pt, (x, y) in e["guess"].items())
+            print(f"pose {e['pose']}: assembly chosen at {at}: {e['reason']} ({pts})")
+            continue
         print(f"pose {e['pose']}: {what} at {at}")
     bad = sum(s != "ok" for s in sw.status)
     print(f"{len(sw)} poses, {len(sw) - bad} solved" + (f", {bad} not solved" if bad else ""))

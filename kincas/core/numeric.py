@@ -272,11 +272,15 @@ class Model:
         return np.asarray(self.sym.f_points(q, u, p))
 
     # --- the first pose: from the user's guess ---
-    def initial_q(self, u, p, guess: dict[str, tuple[float, float]], L: float) -> np.ndarray:
+    def initial_q(self, u, p, guess: dict[str, tuple[float, float]], L: float,
+                  turn: dict | None = None, free: list | None = None) -> np.ndarray:
         """Unknowns placed from guessed points, walking the spanning tree from the ground.
 
         A link hanging on point P takes the angle that points it at another of its points
-        whose position is guessed (or already known); with none, angle 0.
+        whose position is guessed (or already known); with none, angle 0, or `turn[link]`
+        where given. The links so left free of the guess (their angle an unknown, no input
+        turning them) are appended to `free` where given: kincas/core/guessed.py tries
+        them in several turns, so that the guessed points decide their assembly.
         """
         m, sym = self.sym.mech, self.sym
         loc_flat, gflat = (a.ravel() for a in self._geometry(u, p))
@@ -293,6 +297,7 @@ class Model:
         angle_in = {i.target: u[k] for k, i in enumerate(m.inputs) if i.kind == "angle"}
         centre = np.mean(list(gv.values()), axis=0) if gv else np.zeros(2)
         theta = {"ground": 0.0}  # angles placed so far (a relative input starts from them)
+        turn = turn or {}
         for lname, at in m.structure.order:
             pts = [pt for pt, _ in m.link(lname).points]
             ref = [pt for pt in pts if pt in guessed or pt in known]
@@ -300,7 +305,7 @@ class Model:
             if at is not None:
                 anchor = guessed.get(at, known[at])
                 others = [pt for pt in ref if pt != at]
-                th = 0.0
+                th, unset = turn.get(lname, 0.0), not others
                 if others:
                     d = pos[others[0]] - anchor
                     dl = loc[(lname, others[0])] - loc[(lname, at)]
@@ -310,7 +315,7 @@ class Model:
                 R = np.array([[c, -s], [s, c]])
                 origin = known[at] - R @ loc[(lname, at)]
             else:
-                th = 0.0
+                th, unset = turn.get(lname, 0.0), len(ref) < 2
                 if len(ref) >= 2:
                     d, dl = pos[ref[1]] - pos[ref[0]], loc[(lname, ref[1])] - loc[(lname, ref[0])]
                     th = math.atan2(d[1], d[0]) - math.atan2(dl[1], dl[0])
@@ -321,6 +326,8 @@ class Model:
                 q[index[f"{lname}.x"]], q[index[f"{lname}.y"]] = origin
             if f"{lname}.angle" in index:
                 q[index[f"{lname}.angle"]] = th
+                if unset and free is not None and th == turn.get(lname, 0.0):  # no input turned it
+                    free.append(lname)
             theta[lname] = th
             for pt in pts:
                 known.setdefault(pt, origin + R @ loc[(lname, pt)])

@@ -22,3 +22,7 @@ BRANCH = 1e-8  # |det| of the column-scaled g_q below this: too close to singula
 RANK = 1e-8  # a scaled singular value below this times the largest counts as zero
 RANK_GAP = 1e-4  # g_q's smallest scaled singular value above this times the largest: a regular assembly
 SAME_ASSEMBLY = 1e-6  # assemblies closer than this (scaled) are one (the redundant-joint test)
+FREE_LINKS = 6  # links left free by a guess that are tried in several turns (core/guessed.py), at most
+NEARER = 1e-9  # another start's assembly is nearer the guessed points when its cost is below (1 - this) times
+CHOICE_STARTS = 128  # scattered starts finding a guessless sweep's other assemblies (analysis/choice.py)
+CHOICE_TRIES = 8  # of which at most this many are swept

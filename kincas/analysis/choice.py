@@ -1,0 +1,84 @@
+"""A sweep without a guess: among the first pose's assemblies, one that runs the whole sweep.
+
+With no `[guess]`, the first pose is assembled in the default modes (kincas/core/assembly.py).
+That assembly may lose poses another one keeps: the Whitworth quick return's lever pointing
+away from its fixed pin lifts D out of the rod's reach for 11 of 73 poses, while with the
+lever towards the pin every pose assembles. So where the default fails poses, and each of
+them has some assembly (asked of `first_pose` without a guess: for dyads and small groups at
+every lost pose, which group by group assembly decides without doubt; for larger groups, whose
+search may end in IPOPT, at the first and the middle pose of each gap), the first pose's other
+assemblies are found (`find_modes`) and swept from their points, fewest groups changed first,
+until one solves every pose. That one is returned with an `"assembly"` event naming it (its points, ready as a
+`[guess]`; the groups whose mode differs from the default) and why; where none does, the
+default stands. A user's guess is never overridden: this runs only without one.
+
+>>> import numpy as np, kincas
+>>> m = kincas.Mechanism(ground={"O": (0, 0), "A": (0, -20)},
+...     links=[kincas.Link.bar("crank", "O", "B", 40), kincas.Link.bar("lever", "B", "D", 100),
+...            kincas.Link.bar("rod", "D", "E", 150)],
+...     slides=[kincas.Slide("A", "lever", name="slot"),
+...             kincas.Slide("E", "ground", through=(0, -20), name="ram")],
+...     inputs=[kincas.Input.angle("crank")])
+>>> sw = kincas.sweep(m, {"crank.angle": np.radians(np.arange(0, 361, 5))}, report=["E.x"])
+>>> bool(sw.ok.all()), [e["kind"] for e in sw.events if e["kind"] == "assembly"]
+(True, ['assembly'])
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.assembly import ambiguous, first_pose, group_links, modes
+from ..core.tolerances import CHOICE_STARTS, CHOICE_TRIES
+from ..errors import ModelError
+
+
+def _unreachable(model, U, p, L, ok) -> bool:
+    """Whether some pose the default lost has no assembly in any mode. For dyads and small
+    groups every lost pose is asked (group by group assembly decides it, cheaply); where a
+    larger group makes that a search (with IPOPT), the first and the middle pose of each gap."""
+    bad = np.flatnonzero(~ok)
+    if ambiguous(model):
+        gaps = np.split(bad, np.flatnonzero(np.diff(bad) > 1) + 1)
+        bad = sorted({int(g[0]) for g in gaps} | {int(g[len(g) // 2]) for g in gaps})
+    return any(not first_pose(model, U[k], p, L, {}).ok for k in bad)
+
+
+def choose_assembly(model, m, U, p, L, default, rerun):
+    """`default` (a Sweep from the default modes, no guess) or, where it fails poses, the
+    sweep `rerun(guess)` from the first of the first pose's other assemblies that solves
+    every pose, with an "assembly" event; None to keep the default."""
+    ok, n = np.asarray(default.ok), len(default)
+    if ok.all() or not ok[0] or model.nq == 0:
+        return None
+    if _unreachable(model, U, p, L, ok):
+        return None  # some pose has no assembly at all: none runs the whole sweep
+    from .modes import find_modes
+    u0 = U[0]
+    try:
+        found = find_modes(m, {i.key: float(v) for i, v in zip(m.inputs, u0)}, starts=CHOICE_STARTS)
+    except ModelError:  # the search is a courtesy: where it cannot be posed, the default stands
+        return None
+    sign0 = modes(model, model.jac(default.q[0], u0, p), L)[0]
+    pts0 = model.points(default.q[0], u0, p).T.ravel()
+    names = group_links(model)
+    others = []
+    for k, md in enumerate(found):
+        pts = np.ravel([md.points[nm] for nm in m.moving_points])
+        if np.abs(pts - pts0).max() <= 1e-6 * L:
+            continue  # the default itself
+        changed = np.flatnonzero(modes(model, model.jac(md.q, u0, p), L)[0] != sign0)
+        others.append((len(changed), k, md, changed))
+    others.sort(key=lambda t: t[:2])
+    for _, _, md, changed in others[:CHOICE_TRIES]:
+        sw = rerun(md.guess)
+        if np.asarray(sw.ok).all():
+            groups = [names[i] for i in changed]
+            which = (", ".join("[" + ", ".join(g) + "]" for g in groups) + " in the other mode"
+                     if groups else "another assembly of the same modes")
+            reason = (f"no [guess], and the default assembly fails {int((~ok).sum())} of {n} poses; "
+                      f"this one (group {which}) solves all {n}; to keep it, give its points as [guess]")
+            sw.events.insert(0, {"kind": "assembly", "pose": 0, "poses": n, "groups": groups,
+                                 "guess": dict(md.guess), "reason": reason,
+                                 "inputs": {i.key: float(v) for i, v in zip(m.inputs, u0)}})
+            return sw
+    return None
