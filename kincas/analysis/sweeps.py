@@ -28,7 +28,7 @@ from ..core.symbolic import default_report, needs_jerk
 from .choice import choose_assembly
 from .continuation import careful_pose
 from .resume import unlabelled_resumes
-from .events import null_derivatives
+from .events import null_derivatives, sweep_events
 from ..core.joints import check_first_pose
 from .inputs import input_table as _input_table
 from .prepared import model_and_prepared
@@ -320,5 +320,4 @@ def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, signs, s
     of a group's scaled block, so only the few poses where it is small, and the ends of a
     change of a group's sign, get exact per-group measures.
     """
-    from .events import sweep_events
     return sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed)
