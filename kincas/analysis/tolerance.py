@@ -255,6 +255,7 @@ class _Samples:
     to: list
 
     def __call__(self, X):
+        from ..core.cancel import checkpoint
         from ..core.numeric import compile
         from .designs import sweep_designs
 
@@ -276,6 +277,7 @@ class _Samples:
             todo = [(a, b, np.arange(n_s)) for a, b in zip(edges[::2], edges[1::2])]
         restarts = 0
         while todo:
+            checkpoint()  # Ctrl-C (kincas/core/cancel.py)
             a, b, idx = todo.pop()
             pts = model.points(sw.q[a], U[a], p0)
             guess = {nm: tuple(pts[:, j]) for j, nm in enumerate(m.moving_points)}

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import OutputError, SceneError
+from .atomic import open_replacing
 from ..synthesis.cam_design import Segment, design_cam
 
 FIELDS = {"base_radius", "roller_radius", "offset", "samples", "segments", "name", "body", "follower"}
@@ -115,7 +116,8 @@ def cli_run(args) -> int:
     unit = "deg" if deg else "rad"
     if args.out:
         try:
-            Path(args.out).write_text(profile_toml(d, names, deg, path.name), encoding="utf-8")
+            with open_replacing(args.out, "w", encoding="utf-8") as f:  # whole or not at all
+                f.write(profile_toml(d, names, deg, path.name))
         except OSError as e:
             raise OutputError(f"--out: cannot write {args.out!r}: {e.strerror or e}") from None
     if args.csv:
@@ -126,7 +128,7 @@ def cli_run(args) -> int:
                 "profile_x": d.profile[:, 0], "profile_y": d.profile[:, 1],
                 f"profile_angle [{unit}]": _user(phi, deg), "profile_radius": np.hypot(*d.profile.T)}
         try:
-            with open(args.csv, "w", newline="", encoding="utf-8") as f:
+            with open_replacing(args.csv, "w", newline="", encoding="utf-8") as f:
                 w = csv.writer(f)
                 w.writerow(cols)
                 w.writerows(zip(*[np.asarray(v).tolist() for v in cols.values()]))

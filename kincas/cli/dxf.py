@@ -97,4 +97,7 @@ def dxf_document(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=N
 
 def write_dxf(path, m: Mechanism, sweep: Sweep, pose: int | None = None, **kw) -> None:
     """Write `dxf_document(m, sweep, pose, **kw)` to `path`."""
-    dxf_document(m, sweep, pose, **kw).saveas(str(path))
+    from .atomic import replacing
+    doc = dxf_document(m, sweep, pose, **kw)
+    with replacing(path) as tmp:
+        doc.saveas(tmp)

@@ -95,7 +95,8 @@ def html_page(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0
 
 def write_html(path, m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0) -> None:
     """Write the page to `path`."""
-    with open(path, "w", encoding="utf-8") as f:
+    from .atomic import open_replacing
+    with open_replacing(path, "w", encoding="utf-8") as f:
         f.write(html_page(m, sweep, scene, paths, dense))
 
 

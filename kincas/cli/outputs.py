@@ -77,7 +77,8 @@ def write_csv(out, sweep: Sweep, scene=None) -> None:
     Numbers are written with all their digits (shortest text that reads back the same float).
     """
     if isinstance(out, (str, bytes)) or hasattr(out, "__fspath__"):
-        with open(out, "w", newline="", encoding="utf-8") as f:
+        from .atomic import open_replacing
+        with open_replacing(out, "w", newline="", encoding="utf-8") as f:  # whole or not at all
             return write_csv(f, sweep, scene)
     inputs, values = user_columns(sweep, scene)
     values = {k: v for k, v in values.items() if k not in inputs}  # an input reported: once
@@ -236,7 +237,8 @@ def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, 
     fig.canvas.draw()  # lay the figure out once; every frame keeps that layout
     fig.set_layout_engine("none")
     writer = PillowWriter(fps=fps)
-    with writer.saving(fig, str(path), dpi):
+    from .atomic import replacing
+    with replacing(path) as tmp, writer.saving(fig, tmp, dpi):  # no half animation left
         if progress is not None:
             progress(0, len(pick))
         for k, i in enumerate(pick):  # one drawing per frame
@@ -355,7 +357,7 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
                                              _names(getattr(args, "evolute", None) or ""),
                                              _names(getattr(args, "centrodes", None) or ""))),
             ("animate", lambda p: _animate(p, m, sweep, paths, captions, length, _rendering(args))),
-            ("plot_quantities", lambda p: plot_quantities(sweep, scene=scene).savefig(p, dpi=100)),
+            ("plot_quantities", lambda p: savefig(plot_quantities(sweep, scene=scene), p, dpi=100)),
             ("html", lambda p: _html(p, m, sweep, scene, paths)),
             ("svg", lambda p: _svg(p, m, sweep, scene, pose, paths)),
             ("dxf", lambda p: _dxf(p, m, sweep, scene, pose, paths))]
@@ -411,7 +413,14 @@ def _save_drawing(path, m, sweep, pose, paths, captions, length, evolute=(), cen
     if evolute or centrodes:  # kinematic geometry over the drawing (kincas/cli/draw_geometry.py)
         from .draw_geometry import draw_geometry
         draw_geometry(ax, m, sweep, i, evolute, centrodes)
-    fig.savefig(path, dpi=100)
+    savefig(fig, path, dpi=100)
+
+
+def savefig(fig, path, **kw) -> None:
+    """`fig.savefig(path, **kw)`, the file whole or not at all (kincas/cli/atomic.py)."""
+    from .atomic import replacing
+    with replacing(path) as tmp:
+        fig.savefig(tmp, **kw)
 
 
 def _rendering(args):

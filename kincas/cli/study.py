@@ -188,19 +188,21 @@ def _has(mod) -> bool:
 
 def write(r: StudyResult, path) -> None:
     """Write the study's rows to .nc, .csv or .parquet (chosen by the suffix)."""
+    from .atomic import replacing
     path = Path(path)
     suffix = path.suffix.lower()
+    if suffix not in FORMATS:
+        raise OutputError(f"--out: {str(path)!r}: expected a file ending in {', '.join(FORMATS)}")
     try:
-        if suffix == ".csv":
-            _write_csv(r, path)
-        elif suffix == ".parquet":
-            _write_parquet(r, path)
-        elif suffix == ".nc":
-            ds = r.to_xarray()
-            engine = "netcdf4" if _has("netCDF4") else "h5netcdf" if _has("h5netcdf") else "scipy"
-            ds.to_netcdf(path, engine=engine)
-        else:
-            raise OutputError(f"--out: {str(path)!r}: expected a file ending in {', '.join(FORMATS)}")
+        with replacing(path) as tmp:  # whole or not at all (kincas/cli/atomic.py)
+            if suffix == ".csv":
+                _write_csv(r, tmp)
+            elif suffix == ".parquet":
+                _write_parquet(r, tmp)
+            else:
+                ds = r.to_xarray()
+                engine = "netcdf4" if _has("netCDF4") else "h5netcdf" if _has("h5netcdf") else "scipy"
+                ds.to_netcdf(tmp, engine=engine)
     except OSError as e:
         raise OutputError(f"--out: cannot write {str(path)!r}: {e.strerror or e}") from None
 

@@ -140,5 +140,6 @@ def svg_text(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None,
 
 def write_svg(path, m: Mechanism, sweep: Sweep, pose: int | None = None, **kw) -> None:
     """Write `svg_text(m, sweep, pose, **kw)` to `path`."""
-    with open(path, "w", encoding="utf-8") as f:
+    from .atomic import open_replacing
+    with open_replacing(path, "w", encoding="utf-8") as f:
         f.write(svg_text(m, sweep, pose, **kw))

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..results import wrap_angle
+from .cancel import interruptible
 from .expressions_sym import CONST, SAMPLE, SYMBOLIC
 from .symbolic import is_angular
 
@@ -197,7 +198,8 @@ class SampledNLP:
                 "ipopt.max_iter": int(max_iter), "ipopt.tol": tol, "error_on_fail": False,
                 "ipopt.bound_relax_factor": 0.0}
         solver = ca.nlpsol("kincas_optimize", "ipopt", {"x": X, "f": f, "g": G}, opts)
-        out = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=np.concatenate(lbg), ubg=np.concatenate(ubg))
+        with interruptible():  # IPOPT would take Ctrl-C for a failed solve and go on
+            out = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=np.concatenate(lbg), ubg=np.concatenate(ubg))
         stats = solver.stats()
         fgs = ca.Function("fg", [X], [f, G])
         fg = lambda x: tuple(np.asarray(v).ravel() for v in fgs(x))  # numpy values for the checks

@@ -32,6 +32,7 @@ import numpy as np
 from ..model import mechanism as _mechanism
 from ..model.mechanism import Mechanism, needs_rank_test
 from . import joints as _joints
+from .cancel import interruptible
 from .newton import lsolve as _lsolve, newton as _newton
 from .redundant import decide
 from .structure import Structure
@@ -348,7 +349,8 @@ class Model:
                 T[:, k], W[k] = targets[n], 1.0
         qs = np.where(sym.is_length, L, 1.0)
         par = np.concatenate([np.ravel(u), np.ravel(p), T.ravel(order="F"), W, q0 / qs, [L]])
-        out = solver(x0=q0 / qs, p=par, lbg=0, ubg=0)
+        with interruptible():  # IPOPT would take Ctrl-C for a failed solve and go on
+            out = solver(x0=q0 / qs, p=par, lbg=0, ubg=0)
         q = np.asarray(out["x"]).ravel() * qs
         return self.newton(q, u, p, L)  # polish, and judge by the residual alone
 

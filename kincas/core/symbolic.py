@@ -182,7 +182,10 @@ class Symbolic:
             if kind == "plain" and self.position_expr(a, b)[0] is None and self.extra(n)[0]:
                 out += [f"{where}: {n!r}: {msg}" for msg in self.extra(n)[1]]
                 continue
-            if kind == "sens":
+            if kind == "sens" and parse_quantity(a)[0] == "sens":  # d2Q/dp2: not built
+                out.append(f"{where}: {n!r}: a sensitivity of a sensitivity is not supported "
+                           f"(d(Q)/d(p) takes a quantity Q, not d(...)/d(...))")
+            elif kind == "sens":
                 out += self.check_names([a], where)
                 if b not in self.pnames:
                     out.append(f"{where}: {n!r}: unknown parameter {b!r}")
