@@ -13,6 +13,7 @@ derivative by central differences:
 import numpy as np
 import pytest
 
+import closed_forms
 import kincas
 from kincas import Input, Link, Mechanism
 from kincas.errors import ModelError
@@ -26,13 +27,8 @@ def fourbar(b=3.5):
 
 
 def closed_C(th, b):
-    """C by intersecting the circles (B, b) and (D, 3), on the upper side."""
-    Bx, By = np.cos(th), np.sin(th)
-    ex, ey = 4 - Bx, -By
-    r = np.hypot(ex, ey)
-    x = (b * b - 9 + r * r) / (2 * r)
-    h = np.sqrt(b * b - x * x)
-    return np.array([Bx + (x * ex - h * ey) / r, By + (x * ey + h * ex) / r])
+    """C (2, n): the circles (B, b) and (D, 3) intersected on the upper side."""
+    return closed_forms.fourbar((0, 0), (4, 0), 1.0, b, 3.0, th, +1)[1].T
 
 
 def closed_V(th, b, w):
