@@ -30,7 +30,8 @@ from .continuation import careful_pose
 from .resume import unlabelled_resumes
 from .events import null_derivatives, sweep_events
 from ..core.joints import check_first_pose
-from .inputs import input_table as _input_table
+from .inputs import derivative_table, input_table as _input_table
+from ..model.mechanism import check_guess
 from .prepared import model_and_prepared
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
@@ -110,15 +111,16 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     """
     # the model and the parameter values, size, guess, input keys: once per mechanism
     model, pm = model_and_prepared(m, _model_of)
-    report = list(default_report(m) if report is None else report)
+    report = report_names(m, report)
     names = tuple(report)
     pm.check_report(model, names)  # unknown names fail here, before any solving
     U = _input_table(m, inputs, "inputs", None, pm.keys)
     n = U.shape[0]
     Ud = _per_pose(m, rates, "rates", 1.0, n, pm.keys)
     Udd = _per_pose(m, accelerations, "accelerations", 0.0, n, pm.keys)
+    Uddd = None if jerks is None else derivative_table(m, jerks, "jerks", 0.0, n, pm.keys)
     p, L = pm.p, pm.size
-    g = pm.guess if not guess else {**pm.guess, **{k: (m.value(x), m.value(y)) for k, (x, y) in dict(guess).items()}}
+    g = pm.guess if not guess else {**pm.guess, **{k: (m.value(x), m.value(y)) for k, (x, y) in check_guess(m, guess)}}
     events = []
 
     def first(k):
@@ -155,8 +157,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
                                  getattr(run, "crossed", ()))
     events += found
     values = run.values
-    if jerks is not None:  # the inputs' jerks enter only the third derivatives
-        Uddd = np.broadcast_to(_input_table(m, jerks, "jerks", 0.0), U.shape)
+    if Uddd is not None:  # the inputs' jerks enter only the third derivatives
         third = [i for i, nm in enumerate(report) if needs_jerk(nm)]
         if third and ok.any():
             f = model.sym.quantity_function([report[i] for i in third], jerk=True).map(int(ok.sum()))
@@ -188,7 +189,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 
 
 def _per_pose(m, values, what: str, default: float, n: int, keys) -> np.ndarray:
-    """The (n, nu) table of the inputs' rates or accelerations (`input_table`), a new array
+    """The (n, nu) table of the inputs' rates or accelerations (`derivative_table`), a new array
     (`np.broadcast_to` costs more than filling a few thousand numbers, and a short sweep
     pays every microsecond): the usual cases, none given or one number for the one input,
     without building a table first."""
@@ -198,12 +199,8 @@ def _per_pose(m, values, what: str, default: float, n: int, keys) -> np.ndarray:
         v = values.get(keys[0])
         if type(v) is float and math.isfinite(v) or type(v) is int:
             return np.full((n, 1), float(v))
-    T = _input_table(m, values, what, default, keys)
-    if T.shape[0] == n:
-        return np.array(T, dtype=float)  # (a copy: the user's array stays theirs)
-    out = np.empty((n, T.shape[1]))
-    out[:] = T  # (ValueError for any other number of rows, as broadcasting gives)
-    return out
+    return np.array(derivative_table(m, values, what, default, n, keys), dtype=float)  # (a copy:
+    # the user's array stays theirs)
 
 
 class _CarefulRun:
@@ -303,8 +300,29 @@ def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     >>> kincas.solve(m, {"crank.angle": 0.0}, report=["C.x"]).status  # a 3 m rocker is fine
     'ok'
     """
+    for what, values in (("inputs", inputs), ("rates", rates), ("accelerations", accelerations),
+                         ("jerks", jerks)):
+        if values is not None and _input_table(m, values, what, 0.0).shape[0] > 1:
+            raise ModelError(f"{what}: solve() solves one pose, so give one value per input "
+                             f"(kincas.sweep solves several)")
     return sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
                  guess=guess, jerks=jerks).pose(0)
+
+
+def report_names(m: Mechanism, report) -> list[str]:
+    """The quantities to report: the default's when None, one name given alone as a list;
+    ModelError naming `report` for anything that is not a name."""
+    if report is None:
+        return list(default_report(m))
+    report = [report] if isinstance(report, str) else report
+    try:
+        report = list(report)
+    except TypeError:
+        raise ModelError(f"report: expected a list of quantity names, got {report!r:.80}") from None
+    bad = [r for r in report if not isinstance(r, str)]
+    if bad:
+        raise ModelError([f"report: expected a quantity's name, got {r!r:.80}" for r in bad])
+    return report
 
 
 # --- singular positions met by a sweep ---

@@ -136,7 +136,10 @@ def _check_args(args) -> None:
             if isinstance(n, int) and not isinstance(n, bool) and n > 0:
                 std = t.get("std", {})
                 poses = max((len(v) for v in sc.study.inputs.values()), default=1)
-                bounds.check(field, n, bounds.per_sample(nq, nrep, len(std) if isinstance(std, dict) else 1, poses))
+                from ..analysis.executor import default_workers
+                need = bounds.tolerance_bytes(n, poses, nq, nrep, len(std) if isinstance(std, dict) else 1,
+                                              default_workers())
+                bounds.check_total(f"{field}: {n} (x {poses} poses)", need, "use fewer")
     except ValueError as e:
         raise OutputError(str(e)) from None
 

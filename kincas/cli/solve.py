@@ -36,7 +36,9 @@ def cli_arguments(parser) -> None:
 
 def cli_run(args) -> int:
     """Solve the scene and print (or write) the results."""
-    sc = load(args.scene)
+    from . import bounds
+    with bounds.json_output(args.json):  # the sweep's size is checked as the output will cost
+        sc = load(args.scene)
     wants_files = (args.csv or args.plot or args.animate or args.plot_quantities or args.html
                    or args.svg or args.dxf)
     if wants_files or args.pose is not None or args.evolute or args.centrodes:  # fail before a long solve

@@ -114,6 +114,7 @@ def cli_run(args) -> int:
 
     sc = load(args.scene)
     kw = read_section(sc)
+    _check_size(sc, kw, args.workers)
     if args.out and Path(args.out).suffix.lower() not in FORMATS:
         raise OutputError(f"--out: {args.out!r}: expected a file ending in {', '.join(FORMATS)}")
     if args.out:
@@ -141,8 +142,29 @@ def cli_run(args) -> int:
     if args.plot:
         from .mapplot import plot_map
         plot_map(r, args.plot, title=st.title)
-    _summary(st.title, r, args.out)
+    _summary(st.title, r, args.out, args.plot)
     return 0 if all(s == "ok" for s in r.status) else 3
+
+
+def _check_size(sc, kw, workers) -> None:
+    """Refuse, before any design is made, a study that would not fit in memory (one line
+    naming the grid or the samples, the memory, and the ways round)."""
+    from . import bounds
+    from ..analysis.executor import default_workers
+    from ..core.numeric import compile
+    from ..synthesis.expressions import parse
+    grid, n = kw["grid"], kw["samples"]
+    designs = math.prod(grid) if grid is not None else n
+    field = f"[study] grid = {grid}" if grid is not None else f"[study] samples = {n}"
+    poses = max((len(v) for v in sc.study.inputs.values()), default=1)
+    wanted = {q for t in kw["report"] for q in parse(t, "report").quantities}
+    need = bounds.study_bytes(designs, poses, compile(sc.mechanism).sym.nq, len(wanted),
+                              len(kw["vary"]), len(kw["report"]), workers or default_workers())
+    try:
+        bounds.check_total(f"{field} ({designs:,} designs x {poses} poses)", need,
+                           "use fewer designs or poses")
+    except ValueError as e:
+        raise OutputError(str(e)) from None
 
 
 def _client(address):
@@ -155,7 +177,7 @@ def _client(address):
         raise OutputError(f"--scheduler: cannot connect to {address!r}: {e}") from None
 
 
-def _summary(title, r: StudyResult, out):
+def _summary(title, r: StudyResult, out, plot=None):
     ok = int(r.ok.sum())
     print(f"{title or 'kincas'}: study of {len(r.status)} designs over {', '.join(r.names)}: "
           f"{ok} solved at every pose, {len(r.status) - ok} not")
@@ -165,8 +187,9 @@ def _summary(title, r: StudyResult, out):
             print(f"  {t}: from {np.nanmin(v):.6g} to {np.nanmax(v):.6g}")
         else:
             print(f"  {t}: no value (no design solved)")
-    if out:
-        print(f"wrote {out}")
+    for path in (out, plot):
+        if path:
+            print(f"wrote {path}")
 
 
 # --- writing the rows ---
