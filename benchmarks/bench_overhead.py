@@ -126,7 +126,14 @@ def main(argv=None):
     ap.add_argument("--wall", action="store_true", help="wall-clock time instead of CPU time")
     ap.add_argument("--against", help="a checkout whose kincas is timed beside this one")
     ap.add_argument("--first-use", help="calls (e.g. 1,100,1000): fresh processes, empty cache")
+    ap.add_argument("--report", action="store_true",
+                    help="both regimes (warm at 360, 3,600 and 100,000 poses; first use at 1, 100 and "
+                         "1,000 calls) written to results_overhead.md for benchmarks/run.py "
+                         "(the default without arguments)")
+    argv = sys.argv[1:] if argv is None else argv
     a = ap.parse_args(argv)
+    if a.report or not argv:
+        return report()
     if a.first_use:
         calls = sorted(map(int, a.first_use.split(",")))
         print(f"{'case':10} {'tool':10} " + " ".join(f"{str(c) + ' calls s':>13}" for c in calls))
@@ -150,6 +157,40 @@ def main(argv=None):
             k, pl, cf = t["kincas"], t.get("pylinkage", float("nan")), t["closed form"]
             extra = f" {t['against']:8.3f} {k / t['against']:9.2f}" if against else ""
             print(f"{name:10} {n:7d} {k:15.3f} {pl:10.3f} {cf:8.3f} {k / pl:6.2f} {k / cf:8.2f}{extra}", flush=True)
+
+
+def report(path: Path = Path(__file__).resolve().parent / "results_overhead.md") -> None:
+    """Both regimes side by side, as markdown beside this file (benchmarks/run.py quotes it)."""
+    import kincas  # noqa: F401  (this checkout's)
+    lines = ["# What users call: `kincas.sweep` per call, warm and on first use", "",
+             "Warm: CPU time per pose, median of interleaved calls in one process (the library built "
+             "first); positions and velocities of the compared points. First use: wall time in a fresh "
+             "process with kincas's cache empty, from setup to the end of the n-th 360-pose sweep "
+             "(compiles and JIT included; numba's cache as installed).", "",
+             "| case | poses | kincas µs/pose | pylinkage (numba) | closed form (numpy) | × pylinkage | × closed form |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for name in CASES:
+        for n in (360, 3_600, 100_000):
+            case = CASES[name](n)
+            if len(case.theta) != n:
+                case = case.with_theta(cases.sweep_angles(n))
+            t = measure(case, 40 if n <= 4000 else 5)
+            k, pl, cf = t["kincas"], t.get("pylinkage", float("nan")), t["closed form"]
+            lines.append(f"| {name} | {n:,} | {k:.3f} | {pl:.3f} | {cf:.3f} | {k / pl:.2f} | {k / cf:.2f} |")
+            print(lines[-1], flush=True)
+    calls = [1, 100, 1000]
+    lines += ["", "| case | tool | " + " | ".join(f"{c:,} calls (s)" for c in calls) + " |",
+              "|---|---|" + "---:|" * len(calls)]
+    for name in ("fourbar", "jansen"):
+        got = {t: first_use(t, name, calls) for t in ("kincas", "pylinkage")}
+        for t, v in got.items():
+            lines.append(f"| {name} | {t} | " + " | ".join(f"{x:.3f}" for x in v) + " |")
+        lines.append(f"| {name} | kincas ÷ pylinkage | " + " | ".join(
+            f"{a_ / b_:.2f}" for a_, b_ in zip(*got.values())) + " |")
+        print("\n".join(lines[-3:]), flush=True)
+    tmp = path.with_suffix(".md.tmp")
+    tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    tmp.replace(path)
 
 
 if __name__ == "__main__":
