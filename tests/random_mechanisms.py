@@ -634,6 +634,9 @@ def _sweep_reference(fr: Frames, rng, sp):
 def _realize(family, seed, sp, fr, rng, U, Z, direction, s, phi, offset, off_sizes):
     R = rot(phi)
     glob = lambda xy: offset + s * (R @ np.asarray(xy, float))
+    # what the declaration names (which links give a cg, where the loads act) is the same for
+    # every mechanism of a family: one kincas structure, one model, one kernel per family
+    pick = np.random.default_rng(FAMILIES.index(family))
     params = {}
 
     def par(name, v):
@@ -650,7 +653,7 @@ def _realize(family, seed, sp, fr, rng, U, Z, direction, s, phi, offset, off_siz
         ext = max(np.linalg.norm(v) for v in loc.values()) * s
         inertia = mass * ext ** 2 * rng.uniform(0.01, 0.2)
         kw = {"mass": par(f"m_{name}", mass), "inertia": par(f"J_{name}", inertia)}
-        if rng.random() < 0.6:
+        if len(links) % 2 == 0:  # the others' cg is the default, the mean of their points
             c = np.mean(list(loc.values()), axis=0) * s + rng.uniform(-0.2, 0.2, 2) * ext
             kw["cg"] = (par(f"cgx_{name}", c[0]), par(f"cgy_{name}", c[1]))
         masses[name] = mass
@@ -681,13 +684,13 @@ def _realize(family, seed, sp, fr, rng, U, Z, direction, s, phi, offset, off_siz
     ga = rng.uniform(-math.pi, math.pi)
     gravity = (par("grav_x", gmag * math.cos(ga)), par("grav_y", gmag * math.sin(ga)))
     moving = [p for p in sp.pos]
-    fpt = moving[int(rng.integers(len(moving)))]
+    fpt = moving[int(pick.integers(len(moving)))]
     fa = rng.uniform(-math.pi, math.pi)
     fmag = 10 * mbar * gmag
-    spt = moving[int(rng.integers(len(moving)))]
-    gpt = list(sp.ground)[int(rng.integers(len(sp.ground)))]
+    spt = moving[int(pick.integers(len(moving)))]
+    gpt = list(sp.ground)[int(pick.integers(len(sp.ground)))]
     l_now = math.dist(sp.ground[gpt], sp.pos[spt]) * s
-    tl = sp.links[int(rng.integers(len(sp.links)))][1]
+    tl = sp.links[int(pick.integers(len(sp.links)))][1]
     loads = [Load.force(fpt, (par("F_x", fmag * math.cos(fa)), par("F_y", fmag * math.sin(fa)))),
              Load.torque(tl, par("tau", rng.uniform(-1, 1) * fmag * s)),
              Load.spring(gpt, spt, par("k_spring", 10 * mbar * gmag / s), par("l0_spring", l_now * rng.uniform(0.5, 1.5)))]
@@ -695,6 +698,7 @@ def _realize(family, seed, sp, fr, rng, U, Z, direction, s, phi, offset, off_siz
     Us = np.empty_like(U)
     for k, (kind, _) in enumerate(sp.inputs):
         Us[:, k] = U[:, k] + phi if kind == "angle" else U[:, k] * s
+        Us[:, k] = np.linspace(Us[0, k], Us[-1, k], len(Us))  # as a scene's sweep spaces them
     pos = {}
     for p in list(sp.pos):
         pos[p] = np.array([glob(fr.point(z, p)) for z in Z])

@@ -112,6 +112,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     Ud = np.broadcast_to(_input_table(m, rates, "rates", 1.0, pm.keys), U.shape)
     Udd = np.broadcast_to(_input_table(m, accelerations, "accelerations", 0.0, pm.keys), U.shape)
     p, L = pm.p, pm.size
+    if guess:  # a guessed ground point or unknown point is an error, as in Mechanism(guess=...)
+        m.with_guess(**dict(guess))
     g = pm.guess if not guess else {**pm.guess, **{k: (m.value(x), m.value(y)) for k, (x, y) in dict(guess).items()}}
     events = []
 
