@@ -20,7 +20,7 @@ import pytest
 
 import random_mechanisms as rm
 
-N = rm.count(10)
+N = rm.count(6)
 EPS = np.finfo(float).eps
 
 

@@ -9,7 +9,7 @@ import pytest
 import kincas
 import random_mechanisms as rm
 
-N = rm.count(10)
+N = rm.count(6)
 
 
 def mistakes(c):
