@@ -1,6 +1,10 @@
 """`python -m kincas` is the `kincas` command."""
 import sys
 
-from .cli import main
+try:
+    from .cli import main
+except KeyboardInterrupt:  # Ctrl-C while Python imports kincas
+    print("\nkincas: interrupted", file=sys.stderr)
+    sys.exit(130)
 
 sys.exit(main())

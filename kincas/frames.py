@@ -73,7 +73,9 @@ def _index(pd, inputs: dict, n: int):
 
 def sweep_to_pandas(sw, length: str = ""):
     pd = require("pandas")
-    cols = {k: np.asarray(v, float) for k, v in sw.values.items()}
+    # a reported quantity that is also an input (a driven link's angle) is the index, as the
+    # input was given (unwrapped), not a second column of that name (as in to_xarray)
+    cols = {k: np.asarray(v, float) for k, v in sw.values.items() if k not in sw.inputs}
     cols["status"] = sw.status.astype(str)
     cols["flag"] = pd.array([f if f else None for f in sw.flags], dtype="object")
     df = pd.DataFrame(cols, index=_index(pd, sw.inputs, len(sw)))
@@ -102,7 +104,8 @@ def tolerance_to_pandas(r, length: str = ""):
     pd = require("pandas")
     cols = {}
     for n in r.names:
-        cols[n] = np.asarray(r.nominal[n], float)
+        if n not in r.inputs:  # an input is the index
+            cols[n] = np.asarray(r.nominal[n], float)
         cols[f"std {n}"] = np.asarray(r.first_order[n], float)
         cols[f"mc {n}"] = np.asarray(r.monte_carlo[n], float)
     cols["status"] = np.asarray(r.status).astype(str)

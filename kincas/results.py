@@ -81,8 +81,8 @@ class Pose:
     def __contains__(self, name) -> bool:
         return name in self.values or name in self.inputs
 
-    def __iter__(self):
-        return iter([*self.inputs, *self.values])
+    def __iter__(self):  # inputs, then reported quantities; a name once (an input may be reported)
+        return iter(dict.fromkeys([*self.inputs, *self.values]))
 
     def __repr__(self) -> str:
         at = ", ".join(f"{k}={v:.6g}" for k, v in self.inputs.items())
@@ -166,8 +166,8 @@ class Sweep:
     def __contains__(self, name) -> bool:
         return name in self.values or name in self.inputs
 
-    def __iter__(self):
-        return iter([*self.inputs, *self.values])
+    def __iter__(self):  # inputs, then reported quantities; a name once (an input may be reported)
+        return iter(dict.fromkeys([*self.inputs, *self.values]))
 
     def keys(self) -> list[str]:
         """The names: inputs, then reported quantities (so `dict(sweep)` works).
@@ -233,15 +233,12 @@ class Sweep:
         out.append(f"  reported: {_names(self.values, 8) or 'nothing'}")
         return out
 
-    def _repr_html_(self) -> str:
-        """Jupyter's display: the summary and small plots of the quantities."""
-        from .notebook import sweep_html
-        return sweep_html(self)
-
     # --- in the data tools (extra kincas[data]) ---
     def to_pandas(self, length: str = ""):
         """A DataFrame: one row per pose, the inputs as index, a column per quantity, then
         `status` and `flag`; units (radians, and `length` if named) in `df.attrs["units"]`.
+        A reported quantity that is also an input (the driven link's angle) is the index, as
+        the input was given (not wrapped), so `df.reset_index()` gives one column of each name.
 
         Parameters
         ----------

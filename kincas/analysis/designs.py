@@ -40,8 +40,8 @@ from __future__ import annotations
 import math
 import os
 import threading
+import time
 import weakref
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Mapping
 
@@ -49,21 +49,27 @@ import numpy as np
 
 from ..errors import ModelError
 from ..core.batch import BatchEvaluator
+from ..core.cancel import checkpoint
 from ..core.compiled import ptr, rows
 from ..core.designs_kernel import MAX_STEPS, NEWTON, STEP, designs_loop_for
 from ..core.fast import FastRun
 from ..core.numeric import ACCEPT, compile as compile_model
-from ..core.symbolic import default_report
+from ..model.names import default_report
 from ..model.mechanism import Mechanism, as_param
 from ..core.assembly import modes
 from ..core.blocks import numeric_signs
 from .continuation import _continue, _first
+from .executor import map_threads
 from .sweeps import _input_table
 
 OK, NO_ASSEMBLY, NOT_SOLVED, BRANCH_LOST, NO_MESH = 0, 1, 2, 3, 4
 STATUS = ("ok", "no assembly", "not solved", "branch lost", "gears do not mesh")
 BLOCK = 32  # designs per C call (a thread's unit of work) on the careful designs' path
-FULL_BLOCK = 256  # designs per call of the whole-designs loop at most
+BLOCK_POSES = 65536  # poses per such call at most (fewer designs when they have many poses)
+FULL_BLOCK = 256  # designs per thread's part of the whole-designs loop at most
+# The whole-designs loop's calls: the first of FIRST_CALL poses, the next sized by its speed to
+# last about CALL_SECONDS (Ctrl-C is heard at once, but the call under way runs to its end)
+FIRST_CALL, CALL_SECONDS = 8192, 0.1
 
 
 # --- the result ---
@@ -297,23 +303,32 @@ class _Job:
         if lib is None or not nominal.ok or nd == 0:
             return todo
         thr, q0 = _thresholds(), np.ascontiguousarray(nominal.q)
-        # one call on one thread (each return waits for the GIL: fewer is faster beside
-        # other threads running Python), else about four blocks per thread
+        # one part on one thread (each return waits for the GIL: fewer is faster beside
+        # other threads running Python), else about four parts per thread; `run` cuts a part
+        # into calls of about CALL_SECONDS
         size = nd if workers == 1 else max(1, min(FULL_BLOCK, math.ceil(nd / (4 * workers))))
         parts = [(a, min(a + size, nd)) for a in range(0, nd, size)]
         stops = np.full(nd, -1)
 
         def run(part):
-            a, b = part
-            stops[a:b] = self.kernel.full(lib, self.U, self.P[a:b], self.Ls[a:b], q0, p0, L0,
-                                          self.Q[a:b], self.vals[a:b], self.Ud, self.Udd, thr)
-            for d in a + np.flatnonzero((stops[a:b] > 0) & (stops[a:b] < n)):  # rare: careful
-                self.code[d, :stops[d]], self.fast[d, :stops[d]] = OK, True
-                self._finish(lib, int(d), int(stops[d]))
-            self._news(int(np.sum(stops[a:b] > 0)))
+            # in calls of about CALL_SECONDS each (Ctrl-C waits for the one under way), sized
+            # by the speed of the calls before; a design's numbers do not depend on its call
+            a, end = part
+            k = max(1, FIRST_CALL // n)
+            while a < end:
+                checkpoint()
+                b = min(end, a + k)
+                t = time.perf_counter()
+                stops[a:b] = self.kernel.full(lib, self.U, self.P[a:b], self.Ls[a:b], q0, p0, L0,
+                                              self.Q[a:b], self.vals[a:b], self.Ud, self.Udd, thr)
+                k = _next_call(k, b - a, time.perf_counter() - t)
+                for d in a + np.flatnonzero((stops[a:b] > 0) & (stops[a:b] < n)):  # rare: careful
+                    self.code[d, :stops[d]], self.fast[d, :stops[d]] = OK, True
+                    self._finish(lib, int(d), int(stops[d]))
+                self._news(int(np.sum(stops[a:b] > 0)))
+                a = b
         if workers > 1 and len(parts) > 1:
-            with ThreadPoolExecutor(workers) as ex:
-                list(ex.map(run, parts))
+            map_threads(run, parts, workers)
         else:
             for part in parts:
                 run(part)
@@ -368,7 +383,7 @@ class _Job:
         model, P, Ls = self.model, self.P[idx], self.Ls[idx]
         nd, u = P.shape[0], np.repeat(self.U[:1], P.shape[0], axis=0)
         ev = BatchEvaluator(model)
-        scale = np.where(model.sym.is_length[None, :], 1.0, 1.0 / Ls[:, None])
+        scale = np.where(model.is_length[None, :], 1.0, 1.0 / Ls[:, None])
         dP = P - p0
         # Steps of at most STEP * size in every parameter, counted per design, so that a
         # design's numbers do not depend on the others computed with it (chunks on a cluster).
@@ -401,7 +416,8 @@ class _Job:
         todo = rest[self.code[rest, 0] == OK]
         self._news(len(rest) - len(todo))
         lib = self.kernel.lib(len(todo) * n) if self.kernel is not None and n > 1 else None
-        blocks = [todo[i:i + BLOCK] for i in range(0, len(todo), BLOCK)]
+        size = max(1, min(BLOCK, BLOCK_POSES // n))  # a short call, for Ctrl-C
+        blocks = [todo[i:i + size] for i in range(0, len(todo), size)]
         batched = lib is None and self.kernel is not None and n > 1
         if batched:  # no compiled kernel: all designs advance together, pose by pose
             blocks = [todo]
@@ -411,6 +427,7 @@ class _Job:
             jax_stops = dict(zip(todo.tolist(), jax_pass(self, todo, _thresholds())))
 
         def run(block):
+            checkpoint()
             if jax_stops is not None:
                 stops = [jax_stops[int(d)] for d in block]
             elif lib is not None:
@@ -423,8 +440,7 @@ class _Job:
                 self._finish(lib, int(d), int(k))
             self._news(len(block))
         if workers > 1 and len(blocks) > 1 and lib is not None:
-            with ThreadPoolExecutor(workers) as ex:
-                list(ex.map(run, blocks))
+            map_threads(run, blocks, workers)
         else:
             for b in blocks:
                 run(b)
@@ -441,11 +457,12 @@ class _Job:
         stops = np.full(len(todo), n)
         live = np.arange(len(todo))  # positions in todo still advancing
         d = todo
-        D = np.where(model.sym.is_length[None, :], self.Ls[d][:, None], 1.0)
+        D = np.where(model.is_length[None, :], self.Ls[d][:, None], 1.0)
         q = self.Q[d, 0]
         _, J, Ju, _ = ev.derivatives(q, np.repeat(U[:1], len(d), 0), self.P[d])
         T = -_solve(J, Ju)
         for k in range(1, n):
+            checkpoint()  # Ctrl-C, when this runs on a worker thread
             if not len(live):
                 break
             d, Dl = todo[live], D[live]
@@ -496,6 +513,7 @@ class _Job:
         again, until the end or a pose that cannot be reached."""
         model, U, n, p, L = self.model, self.U, self.U.shape[0], self.P[d], self.Ls[d]
         while k < n:
+            checkpoint()
             with _lock(model):
                 prev = (self.Q[d, k - 2], U[k - 2]) if k >= 2 else None
                 sol = _continue(model, self.Q[d, k - 1], U[k - 1], U[k], p, L, depth=8, prev=prev)
@@ -574,6 +592,13 @@ class _Job:
         with _lock(self.model):
             self.vals[d, :, k] = ev.quantities(self.report, self.Q[d, k], self.U[k], self.P[d],
                                                self.Ud[k], self.Udd[k]).T
+
+
+def _next_call(k: int, done: int, seconds: float) -> int:
+    """Designs in the next call: CALL_SECONDS at the speed of the last call (`done` designs
+    in `seconds`), growing at most eightfold a call (a first call may be slow to warm up)."""
+    rate = done / max(seconds, 1e-6)
+    return int(max(1, min(8 * k, rate * CALL_SECONDS)))
 
 
 def _modes(model, J, L) -> np.ndarray:

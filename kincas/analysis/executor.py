@@ -7,13 +7,20 @@ task fails is retried (`retries`), and a chunk lost with a dying worker is compu
 the scheduler elsewhere: every chunk's result comes back exactly once, in the chunks' order.
 `progress(done, total)` counts finished chunks.
 
+Ctrl-C (KeyboardInterrupt in the main thread, which waits with a timeout so that it hears it)
+cancels the work: chunks not yet started never start, running ones stop at their next
+`kincas.core.cancel.checkpoint()` (the compiled calls between checkpoints are short), and the
+KeyboardInterrupt goes on to the caller.
+
 >>> run_chunks(lambda c: sum(c), [[1, 2], [3], [4, 5, 6]], workers=2)
 [3, 3, 15]
 """
 from __future__ import annotations
 
 import os
-from concurrent.futures import ThreadPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+
+from ..core.cancel import WAIT, Token, cancelling, checkpoint, current
 
 
 def default_workers() -> int:
@@ -41,21 +48,56 @@ def run_chunks(fn, chunks, *, client=None, workers: int | None = None, progress=
         from distributed import as_completed as dask_completed
 
         futures = client.map(fn, chunks, retries=retries, pure=False)
-        for i, _ in enumerate(dask_completed(futures), 1):
-            if progress is not None:
-                progress(i, total)
-        return client.gather(futures)
+        try:
+            for i, _ in enumerate(dask_completed(futures), 1):
+                if progress is not None:
+                    progress(i, total)
+            return client.gather(futures)
+        except BaseException:  # Ctrl-C: the cluster drops what is left
+            client.cancel(futures)
+            raise
     workers = workers or default_workers()
     if workers == 1 or total <= 1:
         out = []
         for i, c in enumerate(chunks, 1):
+            checkpoint()
             out.append(fn(c))
             if progress is not None:
                 progress(i, total)
         return out
-    with ThreadPoolExecutor(workers) as ex:
-        futures = [ex.submit(fn, c) for c in chunks]
-        for i, _ in enumerate(as_completed(futures), 1):
-            if progress is not None:
-                progress(i, total)
+    return map_threads(fn, chunks, workers, progress)
+
+
+def map_threads(fn, items, workers: int, progress=None) -> list:
+    """[fn(x) for x in items] on `workers` threads, results in order; the first error (or
+    Ctrl-C) cancels what has not started and stops the rest at their next checkpoint."""
+    items, total = list(items), len(items)
+    token = Token(current())  # cancelled with the work this is part of, if any
+    ex = ThreadPoolExecutor(workers)
+    futures = []
+    try:
+        futures = [ex.submit(_within, token, fn, x) for x in items]
+        pending, done = set(futures), 0
+        while pending:
+            finished, pending = wait(pending, timeout=WAIT, return_when=FIRST_COMPLETED)
+            for f in finished:
+                f.result()  # an error: raised now, the rest cancelled below
+            done += len(finished)
+            if finished and progress is not None:
+                progress(done, total)
+            checkpoint()
         return [f.result() for f in futures]
+    except BaseException:
+        token.cancel()
+        for f in futures:
+            f.cancel()
+        raise
+    finally:
+        ex.shutdown(wait=not token.cancelled, cancel_futures=True)
+
+
+def _within(token, fn, x):
+    """fn(x) in a worker thread, its checkpoints testing `token`."""
+    with cancelling(token):
+        checkpoint()
+        return fn(x)

@@ -21,12 +21,13 @@ from ..model.mechanism import Mechanism
 def input_table(m: Mechanism, inputs, what: str, default: float | None, keys=None) -> np.ndarray:
     """(N x nu) array of one value per input and pose from a mapping key -> scalar or array
     (`keys`: the mechanism's input keys, if already at hand). Where every input has one
-    value, the table has one row (N = 1), whatever the number of poses."""
+    value, the table has one row (N = 1), whatever the number of poses. ModelError naming
+    `what` and the input for anything that is not finite numbers, one row per pose."""
     keys = [i.key for i in m.inputs] if keys is None else list(keys)
     if inputs is None and default is not None:  # every input at its default: one row
         return np.full((1, len(keys)), float(default))
     if len(keys) == 1 and isinstance(inputs, Mapping) and len(inputs) == 1 and keys[0] in inputs:
-        c = np.asarray(inputs[keys[0]], dtype=float)  # the common case, one input: no copy
+        c = _floats(inputs[keys[0]], what, keys[0])  # the common case, one input: no copy
         if c.ndim <= 1 and c.size and np.isfinite(c).all():
             return c.reshape(-1, 1)
     if inputs is None:
@@ -44,11 +45,47 @@ def input_table(m: Mechanism, inputs, what: str, default: float | None, keys=Non
         raise ModelError(problems)
     if not keys:  # a structure (no freedom): one pose
         return np.zeros((1, 0))
-    cols = [np.atleast_1d(np.asarray(inputs.get(k, default), dtype=float)) for k in keys]
+    cols = [np.atleast_1d(_floats(inputs.get(k, default), what, k)) for k in keys]
     bad = [k for k, c in zip(keys, cols) if c.ndim != 1 or not np.isfinite(c).all()]
     if bad:
         raise ModelError([f"{what}: {k!r}: expected finite numbers (one per pose)" for k in bad])
+    empty = [k for k, c in zip(keys, cols) if not c.size]
+    if empty:
+        raise ModelError([f"{what}: {k!r}: no values (give at least one)" for k in empty])
     n = max(len(c) for c in cols)
     if any(len(c) not in (1, n) for c in cols):
         raise ModelError(f"{what}: inputs that sweep advance together, so their lengths must agree")
     return np.stack([np.broadcast_to(c, (n,)) for c in cols], axis=1)
+
+
+def derivative_table(m: Mechanism, values, what: str, default: float, n: int, keys=None) -> np.ndarray:
+    """The (n x nu) table of the inputs' rates, accelerations or jerks over n poses: one value
+    per input, or one per pose; ModelError naming `what` and the input otherwise.
+
+    >>> import kincas
+    >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 1)],
+    ...                      inputs=[kincas.Input.angle("crank")])
+    >>> derivative_table(m, {"crank.angle": 2.0}, "rates", 1.0, 3).ravel().tolist()
+    [2.0, 2.0, 2.0]
+    >>> derivative_table(m, {"crank.angle": [1.0, 2.0]}, "rates", 1.0, 3)
+    Traceback (most recent call last):
+    ...
+    kincas.errors.ModelError: rates: crank.angle: 2 values for 3 poses (give one value, or one per pose)
+    """
+    T = input_table(m, values, what, default, keys)
+    if T.shape[0] not in (1, n):
+        keys = [i.key for i in m.inputs] if keys is None else list(keys)
+        raise ModelError(f"{what}: {keys[0] if len(keys) == 1 else keys}: {T.shape[0]} values for "
+                         f"{n} poses (give one value, or one per pose)")
+    return np.broadcast_to(T, (n, T.shape[1]))
+
+
+def _floats(v, what: str, key: str) -> np.ndarray:
+    """v as a float array; ModelError naming `what` and the input for text or other objects."""
+    try:
+        a = np.asarray(v)
+        if a.dtype.kind in "USVMm" or isinstance(v, (str, bytes)):
+            raise ValueError
+        return a.astype(float, copy=False)
+    except (TypeError, ValueError):
+        raise ModelError(f"{what}: {key!r}: expected numbers, got {v!r:.80}") from None

@@ -51,8 +51,8 @@ class Prepared:
         self.size = m.size()
         self.keys = tuple(i.key for i in m.inputs)
         self.guess = {k: (m.value(x), m.value(y)) for k, (x, y) in dict(m.guess).items()}
-        # gears and racks wrap their angles at the first pose (core/joints.settle_first):
-        # that pose stays on the careful path
+        # gears and racks: the first pose's free angles are taken into (-pi, pi] after Newton
+        # (core/turns.settle): that pose stays on the careful path
         self.plain = not (m.gears or m.racks)
         self._places: OrderedDict = OrderedDict()
         self._lock = threading.Lock()

@@ -24,13 +24,15 @@ from ..core.fast import sweeper_for
 from ..model.mechanism import Mechanism
 from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
-from ..core.symbolic import default_report, needs_jerk
+from ..core.symbolic import needs_jerk
+from ..model.names import default_report
 from .choice import choose_assembly
 from .continuation import careful_pose
 from .resume import unlabelled_resumes
 from .events import null_derivatives
 from ..core.joints import check_first_pose
-from .inputs import input_table as _input_table
+from .inputs import derivative_table, input_table as _input_table
+from ..model.mechanism import check_guess
 from .prepared import prepared
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
@@ -104,17 +106,16 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     (np.True_, 3.041666666667, 1.825)
     """
     model = _model_of(m)
-    report = list(default_report(m) if report is None else report)
+    report = report_names(m, report)
     model.quantity_function(tuple(report))  # unknown names fail here, before any solving
     pm = prepared(model, m)  # parameter values, size, guess, input keys: once per mechanism
     U = _input_table(m, inputs, "inputs", None, pm.keys)
     n = U.shape[0]
-    Ud = np.broadcast_to(_input_table(m, rates, "rates", 1.0, pm.keys), U.shape)
-    Udd = np.broadcast_to(_input_table(m, accelerations, "accelerations", 0.0, pm.keys), U.shape)
+    Ud = derivative_table(m, rates, "rates", 1.0, n, pm.keys)
+    Udd = derivative_table(m, accelerations, "accelerations", 0.0, n, pm.keys)
+    Uddd = None if jerks is None else derivative_table(m, jerks, "jerks", 0.0, n, pm.keys)
     p, L = pm.p, pm.size
-    if guess:  # a guessed ground point or unknown point is an error, as in Mechanism(guess=...)
-        m.with_guess(**dict(guess))
-    g = pm.guess if not guess else {**pm.guess, **{k: (m.value(x), m.value(y)) for k, (x, y) in dict(guess).items()}}
+    g = pm.guess if not guess else {**pm.guess, **{k: (m.value(x), m.value(y)) for k, (x, y) in check_guess(m, guess)}}
     events = []
 
     def first(k):
@@ -149,13 +150,10 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
                                  getattr(run, "crossed", ()))
     events += found
     values = run.values
-    if jerks is not None:  # the inputs' jerks enter only the third derivatives
-        Uddd = np.broadcast_to(_input_table(m, jerks, "jerks", 0.0), U.shape)
+    if Uddd is not None:  # the inputs' jerks enter only the third derivatives
         third = [i for i, nm in enumerate(report) if needs_jerk(nm)]
         if third and ok.any():
-            f = model.sym.quantity_function([report[i] for i in third], jerk=True).map(int(ok.sum()))
-            rep = np.repeat(p.reshape(-1, 1), int(ok.sum()), axis=1)
-            got = np.asarray(f(Q[ok].T, U[ok].T, rep, Ud[ok].T, Udd[ok].T, Uddd[ok].T))
+            got = model.third_derivatives([report[i] for i in third], Q[ok], U[ok], p, Ud[ok], Udd[ok], Uddd[ok])
             values = np.array(values, dtype=float)
             values[np.ix_(third, np.flatnonzero(ok))] = got
     null_derivatives(model, report, values, Q, U, p, at)  # no wrong number at a singular pose
@@ -169,7 +167,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
                  status=status, flags=flags,
                  values={nm: values[i] for i, nm in enumerate(report)},
                  q=Q, residual=res, iterations=its,
-                 unknowns=[nm for nm, _ in model.sym.unknowns], size=L, events=events)
+                 unknowns=model.unknown_names, size=L, events=events)
     if g:
         return out  # the guess picks the assembly, whatever poses its branch loses
     # no guess: where the default assembly loses poses, one of the first pose's others that
@@ -276,8 +274,29 @@ def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     >>> kincas.solve(m, {"crank.angle": 0.0}, report=["C.x"]).status  # a 3 m rocker is fine
     'ok'
     """
+    for what, values in (("inputs", inputs), ("rates", rates), ("accelerations", accelerations),
+                         ("jerks", jerks)):
+        if values is not None and _input_table(m, values, what, 0.0).shape[0] > 1:
+            raise ModelError(f"{what}: solve() solves one pose, so give one value per input "
+                             f"(kincas.sweep solves several)")
     return sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
                  guess=guess, jerks=jerks).pose(0)
+
+
+def report_names(m: Mechanism, report) -> list[str]:
+    """The quantities to report: the default's when None, one name given alone as a list;
+    ModelError naming `report` for anything that is not a name."""
+    if report is None:
+        return list(default_report(m))
+    report = [report] if isinstance(report, str) else report
+    try:
+        report = list(report)
+    except TypeError:
+        raise ModelError(f"report: expected a list of quantity names, got {report!r:.80}") from None
+    bad = [r for r in report if not isinstance(r, str)]
+    if bad:
+        raise ModelError([f"report: expected a quantity's name, got {r!r:.80}" for r in bad])
+    return report
 
 
 # --- singular positions met by a sweep ---

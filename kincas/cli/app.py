@@ -1,7 +1,8 @@
 """The command line: `kincas solve SCENE.toml [--json]`.
 
 Exit status: 0 when every pose was solved, 3 when some were not, 2 when the scene itself is
-wrong (with one message on standard error naming the section and the field, no traceback).
+wrong (with one message on standard error naming the section and the field, no traceback),
+or an output cannot be written (a file, or standard output on a full device), 130 on Ctrl-C.
 
 >>> main(["--version"])
 kincas 0.1.0
@@ -55,7 +56,11 @@ def _parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
-    ap = _parser(argv)
+    try:
+        ap = _parser(argv)  # imports the command's module: Ctrl-C may come while it does
+    except KeyboardInterrupt:
+        print("\nkincas: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     args = ap.parse_args(argv)
     if args.version:
         print(f"kincas {__version__}")
@@ -65,12 +70,14 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_SCENE
     try:
         _check_args(args)
-        return args.run(args)
+        status = args.run(args)
+        sys.stdout.flush()  # a full device or a closed pipe shows here, not at the exit
+        return status
     except KeyboardInterrupt:  # Ctrl-C: the user knows why; one line, the shell's usual 130
         print("\nkincas: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     except BrokenPipeError:  # `kincas solve ... | head`: the reader left, nothing is wrong
-        sys.stderr.close()
+        _drop_stdout()
         return EXIT_OK
     except OutputError as e:  # a file or option that cannot be honoured: one line
         print(f"kincas: {e}", file=sys.stderr)
@@ -78,6 +85,24 @@ def main(argv: list[str] | None = None) -> int:
     except KincasError as e:
         print(f"kincas: error in {getattr(args, 'scene', 'scene')}:\n{e}", file=sys.stderr)
         return EXIT_SCENE
+    except OSError as e:  # files are written as OutputError naming them: this is the output
+        _drop_stdout()
+        where = f"cannot write {e.filename}" if e.filename else "cannot write to standard output"
+        print(f"kincas: {where}: {e.strerror or e}", file=sys.stderr)
+        return EXIT_SCENE
+
+
+def _drop_stdout() -> None:
+    """Standard output to /dev/null from here on: what is still buffered in it would fail
+    again at the exit, with Python's "Exception ignored ... flush" on standard error."""
+    import os
+    try:
+        fd = sys.stdout.fileno()
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, fd)
+        os.close(null)
+    except (AttributeError, OSError, ValueError):  # not a real file (tests capture it)
+        pass
 
 
 def _check_args(args) -> None:
@@ -85,6 +110,7 @@ def _check_args(args) -> None:
     directory, and --starts / --samples fit in memory (a typo must not take the machine)."""
     from pathlib import Path
     from . import bounds
+    _not_the_scene(args)
     seed = getattr(args, "seed", None)
     if seed is not None and seed < 0:
         raise OutputError(f"--seed: expected a whole number >= 0, got {seed}")
@@ -94,13 +120,14 @@ def _check_args(args) -> None:
     starts, samples = getattr(args, "starts", None), getattr(args, "samples", None)
     if not (starts or args.command in ("tolerance", "range")):
         return
+    from ..model.mechanism import solved_unknowns
     from .scene import load
-    from ..core.numeric import compile
     sc = load(args.scene)
     if args.command == "range" and not sc.study.inputs:
         raise OutputError("[[inputs]]: none declared, so there is no range of motion to find "
                           "(kincas range ranges an input; kincas solve solves a structure)")
-    nq, nrep = compile(sc.mechanism).sym.nq, len(sc.quantities)
+    # the declarations' count of the unknowns, so that a size check builds no model
+    nq, nrep = solved_unknowns(sc.mechanism), len(sc.quantities)
     try:
         if starts:
             bounds.check("--starts", starts, bounds.per_sample(nq, 0, 0))
@@ -110,6 +137,26 @@ def _check_args(args) -> None:
             if isinstance(n, int) and not isinstance(n, bool) and n > 0:
                 std = t.get("std", {})
                 poses = max((len(v) for v in sc.study.inputs.values()), default=1)
-                bounds.check(field, n, bounds.per_sample(nq, nrep, len(std) if isinstance(std, dict) else 1, poses))
+                from ..analysis.executor import default_workers
+                need = bounds.tolerance_bytes(n, poses, nq, nrep, len(std) if isinstance(std, dict) else 1,
+                                              default_workers())
+                bounds.check_total(f"{field}: {n} (x {poses} poses)", need, "use fewer")
     except ValueError as e:
         raise OutputError(str(e)) from None
+
+
+# options that name a file the command writes, as the user spells them
+OUTPUT_OPTIONS = {"csv": "--csv", "plot": "--plot", "animate": "--animate",
+                  "plot_quantities": "--plot-quantities", "html": "--html", "svg": "--svg",
+                  "dxf": "--dxf", "out": "--out"}
+
+
+def _not_the_scene(args) -> None:
+    """No output may be the scene file itself (by any spelling or link): it would be lost."""
+    from ..views.atomic import same_file
+    scene = getattr(args, "scene", None)
+    for attr, flag in OUTPUT_OPTIONS.items():
+        path = getattr(args, attr, None)
+        if scene and path and same_file(path, scene):
+            raise OutputError(f"{flag}: {path} is the scene file itself; it would be overwritten "
+                              f"(name another file)")

@@ -1,7 +1,9 @@
 """`kincas cam SCENE.toml`: design a disc cam from the scene's `[cam_design]` section.
 
-Prints a summary (largest pressure angle, smallest radius of curvature, undercut), or with
-`--json` one JSON object; `--out PROFILE.toml` writes a scene-ready `[[cams]]` block with the
+Prints a summary (largest pressure angle, smallest radius of curvature, largest jerk
+d3s/dtheta3, undercut), or with `--json` one JSON object (the follower's s and its first three
+derivatives per cam angle, pressure angle, radii of curvature, undercut, the profile in polar
+form and as x, y in the cam's frame); `--out PROFILE.toml` writes a scene-ready `[[cams]]` block with the
 polar profile, `--csv OUT.csv` a row per cam angle. Angles in the scene's unit.
 
 >>> import tempfile, pathlib
@@ -28,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import OutputError, SceneError
+from ..views.atomic import open_replacing
 from ..synthesis.cam_design import Segment, design_cam
 
 FIELDS = {"base_radius", "roller_radius", "offset", "samples", "segments", "name", "body", "follower"}
@@ -115,18 +118,21 @@ def cli_run(args) -> int:
     unit = "deg" if deg else "rad"
     if args.out:
         try:
-            Path(args.out).write_text(profile_toml(d, names, deg, path.name), encoding="utf-8")
+            with open_replacing(args.out, "w", encoding="utf-8") as f:  # whole or not at all
+                f.write(profile_toml(d, names, deg, path.name))
         except OSError as e:
             raise OutputError(f"--out: cannot write {args.out!r}: {e.strerror or e}") from None
+    per = float(_user(1.0, deg))  # scene units of angle per radian: d^k s/dtheta^k / per^k
     if args.csv:
         phi = np.arctan2(d.profile[:, 1], d.profile[:, 0])
-        cols = {f"theta [{unit}]": _user(d.theta, deg), "s": d.s, f"ds/dtheta [per {unit}]": d.ds / _user(1.0, deg),
-                f"d2s/dtheta2 [per {unit}^2]": d.dds / _user(1.0, deg) ** 2, f"pressure [{unit}]": _user(d.pressure, deg),
+        cols = {f"theta [{unit}]": _user(d.theta, deg), "s": d.s, f"ds/dtheta [per {unit}]": d.ds / per,
+                f"d2s/dtheta2 [per {unit}^2]": d.dds / per ** 2, f"d3s/dtheta3 [per {unit}^3]": d.ddds / per ** 3,
+                f"pressure [{unit}]": _user(d.pressure, deg),
                 "rho_pitch": d.rho_pitch, "rho_profile": d.rho_profile, "undercut": d.undercut.astype(int),
                 "profile_x": d.profile[:, 0], "profile_y": d.profile[:, 1],
                 f"profile_angle [{unit}]": _user(phi, deg), "profile_radius": np.hypot(*d.profile.T)}
         try:
-            with open(args.csv, "w", newline="", encoding="utf-8") as f:
+            with open_replacing(args.csv, "w", newline="", encoding="utf-8") as f:
                 w = csv.writer(f)
                 w.writerow(cols)
                 w.writerows(zip(*[np.asarray(v).tolist() for v in cols.values()]))
@@ -138,15 +144,23 @@ def cli_run(args) -> int:
     if args.json:
         fin = lambda a: [None if not math.isfinite(x) else x for x in np.asarray(a, float).tolist()]  # noqa: E731
         phi, r = d.polar()
-        print(json.dumps({"units": {"angle": unit}, "theta": fin(_user(d.theta, deg)), "s": fin(d.s),
+        units = {"angle": unit, "ds/dtheta": f"length/{unit}", "d2s/dtheta2": f"length/{unit}^2",
+                 "d3s/dtheta3": f"length/{unit}^3"}
+        print(json.dumps({"units": units, "theta": fin(_user(d.theta, deg)), "s": fin(d.s),
+                          "ds/dtheta": fin(d.ds / per), "d2s/dtheta2": fin(d.dds / per ** 2),
+                          "d3s/dtheta3": fin(d.ddds / per ** 3),
                           "pressure": fin(_user(d.pressure, deg)), "rho_pitch": fin(d.rho_pitch),
                           "rho_profile": fin(d.rho_profile), "undercut": d.undercut.tolist(),
-                          "profile": {"angles": fin(_user(phi, deg)), "radii": fin(r)}}))
+                          "profile": {"angles": fin(_user(phi, deg)), "radii": fin(r),
+                                      "x": fin(d.profile[:, 0]), "y": fin(d.profile[:, 1])}}))
     else:
         print(f"cam design: {len(d.theta)} angles, largest pressure angle "
               f"{float(_user(d.pressure[k], deg)):.4g} {unit} at {float(_user(d.theta[k], deg)):.4g} {unit}, "
               f"smallest |radius of curvature| of the profile {abs(d.rho_profile[j]):.4g} "
               f"at {float(_user(d.theta[j], deg)):.4g} {unit}")
+        i = int(np.argmax(np.abs(d.ddds)))  # the follower's jerk, per cam angle cubed
+        print(f"largest |d3s/dtheta3| {abs(d.ddds[i]) / per ** 3:.6g} per {unit}^3 "
+              f"at {float(_user(d.theta[i], deg)):.4g} {unit} (the jerk is this times the cam's speed cubed)")
         if d.undercut.any():
             a = _user(d.theta[d.undercut], deg)
             print(f"undercut: the roller cannot follow the profile from {a.min():.4g} to {a.max():.4g} {unit}")

@@ -7,9 +7,10 @@ import math
 import sys
 from pathlib import Path
 
-from ..analysis.modes import find_modes, scene_with_guess
-from ..errors import SceneError
+from ..analysis.modes import find_modes
+from ..errors import OutputError, SceneError
 from .scene import load
+from .scene_guess import scene_with_guess
 
 
 def cli_arguments(parser) -> None:
@@ -89,13 +90,19 @@ def _solve_starts_on(sc, modes):
 
 def _write_scenes(path, directory, modes) -> list[Path]:
     """DIR/<scene>_mode<k>.toml for every mode: the scene as written, with that mode's guess."""
+    from ..views.atomic import open_replacing
     src, out = Path(path), Path(directory)
     text = src.read_text(encoding="utf-8")
-    out.mkdir(parents=True, exist_ok=True)
     written = []
-    for k, md in enumerate(modes, 1):
-        target = out / f"{src.stem}_mode{k}.toml"
-        note = f"assembly mode {k} of {len(modes)}, found by `kincas modes {src.name}`"
-        target.write_text(scene_with_guess(text, md, note), encoding="utf-8")
-        written.append(target)
+    target = out
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        for k, md in enumerate(modes, 1):
+            target = out / f"{src.stem}_mode{k}.toml"
+            note = f"assembly mode {k} of {len(modes)}, found by `kincas modes {src.name}`"
+            with open_replacing(target, "w", encoding="utf-8") as f:  # whole or not at all
+                f.write(scene_with_guess(text, md, note))
+            written.append(target)
+    except OSError as e:
+        raise OutputError(f"--write: cannot write {str(target)!r}: {e.strerror or e}") from None
     return written

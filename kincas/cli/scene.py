@@ -25,6 +25,7 @@ in a scene is gathered into one `SceneError` naming the section and the field.
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -101,13 +102,40 @@ class Scene:
 
     def user_values(self, s: Sweep) -> dict[str, np.ndarray]:
         """Reported quantities in the scene's units (degrees where the scene says so)."""
-        from ..core.symbolic import is_angular
+        from ..model.names import is_angular
         return {k: self._to_user(k, v, angle=is_angular(k, self.mechanism)) for k, v in s.values.items()}
 
     def _to_user(self, name, v, angle):
         # A parameter used as an angle stays in the scene's unit inside, so d(Q)/d(p) is
         # already per degree of p; only the quantity's own angle unit is converted here.
         return np.degrees(v) if angle and self.study.deg else np.asarray(v, float)
+
+
+LEAN = 1000  # more unused parameters than this are left out of the model
+_WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_\-]*")
+
+
+def mentioned(doc) -> set[str]:
+    """Every name a parsed TOML value could refer to a parameter by: its tables' keys and the
+    words of its strings (with and without their hyphens: `a-b` may be a name or a - b).
+
+    >>> sorted(mentioned({"links": {"crank": {"length": "a-b"}}, "report": ["d(C.x)/d(r)"]}))
+    ['C', 'a', 'a-b', 'b', 'crank', 'd', 'length', 'links', 'r', 'report', 'x']
+    """
+    out: set[str] = set()
+    todo = [doc]
+    while todo:
+        v = todo.pop()
+        if isinstance(v, dict):
+            out.update(k for k in v if isinstance(k, str))
+            todo.extend(v.values())
+        elif isinstance(v, list):
+            todo.extend(v)
+        elif isinstance(v, str):
+            for w in _WORD.findall(v):
+                out.add(w)
+                out.update(w.split("-"))
+    return out
 
 
 def load(path: str | Path) -> Scene:
@@ -125,7 +153,15 @@ def load(path: str | Path) -> Scene:
 
 
 def loads(text: str) -> Scene:
-    """Parse a scene from TOML text."""
+    """Parse a scene from TOML text (refused before parsing if its entries alone would not
+    fit in memory: TOML's parser takes about 5 kB per `name = value`)."""
+    from . import bounds
+    n = bounds.scene_entries(text)
+    try:
+        bounds.check_total(f"scene: about {n:,} entries (`name = value`)", n * bounds.PER_ENTRY,
+                           "declare fewer (parameters that nothing uses can go)")
+    except ValueError as e:
+        raise SceneError(str(e)) from None
     try:
         doc = tomllib.loads(text.removeprefix("\ufeff"))
     except tomllib.TOMLDecodeError as e:
@@ -242,19 +278,32 @@ class _Reader:
         if self.problems:
             raise SceneError(self.problems)
         try:
-            m = Mechanism(parameters=self.params, ground=ground, links=[lk for lk in links if lk],
+            m = Mechanism(parameters=self.lean_parameters(), ground=ground, links=[lk for lk in links if lk],
                           slides=slides, inputs=inputs, guess=guess, gravity=grav, loads=loads,
                           gears=gears, racks=racks, cams=cams)
         except KincasError as e:
             raise SceneError(e.problems) from None
         if report is None:
-            from ..core.symbolic import default_report
+            from ..model.names import default_report
             report = default_report(m)
         self.check_quantities(m, report, sens)
         study = Study(title=title if isinstance(title, str) else "", units=self.units,
                       inputs=values, rates=rates, accelerations=accs, report=report,
                       sensitivity=sens, written=written, raw=doc, jerks=self.jerks)
         return Scene(m, study)
+
+    def lean_parameters(self) -> dict:
+        """The parameters the model is built with: all of them, unless more than LEAN are
+        named nowhere else in the scene (no field, expression, key or report mentions them):
+        those are left out, since every parameter is a symbol of the model and thousands of
+        unused ones cost seconds and memory for nothing."""
+        if len(self.params) <= LEAN:
+            return self.params
+        used = mentioned({k: v for k, v in self.doc.items() if k != "parameters"})
+        unused = [k for k in self.params if k not in used]
+        if len(unused) <= LEAN:
+            return self.params
+        return {k: v for k, v in self.params.items() if k in used}
 
     def array(self, name) -> list[dict]:
         v = self.doc.get(name, [])
@@ -399,7 +448,7 @@ class _Reader:
         if all(plain_quantity(m, n) for n in [*report, *sens]):
             return
         from ..core.numeric import model_of
-        sym = model_of(m, check=False).sym
+        sym = model_of(m, check=False)
         bad = sym.check_names(report)
         # each `of` name and each `to` name once, under the field they were written in
         of = list(dict.fromkeys(parse_quantity(n)[1] for n in sens))

@@ -36,14 +36,16 @@ def cli_arguments(parser) -> None:
 
 def cli_run(args) -> int:
     """Solve the scene and print (or write) the results."""
-    sc = load(args.scene)
+    from . import bounds
+    with bounds.json_output(args.json):  # the sweep's size is checked as the output will cost
+        sc = load(args.scene)
     wants_files = (args.csv or args.plot or args.animate or args.plot_quantities or args.html
                    or args.svg or args.dxf)
     if wants_files or args.pose is not None or args.evolute or args.centrodes:  # fail before a long solve
         from .outputs import check_outputs
         check_outputs(args, sc.mechanism, len(next(iter(sc.study.inputs.values()))))
     sw = sc.run(progress=progress_for(args))
-    from .numbers import clean  # zero to the solve's accuracy is printed as 0, not as noise
+    from ..views.numbers import clean  # zero to the solve's accuracy is printed as 0, not as noise
     inputs, values = sc.user_inputs(sw), clean(sc.user_values(sw), sc, sw)
     if args.json:
         doc = {"title": sc.study.title, "units": sc.study.units,

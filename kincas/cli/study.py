@@ -114,12 +114,13 @@ def cli_run(args) -> int:
 
     sc = load(args.scene)
     kw = read_section(sc)
+    _check_size(sc, kw, args.workers)
     if args.out and Path(args.out).suffix.lower() not in FORMATS:
         raise OutputError(f"--out: {args.out!r}: expected a file ending in {', '.join(FORMATS)}")
     if args.out:
         _check_writer(Path(args.out).suffix.lower())
     if args.plot:
-        from .mapplot import check_plot
+        from ..views.mapplot import check_plot
         check_plot(args.plot, kw["vary"])
     if args.workers is not None and args.workers < 1:
         raise OutputError(f"--workers: expected a whole number >= 1, got {args.workers}")
@@ -139,10 +140,31 @@ def cli_run(args) -> int:
     if args.out:
         write(r, args.out)
     if args.plot:
-        from .mapplot import plot_map
+        from ..views.mapplot import plot_map
         plot_map(r, args.plot, title=st.title)
-    _summary(st.title, r, args.out)
+    _summary(st.title, r, args.out, args.plot)
     return 0 if all(s == "ok" for s in r.status) else 3
+
+
+def _check_size(sc, kw, workers) -> None:
+    """Refuse, before any design is made, a study that would not fit in memory (one line
+    naming the grid or the samples, the memory, and the ways round)."""
+    from . import bounds
+    from ..analysis.executor import default_workers
+    from ..model.mechanism import solved_unknowns
+    from ..synthesis.expressions import parse
+    grid, n = kw["grid"], kw["samples"]
+    designs = math.prod(grid) if grid is not None else n
+    field = f"[study] grid = {grid}" if grid is not None else f"[study] samples = {n}"
+    poses = max((len(v) for v in sc.study.inputs.values()), default=1)
+    wanted = {q for t in kw["report"] for q in parse(t, "report").quantities}
+    need = bounds.study_bytes(designs, poses, solved_unknowns(sc.mechanism), len(wanted),
+                              len(kw["vary"]), len(kw["report"]), workers or default_workers())
+    try:
+        bounds.check_total(f"{field} ({designs:,} designs x {poses} poses)", need,
+                           "use fewer designs or poses")
+    except ValueError as e:
+        raise OutputError(str(e)) from None
 
 
 def _client(address):
@@ -155,7 +177,7 @@ def _client(address):
         raise OutputError(f"--scheduler: cannot connect to {address!r}: {e}") from None
 
 
-def _summary(title, r: StudyResult, out):
+def _summary(title, r: StudyResult, out, plot=None):
     ok = int(r.ok.sum())
     print(f"{title or 'kincas'}: study of {len(r.status)} designs over {', '.join(r.names)}: "
           f"{ok} solved at every pose, {len(r.status) - ok} not")
@@ -165,8 +187,9 @@ def _summary(title, r: StudyResult, out):
             print(f"  {t}: from {np.nanmin(v):.6g} to {np.nanmax(v):.6g}")
         else:
             print(f"  {t}: no value (no design solved)")
-    if out:
-        print(f"wrote {out}")
+    for path in (out, plot):
+        if path:
+            print(f"wrote {path}")
 
 
 # --- writing the rows ---
@@ -188,19 +211,21 @@ def _has(mod) -> bool:
 
 def write(r: StudyResult, path) -> None:
     """Write the study's rows to .nc, .csv or .parquet (chosen by the suffix)."""
+    from ..views.atomic import replacing
     path = Path(path)
     suffix = path.suffix.lower()
+    if suffix not in FORMATS:
+        raise OutputError(f"--out: {str(path)!r}: expected a file ending in {', '.join(FORMATS)}")
     try:
-        if suffix == ".csv":
-            _write_csv(r, path)
-        elif suffix == ".parquet":
-            _write_parquet(r, path)
-        elif suffix == ".nc":
-            ds = r.to_xarray()
-            engine = "netcdf4" if _has("netCDF4") else "h5netcdf" if _has("h5netcdf") else "scipy"
-            ds.to_netcdf(path, engine=engine)
-        else:
-            raise OutputError(f"--out: {str(path)!r}: expected a file ending in {', '.join(FORMATS)}")
+        with replacing(path) as tmp:  # whole or not at all (kincas/views/atomic.py)
+            if suffix == ".csv":
+                _write_csv(r, tmp)
+            elif suffix == ".parquet":
+                _write_parquet(r, tmp)
+            else:
+                ds = r.to_xarray()
+                engine = "netcdf4" if _has("netCDF4") else "h5netcdf" if _has("h5netcdf") else "scipy"
+                ds.to_netcdf(tmp, engine=engine)
     except OSError as e:
         raise OutputError(f"--out: cannot write {str(path)!r}: {e.strerror or e}") from None
 

@@ -35,7 +35,7 @@ import casadi as ca
 import numpy as np
 
 from .newton import newton
-from .joints import settle_first
+from .turns import nearest, settle, tied, turns, wandered
 from .numeric import Solution, _Call
 from .tolerances import ACCEPT, TOL
 
@@ -240,21 +240,32 @@ def _candidates(model, q, u, p, L, i, target, near, starts):
     (from the reference pose's start, then spread starts), then one in another mode. A
     dyad of two angles gets its circle intersections instead of Newton runs."""
     rows, cols = blocks(model)[i]
+    c = np.where(model.sym.is_length, 1.0 / L, 1.0)
+    far = lambda qs: 0.0 if near is None else float(np.abs((qs - near) * c).sum())  # noqa: E731
     closed = _dyad_solutions(model, q, u, p, L, i, near)
     if closed is not None:
-        c = np.where(model.sym.is_length, 1.0 / L, 1.0)
-        far = lambda qs: 0.0 if near is None else float(np.abs((qs - near) * c).sum())
         found = [(modes(model, model.jac(qs, u, p), L)[0][i], far(qs), qs) for qs in closed]
         yield from ((t[0], t[2]) for t in sorted(found, key=lambda t: (target != 0 and t[0] != target, t[1])))
         return
-    other, taken = None, None
+    # a gear's or rack's angle: its assemblies lie about a turn apart (kincas/core/turns.py),
+    # each start may land on another: every start is run and the nearest of each mode kept
+    ties = bool(tied(model)[cols].any())
+    every = near is not None and ties
+    other, taken, found = None, None, {}
+    before = np.concatenate([c for _, c in blocks(model)[:i]] + [np.zeros(0, int)])
     for s in _starts(model, cols, L, near, starts if len(cols) <= 2 else 4 * starts):
         q0 = q.copy()
         q0[cols] = s
+        if ties:  # the turns that gears and racks want, from the groups before (core/turns.py)
+            q0 = turns(model, q0, u, p, cols=cols, known=set(before.tolist()), start=near is None)
         qs, r = _block_newton(model, q0, u, p, L, i)
         if r > ACCEPT:
             continue
         mode = modes(model, model.jac(qs, u, p), L)[0][i]
+        if every:
+            if (mode == target or mode != 0) and (mode not in found or far(qs) < far(found[mode])):
+                found[mode] = qs
+            continue
         if mode == target:
             yield mode, qs
             taken, target = mode, None  # one per mode
@@ -264,6 +275,7 @@ def _candidates(model, q, u, p, L, i, target, near, starts):
             break
     if other is not None:
         yield other
+    yield from sorted(found.items(), key=lambda t: (target != 0 and t[0] != target, far(t[1])))
 
 
 def assemble(model, u, p, L, want=None, near=None, starts: int = 8) -> Solution | None:
@@ -430,7 +442,7 @@ def first_pose(model, u, p, L, guess) -> Solution:
     """The first pose of a sweep (and where `kincas modes` and `kincas range` start): from
     the guessed points (the assembly nearest them, kincas/core/guessed.py), or without a
     guess group by group in the default modes (above)."""
-    return settle_first(model, _assembled(model, u, p, L, guess), u, p, L)  # gears: angles in (-pi, pi]
+    return settle(model, _assembled(model, u, p, L, guess), u, p, L)  # free angles in (-pi, pi]
 
 
 def _assembled(model, u, p, L, guess) -> Solution:
@@ -442,9 +454,13 @@ def _assembled(model, u, p, L, guess) -> Solution:
             return sol if sol is not None else no_assembly(model, np.zeros(model.nq))
     from .guessed import guessed_start  # it builds on this module
     q0 = guessed_start(model, u, p, L, guess) if guess else model.initial_q(u, p, guess, L)
-    sol = model.newton(q0, u, p, L)
+    sol, grouped = model.newton(q0, u, p, L), None
     if not sol.ok and guess:  # group by group from the guessed pose, then IPOPT if in doubt
-        sol = assemble(model, u, p, L, near=q0) or sol
+        sol = grouped = assemble(model, u, p, L, near=q0) or sol
+    if sol.ok and guess and wandered(model, q0, sol.q):  # a gear's or rack's angle went turns away:
+        targets = {k: np.array(v) for k, v in guess.items()}  # the assembly nearest the guess
+        more = [assemble(model, u, p, L, near=q0)] if grouped is None else []
+        sol = nearest(model, [sol, *more, model.nearest_assembly(q0, u, p, targets, L)], u, p, targets)
     if not sol.ok and ambiguous(model):  # IPOPT: the assembly nearest the guessed points
         sol = model.nearest_assembly(q0, u, p, {k: np.array(v) for k, v in guess.items()}, L)
     return sol

@@ -28,6 +28,8 @@ import time
 import warnings
 from pathlib import Path
 
+from .cancel import WAIT, checkpoint, held
+
 import casadi as ca
 import numpy as np
 
@@ -104,7 +106,7 @@ class Library:
         second finds the library built. A library is written under a temporary name and
         renamed into place, so nobody ever loads a half-written one."""
         key = str(self.path)
-        with _LIBS_LOCK:
+        with held(_LIBS_LOCK):  # Ctrl-C heard while another thread compiles
             if key not in _LIBS:
                 if not self.path.exists():
                     self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -131,14 +133,38 @@ class Library:
             src, out = Path(tmp) / "k.c", Path(tmp) / "k.so"
             src.write_text(self.source)
             for flags in (_FLAGS, _PLAIN):  # a compiler that lacks a flag still gets a try
-                done = subprocess.run([self.cc, *flags, str(src), "-o", str(out), "-lm"],
-                                      capture_output=True, text=True, timeout=600)
-                if done.returncode == 0:
+                code, err = _run([self.cc, *flags, str(src), "-o", str(out), "-lm"], timeout=600)
+                if code == 0:
                     break
-            if done.returncode != 0:
-                raise RuntimeError(f"{self.cc} failed: {done.stderr.strip()[-400:]}")
+            if code != 0:
+                raise RuntimeError(f"{self.cc} failed: {err.strip()[-400:]}")
             os.replace(out, self.path)  # atomic: other processes see all of it or nothing
         self.times["compile"] = time.perf_counter() - t0
+
+
+def _run(cmd, timeout: float) -> tuple[int, str]:
+    """(exit status, standard error) of `cmd`; killed on Ctrl-C, even from a worker thread
+    (kincas/core/cancel.py: a compile can take seconds, the exit must not wait for it)."""
+    group = os.name == "posix"  # the compiler's own children (cc1, as) go with it
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=group)
+    end = time.monotonic() + timeout
+    try:
+        while True:
+            try:
+                _, err = proc.communicate(timeout=WAIT)
+                return proc.returncode, err
+            except subprocess.TimeoutExpired:
+                checkpoint()
+                if time.monotonic() > end:
+                    raise
+    except BaseException:
+        try:
+            os.killpg(proc.pid, 9) if group else proc.kill()
+        except OSError:
+            pass
+        proc.communicate()
+        raise
 
 
 class _file_lock:
@@ -149,8 +175,17 @@ class _file_lock:
 
     def __enter__(self):
         self.fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
-        if fcntl is not None:
-            fcntl.flock(self.fd, fcntl.LOCK_EX)
+        try:
+            while fcntl is not None:  # another process compiles: wait, hearing Ctrl-C
+                try:
+                    fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                    break
+                except BlockingIOError:
+                    checkpoint()
+                    time.sleep(WAIT / 2)
+        except BaseException:
+            os.close(self.fd)
+            raise
         return self
 
     def __exit__(self, *exc):
@@ -274,7 +309,7 @@ class Backend:
         """The loaded library to use for n poses, or None for the virtual machine."""
         if self.lib is not None or self.failed or self.compile is False or compiling_disabled():
             return self.lib
-        with self._lock:  # one thread builds; the others wait and then use it
+        with held(self._lock):  # one thread builds; the others wait (hearing Ctrl-C), then use it
             if self.lib is not None or self.failed:
                 return self.lib
             try:  # a failed build must never fail a user's solve

@@ -1,8 +1,8 @@
 """Residuals, quantities and placement of gears, racks, cams and relative angle inputs.
 
 Called from `Symbolic._build` (`equations`), as one of Symbolic's quantity extensions
-(`check`, `expression`), from `Model.initial_q` (`relative_start`, `place`) and the first pose of a sweep (`settle_first`,
-`first_pose_problems`). Every equation is written in lengths, so that Newton's residual,
+(`check`, `expression`), from `Model.initial_q` (`relative_start`, `place`) and the first
+pose of a sweep (`first_pose_problems`). Every equation is written in lengths, so that Newton's residual,
 relative to the mechanism's size, means the same for them as for loop closures:
 
 - relative input "A/B": l_A (theta_A - theta_B - u) = 0, l_A a length of link A;
@@ -13,8 +13,9 @@ relative to the mechanism's size, means the same for them as for loop closures:
   frame, mapped to the world by that frame: knife edge F - P = 0; roller C - (P + rho N) = 0;
   flat face (link x axis d through o): d x (P - o) = 0 and d x T = 0.
 
-Angles stay continuous (unknowns are followed by continuation); each starts in (-pi, pi] at
-the first pose, which is what gears and racks relate.
+Angles stay continuous (unknowns are followed by continuation). At the first pose an angle
+whose turn is free starts in (-pi, pi]; one that a gear, rack or relative input ties to the
+inputs takes the turn its relation gives (kincas/core/turns.py).
 
 >>> import kincas
 >>> from kincas.model.joints import Gear
@@ -36,6 +37,7 @@ from ..errors import ModelError
 from ..model import spline
 from ..model.joints import Circle, split_relative
 from ..model.mechanism import GROUND, as_param
+from .turns import turns
 from ..model.names import ANGULAR_ATTRS  # noqa: F401  (cam quantities: angles, kept here too)
 
 _PRESSURE_FLOOR = 1e-9  # a follower slower than this times the inputs' speed scale stands
@@ -246,7 +248,9 @@ def _profile_samples(c, data, n=1440):
 def place(model, q, u, p):
     """Start each cam's contact parameter at the profile point nearest its follower (knife,
     roller's centre less its radius), or for a flat face at the profile point farthest
-    towards the face; then every angle unknown in (-pi, pi]."""
+    towards the face; then every angle whose turn is free in (-pi, pi], and the angles that
+    gears, racks and relative inputs tie to others at the turns their relations give them
+    (kincas/core/turns.py)."""
     sym = model.sym
     if sym.mech.cams:
         raw = np.asarray(_cam_function(model)(q, u, p)).ravel()
@@ -269,30 +273,7 @@ def place(model, q, u, p):
             else:
                 best = int(np.argmin(np.hypot(*(P + rho * N - f_loc).T)))
             q[index[f"{c.name}.phi"]] = phi[best]
-    angles = ~sym.is_length
-    q[angles] = np.mod(q[angles] + math.pi, 2 * math.pi) - math.pi
-    return q
-
-
-def settle_first(model, sol, u, p, L):
-    """Gears and racks relate absolute angles, each taken in (-pi, pi] at the first pose:
-    where Newton ended with one outside, wrap it and solve again (a few times at most)."""
-    m = model.sym.mech
-    if not (m.gears or m.racks) or not sol.ok:
-        return sol
-    angles = np.array([k == "angle" and not name.endswith(".phi") for name, k in model.sym.unknowns])
-    for _ in range(4):
-        q = sol.q.copy()
-        w = np.mod(q[angles] + math.pi, 2 * math.pi) - math.pi
-        w[w == -math.pi] = math.pi
-        if np.array_equal(w, q[angles]):
-            return sol
-        q[angles] = w
-        new = model.newton(q, u, p, L)
-        if not new.ok:
-            return sol
-        sol = new
-    return sol
+    return turns(model, q, u, p)  # free angles in (-pi, pi], tied ones where their relations say
 
 
 # --- checks at the first solved pose ---

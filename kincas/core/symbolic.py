@@ -33,7 +33,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import GROUND, Mechanism, as_param
-from ..model.names import LINK_Q, POINT_Q, SENS, SLIDE_Q, is_angular, parse_quantity  # noqa: F401
+from ..model.names import LINK_Q, POINT_Q, SENS, SLIDE_Q, default_report, is_angular, parse_quantity  # noqa: F401
 from . import joints as _joints
 
 # --- quantity names (kincas/model/names.py: parsed without the solver) ---
@@ -54,11 +54,6 @@ def needs_jerk(name: str) -> bool:
     if kind == "sens":
         return needs_jerk(a)
     return b in ("jx", "jy", "jerk")
-
-
-def default_report(m: Mechanism) -> list[str]:
-    """Positions of all moving points and angles of all links."""
-    return [f"{p}.{c}" for p in m.moving_points for c in "xy"] + [f"{lk.name}.angle" for lk in m.links]
 
 
 class Symbolic:
@@ -182,7 +177,10 @@ class Symbolic:
             if kind == "plain" and self.position_expr(a, b)[0] is None and self.extra(n)[0]:
                 out += [f"{where}: {n!r}: {msg}" for msg in self.extra(n)[1]]
                 continue
-            if kind == "sens":
+            if kind == "sens" and parse_quantity(a)[0] == "sens":  # d2Q/dp2: not built
+                out.append(f"{where}: {n!r}: a sensitivity of a sensitivity is not supported "
+                           f"(d(Q)/d(p) takes a quantity Q, not d(...)/d(...))")
+            elif kind == "sens":
                 out += self.check_names([a], where)
                 if b not in self.pnames:
                     out.append(f"{where}: {n!r}: unknown parameter {b!r}")

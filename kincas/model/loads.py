@@ -18,6 +18,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from .values import _pair, as_number
+
 # --- declarations ---
 
 
@@ -89,8 +91,7 @@ class Load:
         >>> Load.force("C", (0, -9.81)).value
         (0, -9.81)
         """
-        fx, fy = force
-        return cls("force", at=point, value=(fx, fy))
+        return cls("force", at=point, value=_pair(force, f"[[loads]] force at {point}: force"))
 
     @classmethod
     def torque(cls, link: str, torque) -> "Load":
@@ -110,7 +111,7 @@ class Load:
         >>> Load.torque("rocker", "T").at
         'rocker'
         """
-        return cls("torque", at=link, value=torque)
+        return cls("torque", at=link, value=as_number(torque))
 
     @classmethod
     def spring(cls, a: str, b: str, stiffness, free_length) -> "Load":
@@ -130,7 +131,8 @@ class Load:
         >>> Load.spring("A", "P", 200, 40).stiffness
         200
         """
-        return cls("spring", points=(a, b), stiffness=stiffness, free_length=free_length)
+        return cls("spring", points=(a, b), stiffness=as_number(stiffness),
+                   free_length=as_number(free_length))
 
     @property
     def link(self) -> str:

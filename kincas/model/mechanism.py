@@ -27,14 +27,17 @@ from typing import Iterable, Mapping
 from ..errors import ModelError
 from . import joints as _joints
 from .loads import Load, check_loads
-from .parts import Input, Link, Num, Param, Slide, _pair, as_param  # noqa: F401  (the parts; their old home)
+from .parts import Input, Link, Num, Param, Slide, _pair, _table, as_number, as_param, is_number  # noqa: F401
 
 GROUND = "ground"
-# How a mechanism whose count falls short learns its redundant equations: kincas.core
-# installs its rank test here when it is imported (declarations never import the solver).
+# How a mechanism whose count falls short learns its redundant equations: the rank test of
+# kincas.core, handed over by the package's face (`import kincas` calls use_rank_test);
+# declarations never import the solver, and the solver never edits the declarations.
 _rank_decision = None
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
 NAME_RULE = "a name starts with an ASCII letter or _, then ASCII letters, digits, _ or -"
+RESERVED = (f'"{GROUND}" is reserved: it names the fixed frame (a slide\'s `along = "{GROUND}"`, '
+            f'an angle relative to it, "crank/{GROUND}"); choose another name')
 
 
 # --- the structure of the chain: a spanning tree of revolute joints ---
@@ -149,18 +152,22 @@ class Mechanism:
     structure: Structure = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        def items(v):
-            return tuple((v.items() if isinstance(v, Mapping) else v))
-        object.__setattr__(self, "parameters", tuple((k, float(v)) for k, v in items(self.parameters)))
-        object.__setattr__(self, "ground", tuple((k, _pair(v)) for k, v in items(self.ground)))
-        object.__setattr__(self, "guess", tuple((k, _pair(v)) for k, v in items(self.guess)))
-        object.__setattr__(self, "links", tuple(self.links))
-        object.__setattr__(self, "slides", tuple(self.slides))
-        object.__setattr__(self, "inputs", tuple(self.inputs))
-        for k in ("gears", "racks", "cams"):
-            object.__setattr__(self, k, tuple(getattr(self, k)))
-        object.__setattr__(self, "gravity", _pair(self.gravity))
-        object.__setattr__(self, "loads", tuple(self.loads))
+        params, bad = [], []
+        for k, v in _table(self.parameters, "parameters", "number"):
+            v = as_number(v)
+            if is_number(v):
+                params.append((k, float(v)))
+            else:
+                bad.append(f"[parameters] {k}: expected a number, got {v!r}")
+        if bad:
+            raise ModelError(bad)
+        object.__setattr__(self, "parameters", tuple(params))
+        for f in ("ground", "guess"):
+            object.__setattr__(self, f, tuple((k, _pair(v, f"[{f}] {k}")) for k, v in _table(getattr(self, f), f)))
+        for f, kind in (("links", Link), ("slides", Slide), ("inputs", Input), ("loads", Load),
+                        ("gears", _joints.Gear), ("racks", _joints.Rack), ("cams", _joints.Cam)):
+            object.__setattr__(self, f, _parts(getattr(self, f), f, kind))
+        object.__setattr__(self, "gravity", _pair(self.gravity, "gravity"))
         problems = _check(self)
         if problems:
             raise ModelError(problems)
@@ -189,7 +196,7 @@ class Mechanism:
         """
         if not needs_rank_test(self):
             return 0
-        if _rank_decision is None:  # pragma: no cover - kincas/__init__ installs it
+        if _rank_decision is None:  # pragma: no cover - kincas/__init__ hands it over
             raise ModelError("[inputs]: the rank test needs kincas.core (import kincas)")
         return _rank_decision(self)
 
@@ -353,15 +360,6 @@ class Mechanism:
             extent = max(extent, math.hypot(max(xs) - min(xs), max(ys) - min(ys)))
         return extent if extent > 0 else 1.0
 
-    def _repr_svg_(self) -> str | None:
-        """Jupyter's display: the mechanism drawn at its first pose (`kincas.notebook`; the
-        drawing solves it, so it is built only when a notebook asks)."""
-        try:
-            from ..notebook import mechanism_svg
-            return mechanism_svg(self)
-        except Exception:  # a display must never raise: Jupyter falls back to repr
-            return None
-
     # --- new values ---
     def with_parameters(self, **values: float) -> "Mechanism":
         """A new mechanism with some parameters changed.
@@ -382,9 +380,11 @@ class Mechanism:
         >>> m.with_parameters(r=3).size(), m.size()
         (3.0, 2.0)
         """
-        unknown = [k for k in values if k not in self.param_values]
-        if unknown:
-            raise ModelError([f"[parameters] {k}: no such parameter" for k in unknown])
+        problems = [f"[parameters] {k}: no such parameter" for k in values if k not in self.param_values]
+        problems += [f"[parameters] {k}: expected a number, got {v!r}" for k, v in values.items()
+                     if not is_number(v)]
+        if problems:
+            raise ModelError(problems)
         return replace(self, parameters={**self.param_values, **{k: float(v) for k, v in values.items()}})
 
     def with_guess(self, **points: tuple[float, float]) -> "Mechanism":
@@ -412,19 +412,70 @@ class Mechanism:
 # --- validation: gather every problem, name the section and the field ---
 
 
-def _check(m: Mechanism) -> list[str]:
-    out: list[str] = []
-    params = m.param_values
+def _parts(v, field: str, kind: type) -> tuple:
+    """`v` as a tuple of `kind` (kincas.Link, ...); ModelError naming `field` for anything
+    else (a name given where the part itself is wanted)."""
+    if isinstance(v, (str, bytes, Mapping)) or not isinstance(v, Iterable):
+        raise ModelError(f"{field}: expected a list of kincas.{kind.__name__}, got {v!r:.80}")
+    items = tuple(v)
+    bad = [f"{field}[{i}]: expected a kincas.{kind.__name__}, got {x!r:.80}"
+           for i, x in enumerate(items) if not isinstance(x, kind)]
+    if bad:
+        raise ModelError(bad)
+    return items
 
+
+def _number_check(params, out: list[str]):
+    """num(where, v): appends to `out` what is wrong with a number or a parameter's name."""
     def num(where: str, v):
         p = as_param(v)
         if p is not None:
             if p.name not in params:
                 out.append(f"{where}: unknown parameter {p.name!r}")
-        elif isinstance(v, bool) or not isinstance(v, (int, float)):
+        elif not is_number(v):
             out.append(f"{where}: expected a number or a parameter's name, got {v!r}")
         elif not math.isfinite(v):
             out.append(f"{where}: {v} is not a finite number")
+    return num
+
+
+def _guess_problems(guess, moving: set, gnames: set, num, out: list[str]) -> None:
+    for p, (x, y) in guess:
+        if p not in moving:
+            what = "is a ground point (fixed)" if p in gnames else "is not a point of any link"
+            out.append(f"[guess] {p}: {what}")
+        num(f"[guess] {p}", x), num(f"[guess] {p}", y)
+
+
+def check_guess(m: Mechanism, guess) -> tuple:
+    """A guess given to one call (`sweep(..., guess=)`) checked as the mechanism's own is:
+    its (point, (x, y)) items, or ModelError naming every unknown point and every value
+    that is not a finite number or a parameter's name.
+
+    >>> m = Mechanism(ground={"O": (0, 0)}, links=[Link.bar("crank", "O", "A", 1)],
+    ...               inputs=[Input.angle("crank")])
+    >>> check_guess(m, {"A": (0, 1)})
+    (('A', (0, 1)),)
+    >>> check_guess(m, {"Z": (0, float("nan"))})
+    Traceback (most recent call last):
+    ...
+    kincas.errors.ModelError: 2 problems:
+      [guess] Z: is not a point of any link
+      [guess] Z: nan is not a finite number
+    """
+    items = tuple((k, _pair(v, f"[guess] {k}")) for k, v in _table(guess, "guess"))
+    out: list[str] = []
+    _guess_problems(items, set(m.moving_points), set(m.ground_points),
+                    _number_check(m.param_values, out), out)
+    if out:
+        raise ModelError(out)
+    return items
+
+
+def _check(m: Mechanism) -> list[str]:
+    out: list[str] = []
+    params = m.param_values
+    num = _number_check(params, out)
 
     for k, v in m.parameters:
         if not _NAME.match(k):
@@ -433,14 +484,18 @@ def _check(m: Mechanism) -> list[str]:
             out.append(f"[parameters] {k}: {v} is not a finite number")
     gnames = set()
     for g, (x, y) in m.ground:
-        if g == GROUND or not _NAME.match(g):
+        if g == GROUND:
+            out.append(f"[ground] {g}: {RESERVED}")
+        elif not isinstance(g, str) or not _NAME.match(g):
             out.append(f"[ground] {g}: not a valid point name ({NAME_RULE})")
         gnames.add(g)
         num(f"[ground] {g}", x), num(f"[ground] {g}", y)
     lnames: set[str] = set()
     for lk in m.links:
         where = f"[links] {lk.name}"
-        if lk.name == GROUND or not _NAME.match(lk.name):
+        if lk.name == GROUND:
+            out.append(f"{where}: {RESERVED}")
+        elif not isinstance(lk.name, str) or not _NAME.match(lk.name):
             out.append(f"{where}: not a valid link name ({NAME_RULE})")
         if lk.name in lnames:
             out.append(f"{where}: declared twice")
@@ -478,6 +533,9 @@ def _check(m: Mechanism) -> list[str]:
     keys = set()
     for i, inp in enumerate(m.inputs):
         where = f"[[inputs]] {i + 1}"
+        if not isinstance(inp.target, str):
+            out.append(f"{where}: {inp.kind}: expected a name, got {inp.target!r}")
+            continue
         ok = {"angle": lnames, "slide": snames, "parameter": set(params)}.get(inp.kind)
         rel = _joints.split_relative(inp.target) if inp.kind == "angle" else None
         if rel is not None:  # "A/B": link A relative to body B
@@ -496,11 +554,7 @@ def _check(m: Mechanism) -> list[str]:
         if inp.key in keys:
             out.append(f"{where}: {inp.kind}: {inp.target!r} is driven twice")
         keys.add(inp.key)
-    for p, (x, y) in m.guess:
-        if p not in moving:
-            what = "is a ground point (fixed)" if p in gnames else "is not a point of any link"
-            out.append(f"[guess] {p}: {what}")
-        num(f"[guess] {p}", x), num(f"[guess] {p}", y)
+    _guess_problems(m.guess, moving, gnames, num, out)
     out += _joints.problems(m, lnames, snames, num)
     out += check_loads(m, num)
     if out:
@@ -517,6 +571,27 @@ def _check(m: Mechanism) -> list[str]:
 def counted_freedoms(m: Mechanism) -> int:
     """Degrees of freedom by counting: unknowns minus equations, plus driven parameters."""
     return m.structure.mobility + sum(inp.kind == "parameter" for inp in m.inputs)
+
+
+def solved_unknowns(m: Mechanism) -> int:
+    """The unknowns the solver finds at each pose: the structure's coordinates less the link
+    angles that inputs drive (a driven angle is given, not solved for); the size of q.
+
+    >>> m = Mechanism(ground={"O": (0, 0)}, links=[Link.bar("crank", "O", "A", 1)],
+    ...               inputs=[Input.angle("crank")])
+    >>> m.structure.n_unknowns, solved_unknowns(m)
+    (1, 0)
+    """
+    links = {lk.name for lk in m.links}
+    driven = {i.target for i in m.inputs if i.kind == "angle" and i.target in links}
+    return m.structure.n_unknowns - len(driven)
+
+
+def use_rank_test(decide) -> None:
+    """Let `Mechanism.redundant` ask `decide(mechanism) -> int` (the core's rank test, given by
+    `import kincas`) where counting cannot tell the redundant equations."""
+    global _rank_decision
+    _rank_decision = decide
 
 
 def needs_rank_test(m: Mechanism) -> bool:

@@ -9,9 +9,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping, Union
+from typing import Union
 
 from .loads import Inertia
+from .values import _pair, _table, as_number, is_number  # noqa: F401  (their old home)
 
 # --- numbers that may name a parameter ---
 
@@ -50,11 +51,6 @@ def as_param(v: Num) -> Param | None:
     if isinstance(v, str):
         return Param(v)
     return None
-
-
-def _pair(v) -> tuple[Num, Num]:
-    x, y = v
-    return (x, y)
 
 
 # --- bodies, slides, inputs ---
@@ -98,11 +94,13 @@ class Link:
 
     def __init__(self, name: str, points, two_point: bool = False, *, mass: Num = 0.0,
                  inertia: Num = 0.0, cg=None):
-        items = points.items() if isinstance(points, Mapping) else points
+        where = f"[links] {name}"
+        items = _table(points, f"{where}: points")
         object.__setattr__(self, "name", name)
-        object.__setattr__(self, "points", tuple((p, _pair(xy)) for p, xy in items))
+        object.__setattr__(self, "points", tuple((p, _pair(xy, f"{where}: points.{p}")) for p, xy in items))
         object.__setattr__(self, "two_point", two_point)
-        object.__setattr__(self, "inertial", Inertia(mass, inertia, None if cg is None else _pair(cg)))
+        object.__setattr__(self, "inertial", Inertia(as_number(mass), as_number(inertia),
+                                                     None if cg is None else _pair(cg, f"{where}: cg")))
 
     @classmethod
     def bar(cls, name: str, p: str, q: str, length: Num, **inertia) -> "Link":
@@ -195,7 +193,8 @@ class Slide:
     name: str = ""
 
     def __post_init__(self):
-        object.__setattr__(self, "through", _pair(self.through))
+        object.__setattr__(self, "through", _pair(self.through, f"[[slides]] {self.name or self.point}: line.through"))
+        object.__setattr__(self, "angle", as_number(self.angle))
         if not self.name:
             object.__setattr__(self, "name", self.point)
 

@@ -51,21 +51,31 @@ class Segment:
     law: str = "cycloidal"
 
 
-def law(name: str, x):
-    """(y, y', y'') of a normalized rise from 0 to 1 over x in [0, 1].
+def law(name: str, x, jerk: bool = False):
+    """(y, y', y'') of a normalized rise from 0 to 1 over x in [0, 1]; with `jerk`, y''' too
+    (the jerk per unit of x cubed).
 
     >>> [round(float(v), 12) for v in law("polynomial345", 0.5)]
     [0.5, 1.875, 0.0]
+    >>> float(law("polynomial345", 0.5, jerk=True)[3])
+    -30.0
     """
     x = np.asarray(x, float)
+    out = _law(name, x)
+    return out if jerk else out[:3]
+
+
+def _law(name: str, x):
     if name == "cycloidal":
         w = TURN * x
-        return x - np.sin(w) / TURN, 1 - np.cos(w), TURN * np.sin(w)
+        return x - np.sin(w) / TURN, 1 - np.cos(w), TURN * np.sin(w), TURN ** 2 * np.cos(w)
     if name == "harmonic":
-        return (1 - np.cos(math.pi * x)) / 2, math.pi * np.sin(math.pi * x) / 2, math.pi ** 2 * np.cos(math.pi * x) / 2
+        a = math.pi * x
+        return ((1 - np.cos(a)) / 2, math.pi * np.sin(a) / 2, math.pi ** 2 * np.cos(a) / 2,
+                -math.pi ** 3 * np.sin(a) / 2)
     if name == "polynomial345":
         return (10 * x ** 3 - 15 * x ** 4 + 6 * x ** 5, 30 * x ** 2 - 60 * x ** 3 + 30 * x ** 4,
-                60 * x - 180 * x ** 2 + 120 * x ** 3)
+                60 * x - 180 * x ** 2 + 120 * x ** 3, 60 - 360 * x + 360 * x ** 2)
     raise ValueError(f"law: {name!r} is not one of {list(LAWS)}")
 
 
@@ -113,7 +123,8 @@ def problems(segments, base_radius, roller_radius, offset, samples) -> list[str]
 @dataclass
 class CamDesign:
     """A designed cam, every array over the cam angles `theta` (radians, from 0):
-    follower displacement `s` and its derivatives `ds`, `dds` per radian of cam angle;
+    follower displacement `s` and its derivatives `ds`, `dds`, `ddds` (the jerk) per radian of
+    cam angle (times the cam's speed to that power for time derivatives);
     `pitch` (N x 2) and `profile` (N x 2) in the cam's frame; `pressure` (radians, acute);
     `rho_pitch` and `rho_profile` (radii of curvature, positive where convex; inf where
     straight); `undercut` (bool)."""
@@ -131,6 +142,7 @@ class CamDesign:
     base_radius: float
     roller_radius: float
     offset: float
+    ddds: np.ndarray | None = None
 
     @property
     def s0(self) -> float:
@@ -146,9 +158,9 @@ class CamDesign:
         return phi, r[order]
 
 
-def motion(segments, theta):
-    """(s, s', s'') at cam angles theta (radians, in [0, 2 pi))."""
-    s, ds, dds = (np.zeros_like(theta) for _ in range(3))
+def motion(segments, theta, jerk: bool = False):
+    """(s, s', s'') at cam angles theta (radians, in [0, 2 pi)); with `jerk`, s''' too."""
+    s, ds, dds, ddds = (np.zeros_like(theta) for _ in range(4))
     start, height = 0.0, 0.0
     for sg in segments:
         beta = math.radians(sg.angle)
@@ -156,14 +168,15 @@ def motion(segments, theta):
         if sg.motion == "dwell":
             s[inside] = height
         else:
-            y, y1, y2 = law(sg.law, (theta[inside] - start) / beta)
+            y, y1, y2, y3 = law(sg.law, (theta[inside] - start) / beta, jerk=True)
             sign = 1.0 if sg.motion == "rise" else -1.0
             s[inside] = height + sign * sg.lift * y
             ds[inside] = sign * sg.lift * y1 / beta
             dds[inside] = sign * sg.lift * y2 / beta ** 2
+            ddds[inside] = sign * sg.lift * y3 / beta ** 3
             height += sign * sg.lift
         start += beta
-    return s, ds, dds
+    return (s, ds, dds, ddds) if jerk else (s, ds, dds)
 
 
 def design_cam(segments, base_radius: float, roller_radius: float = 0.0, offset: float = 0.0,
@@ -177,7 +190,7 @@ def design_cam(segments, base_radius: float, roller_radius: float = 0.0, offset:
     if bad:
         raise ValueError("\n".join(bad))
     theta = np.arange(samples) * (TURN / samples)
-    s, ds, dds = motion(segments, theta)
+    s, ds, dds, ddds = motion(segments, theta, jerk=True)
     e, rho = offset, roller_radius
     s0 = math.sqrt((base_radius + rho) ** 2 - e * e)
     c, si = np.cos(theta), np.sin(theta)
@@ -197,4 +210,4 @@ def design_cam(segments, base_radius: float, roller_radius: float = 0.0, offset:
     pressure = np.arctan(np.abs(ds - e) / (s0 + s))
     undercut = (rho_p > 0) & (rho_p <= rho) if rho > 0 else np.zeros_like(theta, dtype=bool)
     return CamDesign(theta, s, ds, dds, pitch, profile, pressure, rho_p, rho_p - rho, undercut,
-                     float(base_radius), float(rho), float(e))
+                     float(base_radius), float(rho), float(e), ddds)

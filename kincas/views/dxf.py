@@ -84,7 +84,7 @@ def dxf_document(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=N
     for name, a in pic.paths.items():
         for run in _runs(a):
             msp.add_lwpolyline([tuple(q) for q in run], dxfattribs={"layer": "paths"})
-    curves = pic.joint_curves(i)  # gears, racks, cams (cli/draw_joints.py): layer "joints"
+    curves = pic.joint_curves(i)  # gears, racks, cams (views/draw_joints.py): layer "joints"
     if curves:
         doc.layers.add("joints")
     for label, body, a in curves:
@@ -97,4 +97,7 @@ def dxf_document(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=N
 
 def write_dxf(path, m: Mechanism, sweep: Sweep, pose: int | None = None, **kw) -> None:
     """Write `dxf_document(m, sweep, pose, **kw)` to `path`."""
-    dxf_document(m, sweep, pose, **kw).saveas(str(path))
+    from .atomic import replacing
+    doc = dxf_document(m, sweep, pose, **kw)
+    with replacing(path) as tmp:
+        doc.saveas(tmp)

@@ -58,7 +58,8 @@ def plot_map(r, path, title: str = "") -> None:
         fig.suptitle(title)
     fig.tight_layout()
     try:
-        fig.savefig(path, dpi=110)
+        from .atomic import savefig
+        savefig(fig, path, dpi=110)
     except OSError as e:
         raise OutputError(f"--plot: cannot write {str(path)!r}: {e.strerror or e}") from None
     finally:
