@@ -31,13 +31,9 @@ def mistakes(c):
         ("a guess of an unknown point", lambda: kincas.sweep(m, U, guess={"nowhere": (0.0, 0.0)})),
         ("a NaN input", lambda: kincas.sweep(m, {k: np.full(3, np.nan) for k in c.keys})),
         ("inputs of different lengths", lambda: kincas.sweep(m, {k: U[k][: 2 + i] for i, k in enumerate(c.keys)}) if len(c.keys) > 1 else kincas.sweep(m, {key: U[key], "x": U[key][:2]})),
+        ("an input given as text", lambda: kincas.sweep(m, {k: "fast" for k in c.keys})),
         ("a negative length", lambda: m.with_parameters(**{p: -1.0 for p, _ in m.parameters if p.startswith(("len_", "m_")) and p not in c.keys})),
     ]
-
-
-def raw_today(c):
-    """Mistakes that raise a raw exception today ([14] item 14 is on them)."""
-    return [("an input given as text", lambda: kincas.sweep(c.mech, {k: "fast" for k in c.keys}))]
 
 
 def failures_of(family, which):
@@ -60,9 +56,3 @@ def test_wrong_calls_raise_kincas_errors(family):
     failures = failures_of(family, mistakes)
     assert not failures, "\n".join(failures)
 
-
-@pytest.mark.xfail(strict=False, reason="[14] item 14: Python misuse raising raw exceptions")
-@pytest.mark.parametrize("family", rm.FAMILIES[:3])
-def test_wrong_calls_that_raise_raw_exceptions_today(family):
-    failures = failures_of(family, raw_today)
-    assert not failures, "\n".join(failures)
