@@ -31,10 +31,12 @@ import numpy as np
 
 import kincas
 from kincas import Input, Link, Load, Mechanism, Slide
+from kincas.model import Gear
 
 FAMILIES = ("fourbar_grashof", "fourbar_nongrashof", "slider_crank", "slider_driven",
             "inverted_slider", "quick_return", "pin_in_slot", "watt", "stephenson",
-            "triad", "dyad_chain", "five_bar", "actuator")
+            "triad", "dyad_chain", "five_bar", "actuator", "geared_five_bar")
+GEARED = ("geared_five_bar",)  # kincas refuses reactions with gears (the Newton-Euler test skips them)
 COND_MIN = 0.03  # smallest singular value of the normalised Jacobian kept over a sweep
 
 
@@ -61,6 +63,8 @@ class Spec:
     links: list  # ("bar", name, P, Q) or ("plate", name, [points])
     slides: list = field(default_factory=list)  # (name, point, along, global angle, t)
     inputs: list = field(default_factory=list)  # ("angle", link) / ("slide", name) / ("parameter", bar)
+    gears: list = field(default_factory=list)  # (link 1, link 2, r1, r2): external mesh, ground carrier
+    origins: dict = field(default_factory=dict)  # plate -> the point at its frame's origin
 
 
 def _pt(rng, c, r0, r1):
@@ -213,7 +217,7 @@ def _dyad_chain(rng):
     sp.family = "dyad_chain"
     sp.links[2] = ("plate", "rocker", ["D", "C", "R1"])
     sp.pos["R1"] = _pt(rng, sp.pos["C"], 0.2, 0.6)
-    last, lastpt = "rocker", "R1"
+    lastpt = "R1"
     for i in (1, 2):
         g = f"H{i}"
         sp.ground[g] = _pt(rng, sp.pos[lastpt], 0.7, 1.2)
@@ -222,7 +226,7 @@ def _dyad_chain(rng):
         nxt = f"R{i + 1}"
         sp.pos[nxt] = _pt(rng, sp.pos[j], 0.2, 0.6)
         sp.links += [("bar", f"arm{i}", lastpt, j), ("plate", f"out{i}", [g, j, nxt])]
-        last, lastpt = f"out{i}", nxt
+        lastpt = nxt
     return sp
 
 
@@ -251,6 +255,19 @@ def _actuator(rng):
                 inputs=[("parameter", "jack")])
 
 
+def _geared_five_bar(rng):
+    """A five-bar whose two cranks are gears in mesh (one input): gear centres A and E."""
+    A, E = (0.0, 0.0), (1.0, 0.0)
+    lam = rng.uniform(0.3, 0.7)
+    B, D = _pt(rng, A, 0.3, 0.7), _pt(rng, E, 0.3, 0.7)
+    C = _dyad_point(rng, B, D)
+    return Spec("geared_five_bar", {"A": A, "E": E}, {"B": B, "D": D, "C": C},
+                [("plate", "gear1", ["A", "B"]), ("bar", "link1", "B", "C"),
+                 ("plate", "gear2", ["E", "D"]), ("bar", "link2", "D", "C")],
+                inputs=[("angle", "gear1")], gears=[("gear1", "gear2", lam, 1 - lam)],
+                origins={"gear1": "A", "gear2": "E"})
+
+
 DRAW = {"fourbar_grashof": lambda r: _fourbar(r, True),
         "fourbar_nongrashof": lambda r: _fourbar(r, False),
         "slider_crank": lambda r: _slider_crank(r, False),
@@ -258,7 +275,7 @@ DRAW = {"fourbar_grashof": lambda r: _fourbar(r, True),
         "inverted_slider": _inverted, "quick_return": _quick_return,
         "pin_in_slot": _pin_in_slot, "watt": _watt, "stephenson": _stephenson,
         "triad": _triad, "dyad_chain": _dyad_chain, "five_bar": _five_bar,
-        "actuator": _actuator}
+        "actuator": _actuator, "geared_five_bar": _geared_five_bar}
 
 
 # --------------------------------------------------------------------------- normalised model
@@ -284,6 +301,8 @@ class Frames:
                 _, name, pts = lk
                 c = np.mean([allpos[p] for p in pts], axis=0)
                 o = c + rng.uniform(-0.3, 0.3, 2)
+                if name in sp.origins:  # a gear: its centre is its frame's origin
+                    o = np.asarray(allpos[sp.origins[name]], float)
                 th = rng.uniform(-math.pi, math.pi)
                 R = rot(-th)
                 self.local[name] = {p: R @ (np.asarray(allpos[p]) - o) for p in pts}
@@ -396,6 +415,10 @@ class Frames:
                 parts.append((i, np.array([-nrm[0], -nrm[1], -nrm @ dth - d @ w])))
             add(nrm @ w, parts)
             self._slide_cache[name] = (P, tp, tg, d, nrm, w)
+        for g1, g2, r1, r2 in self.sp.gears:  # external mesh: theta2 + k theta1 stays as drawn
+            i1, i2, k = self.names.index(g1), self.names.index(g2), r1 / r2
+            add(z[3 * i2 + 2] + k * z[3 * i1 + 2] - (self.theta0[g2] + k * self.theta0[g1]),
+                [(i1, np.array([0, 0, k])), (i2, np.array([0, 0, 1.0]))])
         for k, (kind, target) in enumerate(self.sp.inputs):
             if kind == "angle":
                 add(self.frame(z, target)[1] - u[k], [(self.names.index(target), np.array([0, 0, 1.0]))])
@@ -522,6 +545,8 @@ class Case:
 
     def report_forces(self):
         names = [f"effort({k})" for k in self.keys]
+        if self.mech.gears:  # reactions are refused with gears (their contact force is not modelled)
+            return names
         names += [f"reaction({p}, {b}).{c}" for p, b in self.joints() for c in "xy"]
         return names + [f"reaction({s.name}).{c}" for s in self.mech.slides for c in "xy"]
 
@@ -568,6 +593,9 @@ class Case:
                "ground": {g: list(xy) for g, xy in m.ground}, "links": links}
         if slides:
             out["slides"] = slides
+        if m.gears:
+            out["gears"] = [{"name": g.name, "links": list(g.links), "radii": list(g.radii),
+                             "phase": g.phase} for g in m.gears]
         out["inputs"] = inputs
         out["loads"] = loads
         out["guess"] = {p: list(xy) for p, xy in m.guess}
@@ -698,13 +726,22 @@ def _realize(family, seed, sp, fr, rng, U, Z, direction, s, phi, offset, off_siz
     Us = np.empty_like(U)
     for k, (kind, _) in enumerate(sp.inputs):
         Us[:, k] = U[:, k] + phi if kind == "angle" else U[:, k] * s
+        if kind == "angle":  # the first pose's angle in (-pi, pi], as kincas starts gears' angles
+            Us[:, k] -= 2 * math.pi * round(Us[0, k] / (2 * math.pi))
         Us[:, k] = np.linspace(Us[0, k], Us[-1, k], len(Us))  # as a scene's sweep spaces them
     pos = {}
     for p in list(sp.pos):
         pos[p] = np.array([glob(fr.point(z, p)) for z in Z])
     guess = {p: tuple(glob(np.asarray(xy) + rng.uniform(-0.02, 0.02, 2))) for p, xy in sp.pos.items()}
+    gears = []
+    for g1, g2, r1, r2 in sp.gears:  # the phase from both angles as kincas starts them, in (-pi, pi]
+        wrap = lambda a: (a + math.pi) % (2 * math.pi) - math.pi
+        th1 = wrap(fr.theta0[g1] + phi)
+        phase = wrap(fr.theta0[g2] + phi) + r1 / r2 * th1
+        gears.append(Gear(links=(g1, g2), radii=(par(f"r_{g1}", s * r1), par(f"r_{g2}", s * r2)),
+                          phase=par("phase", phase), name="mesh"))
     mech = Mechanism(parameters=params, ground=ground, links=links, slides=slides, inputs=inputs,
-                     guess=guess, gravity=gravity, loads=loads)
+                     guess=guess, gravity=gravity, loads=loads, gears=gears)
     wmag = rng.uniform(0.5, 3.0) * (1 if rng.random() < 0.5 else -1)
     rates = {k: wmag * direction[i] * units[i] for i, k in enumerate(keys)}
     c_acc, c_jerk = rng.uniform(-2, 2), rng.uniform(-3, 3)
@@ -740,3 +777,17 @@ def natural_scales(c: Case) -> dict:
     j = abs(c.c_jerk)
     per = [1.0, w, w * w + a * w, w ** 3 + 3 * a * w * w + j * w]
     return {"length": [c.size * v for v in per], "angle": per}
+
+
+def check_family(family: str, n: int, check) -> str:
+    """Every problem `check(case)` finds in the first n mechanisms of a family, one line each
+    naming the mechanism ("" when there is none)."""
+    return "\n".join(f"{c.label}: {b}" for c in cases(family, n) for b in check(c))
+
+
+def solved_checked(c: Case, what: str, check) -> list[str]:
+    """`check(case, sweep)` on the case's shared sweep, once every pose is solved."""
+    sw = solved(c, what)
+    if not sw.ok.all():
+        return [f"poses not solved: {sw.status.tolist()}"]
+    return check(c, sw)

@@ -13,7 +13,6 @@ family and the seed, and `random_mechanisms.case(family, seed)` rebuilds the mec
 """
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest
@@ -85,6 +84,14 @@ def position_residuals(c, sw) -> list[str]:
             ok = err * c.size <= tol
         if not ok:
             bad.append(f"input {inp.key} not where it was driven ({err:.2e})")
+    for g in m.gears:  # external mesh: theta2 = -k theta1 + phase, angles continuous from the
+        # first pose, where each is in (-pi, pi]
+        a1, a2 = (sw[f"{lk}.angle"] for lk in g.links)
+        k = m.value(g.radii[0]) / m.value(g.radii[1])
+        cont = lambda a: a[0] + np.unwrap(a - a[0])
+        err = np.abs(cont(a2) + k * cont(a1) - m.value(g.phase)).max()
+        if not err <= 1e-12 * (1 + k):
+            bad.append(f"gear {g.name}: theta2 + k theta1 is {err:.2e} off its phase")
     for p, ref in c.ref.items():  # the generator's own solution (conditioned: >= COND_MIN)
         err = np.abs(xy(sw, p, c) - ref).max()
         if not err <= 1e-9 * c.size + 8 * EPS * far:
@@ -92,18 +99,15 @@ def position_residuals(c, sw) -> list[str]:
     return bad
 
 
+def flagged_or_off(c, sw) -> list[str]:
+    bad = [f"flagged {sw.flags} where the generator keeps clear of singular positions"] if any(sw.flags) else []
+    return bad + position_residuals(c, sw)
+
+
 @pytest.mark.parametrize("family", rm.FAMILIES)
 def test_residuals_and_reference_positions(family):
-    failures = []
-    for c in rm.cases(family, N):
-        sw = rm.solved(c)
-        if not sw.ok.all():
-            failures.append(f"{c.label}: poses not solved: {sw.status.tolist()}")
-            continue
-        if any(sw.flags):
-            failures.append(f"{c.label}: flagged {sw.flags} where the generator keeps clear of singular positions")
-        failures += [f"{c.label}: {b}" for b in position_residuals(c, sw)]
-    assert not failures, "\n".join(failures)
+    failures = rm.check_family(family, N, lambda c: rm.solved_checked(c, "motion", flagged_or_off))
+    assert not failures, failures
 
 
 # --- time derivatives by Richardson extrapolation ---
@@ -182,7 +186,5 @@ def derivative_errors(c) -> list[str]:
 
 @pytest.mark.parametrize("family", rm.FAMILIES)
 def test_velocities_accelerations_jerks_by_richardson(family):
-    failures = []
-    for c in rm.cases(family, N):
-        failures += [f"{c.label}: {b}" for b in derivative_errors(c)]
-    assert not failures, "\n".join(failures)
+    failures = rm.check_family(family, N, derivative_errors)
+    assert not failures, failures
