@@ -165,6 +165,9 @@ def check_loads(m, num) -> list[str]:
             num(f"{where}: cg", i.cg[0]), num(f"{where}: cg", i.cg[1])
         for f in ("mass", "inertia"):
             v = getattr(i, f)
+            name = v if isinstance(v, str) else getattr(v, "name", None)  # a name or a Param
+            if name in m.param_values:  # a parameter's value must not be negative either
+                v = m.value(v)
             if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v < 0:
                 out.append(f"{where}: {f}: must not be negative, got {v}")
     for k, ld in enumerate(m.loads):
