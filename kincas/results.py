@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .result_base import Result
+
 
 def wrap_angle(a: np.ndarray) -> np.ndarray:
     """Wrap radians to (-pi, pi]."""
@@ -30,7 +32,7 @@ def wrap_angle(a: np.ndarray) -> np.ndarray:
 
 
 @dataclass(repr=False)
-class Pose:
+class Pose(Result):
     """One solved (or unsolved) pose: `pose["C.x"]` is a float (NaN when not solved).
 
     A pose is a container of names, as a `Sweep` is (inputs, then reported quantities).
@@ -89,9 +91,59 @@ class Pose:
         flag = f" ({self.flag})" if self.flag else ""
         return f"<Pose {at}: {self.status}{flag}; {len(self.values)} values>"
 
+    def summary(self) -> str:
+        """The status, and how many values (the `repr`'s body).
+
+        Examples
+        --------
+        >>> Pose({}, "no assembly", None, {"C.x": float("nan")}, float("inf")).summary()
+        'no assembly; 1 values'
+        """
+        return f"{self.status}{f' ({self.flag})' if self.flag else ''}; {len(self.values)} values"
+
+    def to_pandas(self, length: str = ""):
+        """A one-row DataFrame: the inputs as index, a column per value, `status`, `flag`.
+
+        Parameters
+        ----------
+        length : str
+            The unit of lengths, recorded in `df.attrs["units"]` ("" : none).
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Examples
+        --------
+        >>> Pose({"crank.angle": 0.0}, "ok", None, {"C.x": 1.5}, 0.0).to_pandas("mm").attrs["units"]["C.x"]
+        'mm'
+        """
+        from .frames import pose_to_pandas
+        return pose_to_pandas(self, length)
+
+    def to_xarray(self, length: str = ""):
+        """A Dataset along `pose` (of length 1), as `Sweep.to_xarray` gives.
+
+        Parameters
+        ----------
+        length : str
+            The unit of lengths, recorded in each variable's units ("" : none).
+
+        Returns
+        -------
+        xarray.Dataset
+
+        Examples
+        --------
+        >>> float(Pose({"crank.angle": 0.0}, "ok", None, {"C.x": 1.5}, 0.0).to_xarray()["C.x"][0])
+        1.5
+        """
+        from .frames import pose_to_xarray
+        return pose_to_xarray(self, length)
+
 
 @dataclass(repr=False)
-class Sweep:
+class Sweep(Result):
     """Poses over a sweep of the inputs: `sweep["C.x"]` is an array with one entry per pose.
 
     A sweep is a container of names (the inputs', then the reported quantities'): `"C.x" in
@@ -188,10 +240,23 @@ class Sweep:
         return list(self)
 
     def __repr__(self) -> str:
-        return f"<Sweep: {self._counts()}; inputs {_names(self.inputs)}; reported {_names(self.values)}>"
+        return f"<Sweep: {self.summary()}>"
 
     def __str__(self) -> str:
         return "\n".join(self.summary_lines())
+
+    def summary(self) -> str:
+        """Poses solved and not, the inputs and the reported quantities (the `repr`'s body).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> Sweep(inputs={"t": np.zeros(2)}, rates={}, accelerations={}, status=["ok", "no assembly"],
+        ...       flags=[None, None], values={"C.x": np.array([1.0, np.nan])}, q=np.zeros((2, 1)),
+        ...       residual=np.zeros(2), iterations=np.zeros(2, int), unknowns=["q"], size=1.0).summary()
+        '2 poses, 1 solved, 1 not solved; inputs t; reported C.x'
+        """
+        return f"{self._counts()}; inputs {_names(self.inputs)}; reported {_names(self.values)}"
 
     def _counts(self) -> str:
         n, good = len(self), int(self.ok.sum())

@@ -58,6 +58,7 @@ from ..core.symbolic import default_report
 from ..model.mechanism import Mechanism, as_param
 from ..core.assembly import modes
 from ..core.blocks import numeric_signs
+from ..result_base import Result
 from .continuation import _continue, _first
 from .executor import map_threads
 from .sweeps import _input_table
@@ -75,8 +76,8 @@ FIRST_CALL, CALL_SECONDS = 8192, 0.1
 # --- the result ---
 
 
-@dataclass
-class DesignSweep:
+@dataclass(repr=False)
+class DesignSweep(Result):
     """Designs x poses. `values[Q]` (n_designs, n_poses) in radians for angles, NaN where a
     pose is not solved; `code` (n_designs, n_poses) indexes STATUS ("ok", "no assembly",
     "not solved", "branch lost"); `params` (n_designs, len(names)) the varied values;
@@ -107,16 +108,34 @@ class DesignSweep:
         bad = np.flatnonzero(self.code[d] != OK)
         return None if not len(bad) else (STATUS[self.code[d, bad[0]]], int(bad[0]))
 
-    def to_xarray(self):
+    def summary(self) -> str:
+        """Designs solved at every pose, poses, varied parameters, reported quantities."""
+        nd, npose = self.code.shape
+        return (f"{nd} designs x {npose} poses, {int(self.design_ok.sum())} solved at every pose; "
+                f"varied {', '.join(self.names) or 'none'}; reported {', '.join(self.values) or 'none'}")
+
+    def to_pandas(self, length: str = ""):
+        """A DataFrame indexed by (design, pose): the varied parameters, the inputs, each
+        quantity and `status`; units in `df.attrs["units"]` (`length` names lengths').
+
+        Examples
+        --------
+        >>> import kincas
+        >>> m = kincas.Mechanism(parameters={"a": 2.0}, ground={"O": (0, 0)},
+        ...     links=[kincas.Link.bar("crank", "O", "A", "a")], inputs=[kincas.Input.angle("crank")])
+        >>> r = kincas.sweep_designs(m, {"a": [1.0, 3.0]}, {"crank.angle": [0.0, 0.5]}, report=["A.x"])
+        >>> df = r.to_pandas("mm")
+        >>> df.loc[(1, 0), "A.x"], df.attrs["units"]["a"]
+        (np.float64(3.0), 'mm')
+        """
+        from ..frames import designs_to_pandas
+        return designs_to_pandas(self, length)
+
+    def to_xarray(self, length: str = ""):
         """An xarray Dataset with dimensions (design, pose): the varied parameters along
         design, the inputs along pose, each quantity and `status` over both."""
-        import xarray as xr
-
-        data = {n: (("design", "pose"), v) for n, v in self.values.items()}
-        data["status"] = (("design", "pose"), self.status.astype(str))
-        coords = {n: ("design", self.params[:, j]) for j, n in enumerate(self.names)}
-        coords.update({k: ("pose", v) for k, v in self.inputs.items()})
-        return xr.Dataset(data, coords=coords)
+        from ..frames import designs_to_xarray
+        return designs_to_xarray(self, length)
 
 
 # --- the designs' table ---

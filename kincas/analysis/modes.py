@@ -88,7 +88,7 @@ class Mode:
 
 
 def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
-               iterations: int = 60) -> list[Mode]:
+               iterations: int = 60) -> "Modes":
     """The distinct real assemblies of `m` at `inputs` (input key -> value; a plain number
     for a one-input mechanism; nothing for a structure without inputs).
 
@@ -108,7 +108,9 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
 
     Returns
     -------
-    list of Mode
+    Modes
+        A list of `Mode` (index it, iterate it as before) that is also a `kincas` result:
+        `ok`, `to_pandas()`, `to_xarray()`.
 
     Examples
     --------

@@ -39,14 +39,15 @@ import numpy as np
 from ..errors import ModelError, SceneError
 from ..core.numeric import model_of
 from ..model.mechanism import Mechanism
+from ..result_base import Result
 
 FEW_POSES = 16  # up to this many poses, each is solved from the nominal's (not swept to)
 CHUNK = 2048  # samples per task of the executor
 
 
 
-@dataclass
-class ToleranceResult:
+@dataclass(repr=False)
+class ToleranceResult(Result):
     """First-order and Monte-Carlo standard deviations of each output at each pose.
 
     `first_order[Q]`, `monte_carlo[Q]`, `nominal[Q]`, `mean_shift[Q]` (Monte-Carlo mean minus
@@ -66,6 +67,16 @@ class ToleranceResult:
     mean_shift: dict[str, np.ndarray]
     failed: np.ndarray
     info: dict = field(default_factory=dict)
+
+    @property
+    def ok(self) -> np.ndarray:
+        """Boolean mask of the poses whose nominal design was solved."""
+        return np.array([s == "ok" for s in self.status], dtype=bool)
+
+    def summary(self) -> str:
+        """Poses, Monte-Carlo samples, parameters and outputs (the `repr`'s body)."""
+        return (f"{len(self.status)} poses, {int(self.ok.sum())} solved; {self.samples} samples; "
+                f"std of {', '.join(self.std)}; outputs {', '.join(self.names)}")
 
     @property
     def agreement(self) -> dict[str, np.ndarray]:

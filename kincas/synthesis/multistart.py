@@ -26,13 +26,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.mechanism import Mechanism
+from ..result_base import Result
 from .study import latin_hypercube
 
 SAME = 1e-4  # optima closer than this fraction of every range are one optimum
 
 
-@dataclass
-class MultistartResult:
+@dataclass(repr=False)
+class MultistartResult(Result):
     """`optima`: distinct optima that passed every check, best (lowest objective) first;
     `results`: every start's `OptimizeResult`, in the starts' order; `starts`: the starting
     values (n_starts, len(vary))."""
@@ -50,6 +51,26 @@ class MultistartResult:
     @property
     def runs(self) -> int:
         return len(self.results)
+
+    @property
+    def ok(self) -> bool:
+        """Whether some start gave a trustworthy optimum."""
+        return bool(self.optima)
+
+    def summary(self) -> str:
+        """Starts, distinct optima, the best objective (the `repr`'s body)."""
+        best = f"; best objective {self.best.objective:.6g}" if self.best is not None else ""
+        return f"{self.runs} starts, {len(self.optima)} distinct optima{best}"
+
+    def to_pandas(self, length: str = ""):
+        """A DataFrame, one row per start: its starting values, `objective`, `ok`, `status`
+        and the varied parameters it reached (`length`: the unit of lengths, in the units)."""
+        from ..frames import multistart_to_pandas
+        return multistart_to_pandas(self, length)
+
+    def to_xarray(self, length: str = ""):
+        """A Dataset along `start`, the columns of `to_pandas`."""
+        return self.to_pandas(length).to_xarray()
 
 
 @dataclass

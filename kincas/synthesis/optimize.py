@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.mechanism import Mechanism
+from ..result_base import Result
 from ..errors import ModelError
 from ..results import Sweep
 from .curve import Curve, constrain as curve_constrain, distances as curve_distances
@@ -62,7 +63,7 @@ class Constraint:
     max: float | None = None
 
 
-@dataclass
+@dataclass(repr=False)
 class OptimizeResult:
     """What the optimiser found, and whether it may be trusted (`ok`).
 
@@ -90,6 +91,15 @@ class OptimizeResult:
     problems: list[str] = field(default_factory=list)
     sweep: Sweep | None = None
     info: dict = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        return f"<OptimizeResult: {self.summary()}>"
+
+    def summary(self) -> str:
+        """Trusted or not, the status, the objective and the varied parameters."""
+        varied = ", ".join(f"{k}={v:.6g}" for k, v in self.varied.items())
+        return (f"{'ok' if self.ok else 'not ok'} ({self.status}); objective {self.objective:.6g}"
+                f" after {self.iterations} iterations; {varied}")
 
     def to_pandas(self, length: str = ""):
         """A DataFrame per sample (inputs as index, the expressions' quantities as columns),
@@ -122,6 +132,11 @@ class OptimizeResult:
     def nit(self) -> int:
         """IPOPT's iterations (`iterations`)."""
         return int(self.iterations)
+
+
+# `ok` is a field here (scipy's OptimizeResult has `success`), which the dataclass would take
+# for a default if it inherited Result's abstract property: a registered Result instead
+Result.register(OptimizeResult)
 
 
 def _as_constraint(c, i) -> Constraint:

@@ -34,6 +34,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import Mechanism
+from ..result_base import Result
 from .expressions import AGGREGATE, CONST, SAMPLE, TOTAL, parse, quantity_name
 
 FIELDS = {"vary", "grid", "samples", "seed", "report"}
@@ -163,8 +164,8 @@ def parse_report(m: Mechanism, report, where: str = "report") -> list:
 # --- the study ---
 
 
-@dataclass
-class StudyResult:
+@dataclass(repr=False)
+class StudyResult(Result):
     """One row per design: `params` (n_designs, len(names)) the varied values, `status`
     ("ok", or why the design failed), `values[text]` one number per design per report
     expression (NaN where the design failed)."""
@@ -186,20 +187,22 @@ class StudyResult:
         cols.update(self.values)
         return cols
 
-    def to_xarray(self):
-        """An xarray Dataset along the dimension `design`."""
-        import xarray as xr
+    def summary(self) -> str:
+        """Designs solved, varied parameters, report expressions (the `repr`'s body)."""
+        return (f"{len(self.status)} designs, {int(self.ok.sum())} ok; varied "
+                f"{', '.join(self.names) or 'none'}; report {', '.join(self.report) or 'none'}")
 
-        cols = self.columns()
-        data = {k: ("design", np.asarray(v, dtype=str if k == "status" else float))
-                for k, v in cols.items()}
-        return xr.Dataset(data, coords={"design": np.arange(len(self.status))})
+    def to_xarray(self, length: str = ""):
+        """An xarray Dataset along the dimension `design` (`length`: the unit of lengths,
+        recorded in the varied parameters' units)."""
+        from ..frames import study_to_xarray
+        return study_to_xarray(self, length)
 
-    def to_pandas(self):
-        """A pandas DataFrame, one row per design."""
-        import pandas as pd
-
-        return pd.DataFrame(self.columns())
+    def to_pandas(self, length: str = ""):
+        """A pandas DataFrame, one row per design; the varied parameters' units in
+        `df.attrs["units"]` (`length` names the unit of lengths)."""
+        from ..frames import study_to_pandas
+        return study_to_pandas(self, length)
 
 
 @dataclass

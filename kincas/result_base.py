@@ -1,0 +1,58 @@
+"""The interface every result of kincas implements (as sympy.physics.mechanics declares one).
+
+A solve, a sweep, a designs' sweep, a study, assembly modes, a range of motion, a tolerance
+analysis, sensitivities and an optimisation each return an object that
+
+- says whether it succeeded in itself (`ok`: a bool, or one per pose / design): a failure is
+  reported in the result, never raised (as scipy's OptimizeResult does);
+- converts to pandas and xarray with the same keywords (`to_pandas(length="")`,
+  `to_xarray(length="")`: `length` names the unit of lengths in the units recorded);
+- prints as one line saying what it holds (`repr`, built from `summary()`).
+
+>>> import kincas
+>>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
+...                      inputs=[kincas.Input.angle("crank")])
+>>> r = kincas.sweep(m, {"crank.angle": [0.0, 1.0]}, report=["A.x"])
+>>> isinstance(r, Result), r.ok.tolist()
+(True, [True, True])
+"""
+from __future__ import annotations
+
+import abc
+
+
+class Result(abc.ABC):
+    """What every public result offers: `ok`, `to_pandas`, `to_xarray`, `summary` and a
+    one-line `repr`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> class Tiny(Result):
+    ...     ok = True
+    ...     def summary(self): return "one number"
+    ...     def to_pandas(self, length=""): return None
+    ...     def to_xarray(self, length=""): return None
+    >>> Tiny()
+    <Tiny: one number>
+    """
+
+    @property
+    @abc.abstractmethod
+    def ok(self):
+        """Whether it succeeded: a bool, or a boolean array (one per pose or design)."""
+
+    @abc.abstractmethod
+    def summary(self) -> str:
+        """A short description of what the result holds (the body of its `repr`)."""
+
+    @abc.abstractmethod
+    def to_pandas(self, length: str = ""):
+        """A pandas DataFrame; `length` names the unit of lengths in `df.attrs["units"]`."""
+
+    @abc.abstractmethod
+    def to_xarray(self, length: str = ""):
+        """An xarray Dataset; `length` names the unit of lengths in each variable's units."""
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__}: {self.summary()}>"
