@@ -26,6 +26,9 @@ _aliases.install()  # `import kincas.modes` and other paths of the flat 0.1 layo
 
 
 def __getattr__(name):
+    from .result_base import RENAMED, TYPES, result_type
+    if name in TYPES or name in RENAMED:  # kincas.Study, kincas.Range, ... (old names warned)
+        return result_type(name)
     return _aliases.attribute(name)
 
 

@@ -56,3 +56,45 @@ class Result(abc.ABC):
 
     def __repr__(self) -> str:
         return f"<{type(self).__name__}: {self.summary()}>"
+
+
+# Every public result type, by the one name it goes by (what it holds, as `Sweep` and `Pose`
+# do), and where it lives: `kincas.Study` etc. load the module on first use.
+TYPES = {"Result": "result_base", "Pose": "results", "Sweep": "results",
+         "DesignSweep": "analysis.designs", "Study": "synthesis.study",
+         "Sensitivities": "analysis.sensitivity", "ToleranceAnalysis": "analysis.tolerance",
+         "Optimization": "synthesis.optimize", "Multistart": "synthesis.multistart",
+         "Modes": "frames", "Range": "analysis.singular"}
+# their names in kincas 0.1, served one more release with a DeprecationWarning
+RENAMED = {"StudyResult": "Study", "ToleranceResult": "ToleranceAnalysis",
+           "OptimizeResult": "Optimization", "MultistartResult": "Multistart"}
+
+
+def result_type(name: str):
+    """The result class `kincas.<name>` (an old name warns and gives the new one).
+
+    Parameters
+    ----------
+    name : str
+        A name of `TYPES` or `RENAMED`.
+
+    Returns
+    -------
+    type
+
+    Examples
+    --------
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as w:
+    ...     warnings.simplefilter("always")
+    ...     result_type("StudyResult").__name__, w[0].category.__name__
+    ('Study', 'DeprecationWarning')
+    """
+    import importlib
+    import warnings
+
+    if name in RENAMED:
+        warnings.warn(f"kincas.{name} is deprecated: use kincas.{RENAMED[name]} (the old name "
+                      f"goes in the next release)", DeprecationWarning, stacklevel=3)
+        name = RENAMED[name]
+    return getattr(importlib.import_module(f"kincas.{TYPES[name]}"), name)

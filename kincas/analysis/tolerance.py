@@ -39,6 +39,7 @@ import numpy as np
 from ..errors import ModelError, SceneError
 from ..core.numeric import model_of
 from ..model.mechanism import Mechanism
+from .._deprecated import renamed
 from ..result_base import Result
 
 FEW_POSES = 16  # up to this many poses, each is solved from the nominal's (not swept to)
@@ -47,7 +48,7 @@ CHUNK = 2048  # samples per task of the executor
 
 
 @dataclass(repr=False)
-class ToleranceResult(Result):
+class ToleranceAnalysis(Result):
     """First-order and Monte-Carlo standard deviations of each output at each pose.
 
     `first_order[Q]`, `monte_carlo[Q]`, `nominal[Q]`, `mean_shift[Q]` (Monte-Carlo mean minus
@@ -124,7 +125,7 @@ class ToleranceResult(Result):
 
 def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | None = None, *,
             samples: int = 2000, seed: int | None = 0, rates=None, accelerations=None,
-            progress=None, workers: int | None = None) -> ToleranceResult:
+            progress=None, workers: int | None = None) -> ToleranceAnalysis:
     """Spread of the `report` quantities over `inputs` from independent normal parameter
     errors with standard deviations `std` (parameter name -> sigma, in its own unit). The
     samples run in chunks on `workers` threads (default: every core); the numbers do not
@@ -150,7 +151,7 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
 
     Returns
     -------
-    ToleranceResult
+    ToleranceAnalysis
 
     Examples
     --------
@@ -189,7 +190,7 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
     dp = rng.standard_normal((samples, len(to))) * sig  # one row per manufactured mechanism
     mc, shift, failed, retried = _monte_carlo(m, sw, report, to, dp, workers)
     nominal = {n: sw[n] for n in report}
-    return ToleranceResult(
+    return ToleranceAnalysis(
         names=report, std={p: float(std[p]) for p in to}, samples=samples, seed=seed,
         inputs=sw.inputs, status=sw.status, nominal=nominal,
         first_order={n: fo[:, j] for j, n in enumerate(report)},
@@ -362,3 +363,7 @@ def read_section(sc) -> dict:
         raise SceneError(problems)
     return {"std": {k: float(v) for k, v in t["std"].items()}, "samples": samples,
             "seed": seed, "report": report}
+
+
+# the name of 0.1 (results are named by what they hold, as Sweep and Pose are)
+__getattr__ = renamed(globals(), {'ToleranceResult': 'ToleranceAnalysis'}, 'kincas.analysis.tolerance')

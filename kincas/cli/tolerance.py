@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 
-from ..analysis.tolerance import ToleranceResult, analyse, read_section
+from ..analysis.tolerance import ToleranceAnalysis, analyse, read_section
 from ..errors import SceneError
 from ..model.names import is_angular
 from .common import _list, _unit, progress_for
@@ -59,7 +59,7 @@ def cli_run(args) -> int:
     return 3 if unsolved else 0
 
 
-def _print(sc, r: ToleranceResult, inputs, fo, mc, unit):
+def _print(sc, r: ToleranceAnalysis, inputs, fo, mc, unit):
     stds = ", ".join(f"{p} {s:g}" for p, s in r.std.items())
     print(f"{sc.study.title or 'kincas'}: tolerance analysis, {r.samples} samples (seed {r.seed})")
     print(f"standard deviations: {stds}")

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.mechanism import Mechanism
+from .._deprecated import renamed
 from ..result_base import Result
 from .study import latin_hypercube
 
@@ -33,9 +34,9 @@ SAME = 1e-4  # optima closer than this fraction of every range are one optimum
 
 
 @dataclass(repr=False)
-class MultistartResult(Result):
+class Multistart(Result):
     """`optima`: distinct optima that passed every check, best (lowest objective) first;
-    `results`: every start's `OptimizeResult`, in the starts' order; `starts`: the starting
+    `results`: every start's `Optimization`, in the starts' order; `starts`: the starting
     values (n_starts, len(vary))."""
 
     optima: list
@@ -94,7 +95,7 @@ class _Start:
 
 def multistart(m: Mechanism, samples, vary: dict, minimize: str | None = None, constraints=(),
                *, starts: int = 8, seed=0, keep: int = 3, same: float = SAME, client=None,
-               workers: int | None = 1, progress=None, **kw) -> MultistartResult:
+               workers: int | None = 1, progress=None, **kw) -> Multistart:
     """Optimise from `starts` designs drawn in the bounds (see the module's text); `kw` are
     `kincas.optimize`'s keywords. `workers` defaults to 1: IPOPT's linear solver is not
     re-entrant, so one process runs one optimisation at a time (a Dask cluster's worker
@@ -120,4 +121,8 @@ def multistart(m: Mechanism, samples, vary: dict, minimize: str | None = None, c
         if all(np.any(np.abs(x - np.array([o.varied[k] for k in names])) > same * width)
                for o in optima):
             optima.append(r)
-    return MultistartResult(optima=optima[:keep], results=results, starts=X, names=names)
+    return Multistart(optima=optima[:keep], results=results, starts=X, names=names)
+
+
+# the name of 0.1 (results are named by what they hold, as Sweep and Pose are)
+__getattr__ = renamed(globals(), {'MultistartResult': 'Multistart'}, 'kincas.synthesis.multistart')

@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.mechanism import Mechanism
+from .._deprecated import renamed
 from ..result_base import Result
 from ..errors import ModelError
 from ..results import Sweep
@@ -51,7 +52,7 @@ from .simultaneous import Problem
 
 MAX_ROUNDS = 3  # IPOPT runs when extremes moved away from where they were tracked
 
-__all__ = ["optimize", "Curve", "Constraint", "OptimizeResult", "cli_arguments", "cli_run"]
+__all__ = ["optimize", "Curve", "Constraint", "Optimization", "cli_arguments", "cli_run"]
 
 
 @dataclass
@@ -64,7 +65,7 @@ class Constraint:
 
 
 @dataclass(repr=False)
-class OptimizeResult:
+class Optimization:
     """What the optimiser found, and whether it may be trusted (`ok`).
 
     `converged`: IPOPT reported success; `ok`: that, and the optimised design passed every
@@ -93,7 +94,7 @@ class OptimizeResult:
     info: dict = field(default_factory=dict)
 
     def __repr__(self) -> str:
-        return f"<OptimizeResult: {self.summary()}>"
+        return f"<Optimization: {self.summary()}>"
 
     def summary(self) -> str:
         """Trusted or not, the status, the objective and the varied parameters."""
@@ -136,7 +137,7 @@ class OptimizeResult:
 
 # `ok` is a field here (scipy's OptimizeResult has `success`), which the dataclass would take
 # for a default if it inherited Result's abstract property: a registered Result instead
-Result.register(OptimizeResult)
+Result.register(Optimization)
 
 
 def _as_constraint(c, i) -> Constraint:
@@ -155,7 +156,7 @@ def _as_constraint(c, i) -> Constraint:
 
 def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, constraints=(), *, data=None,
              rates=None, accelerations=None, deg: bool = False, check_path: bool = True,
-             max_iter: int = 1000, tol: float = 1e-12) -> OptimizeResult:
+             max_iter: int = 1000, tol: float = 1e-12) -> Optimization:
     """Vary the parameters `vary` (name -> (low, high)) to minimise `minimize` subject to
     `constraints` (Constraint, dict {expr, min, max} or tuple (expr, min, max)), with the
     mechanism posed at the `samples` inputs (key -> array, as for `kincas.sweep`).
@@ -194,7 +195,7 @@ def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, con
 
     Returns
     -------
-    OptimizeResult
+    Optimization
         `ok` only if IPOPT converged and every check passed; otherwise `problems` says why.
 
     Examples
@@ -229,7 +230,7 @@ def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, con
 
 
 def _once(m, samples, vary, minimize, constraints, data, rates, accelerations, deg, check_path,
-          max_iter, tol) -> OptimizeResult:
+          max_iter, tol) -> Optimization:
     from ..core.numeric import compile
     from ..analysis.sweeps import sweep
 
@@ -258,7 +259,7 @@ def _once(m, samples, vary, minimize, constraints, data, rates, accelerations, d
     if curve is not None:
         f = f + curve_objective(prob, curve)
     rows = [(c, prob.evaluate(e, c.expr)) for c, e in cons]
-    r = OptimizeResult(**prob.solve(f, rows, check_path, max_iter, tol))
+    r = Optimization(**prob.solve(f, rows, check_path, max_iter, tol))
     if curve is not None:
         r.info["curve"] = {"point": curve.point, "targets": curve.targets,
                            "distances": curve_distances(r.sweep, curve, prob.at)}
@@ -371,7 +372,7 @@ def _read_curve(sc, c, problems):
         return None
 
 
-def run_scene(sc) -> OptimizeResult:
+def run_scene(sc) -> Optimization:
     """Optimise as the scene's [optimize] section says (SceneError for a bad section)."""
     from ..errors import ModelError, SceneError
 
@@ -392,8 +393,12 @@ class _CallableModule(types.ModuleType):
     `kincas.optimize.optimize`) and the function: calling the module calls `optimize`, so
     importing the module path never hides the function."""
 
-    def __call__(self, *args, **kwargs) -> OptimizeResult:
+    def __call__(self, *args, **kwargs) -> Optimization:
         return optimize(*args, **kwargs)
 
 
 sys.modules[__name__].__class__ = _CallableModule
+
+
+# the name of 0.1 (results are named by what they hold, as Sweep and Pose are)
+__getattr__ = renamed(globals(), {'OptimizeResult': 'Optimization'}, 'kincas.synthesis.optimize')

@@ -34,6 +34,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import Mechanism
+from .._deprecated import renamed
 from ..result_base import Result
 from .expressions import AGGREGATE, CONST, SAMPLE, TOTAL, parse, quantity_name
 
@@ -165,7 +166,7 @@ def parse_report(m: Mechanism, report, where: str = "report") -> list:
 
 
 @dataclass(repr=False)
-class StudyResult(Result):
+class Study(Result):
     """One row per design: `params` (n_designs, len(names)) the varied values, `status`
     ("ok", or why the design failed), `values[text]` one number per design per report
     expression (NaN where the design failed)."""
@@ -249,7 +250,7 @@ class _Chunk:
 def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, seed=0,
           rates=None, accelerations=None, degrees: bool = False, client=None,
           workers: int | None = None, chunk: int | None = None, compile: bool | None = None,
-          progress=None, backend: str = "casadi") -> StudyResult:
+          progress=None, backend: str = "casadi") -> Study:
     """Sweep many designs of `m` and evaluate `report` over each (see the module's text).
 
     Parameters
@@ -277,7 +278,7 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, 
 
     Returns
     -------
-    StudyResult
+    Study
 
     Examples
     --------
@@ -338,9 +339,13 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, 
             continue
         at = ", ".join(f"{key} = {_user(U[k, j], key, degrees):.6g}" for j, key in enumerate(keys))
         status.append(f"{STATUS[c]} at {at}" if at else STATUS[c])
-    return StudyResult(names=names, params=X, status=status, report=list(report),
+    return Study(names=names, params=X, status=status, report=list(report),
                        values={t: vals[:, j] for j, t in enumerate(report)})
 
 
 def _user(v, key, degrees):
     return math.degrees(v) if degrees and key.endswith(".angle") else float(v)
+
+
+# the name of 0.1 (results are named by what they hold, as Sweep and Pose are)
+__getattr__ = renamed(globals(), {'StudyResult': 'Study'}, 'kincas.synthesis.study')

@@ -1,0 +1,58 @@
+"""Public names are consistent: each result type goes by one name (what it holds, as Sweep
+and Pose), reachable as `kincas.<Name>`; 0.1's names still work one release, with a
+DeprecationWarning that names the new one; new names never warn."""
+import importlib
+import warnings
+
+import pytest
+
+import kincas
+from kincas.result_base import RENAMED, TYPES, Result
+
+HOMES = {"StudyResult": "kincas.synthesis.study", "ToleranceResult": "kincas.analysis.tolerance",
+         "OptimizeResult": "kincas.synthesis.optimize", "MultistartResult": "kincas.synthesis.multistart"}
+
+
+def test_each_result_type_has_one_name_and_the_interface():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a current name never warns
+        for name in TYPES:
+            cls = getattr(kincas, name)
+            assert cls.__name__ == name
+            assert name == "Result" or issubclass(cls, Result), name
+    assert not any(n.endswith("Result") for n in TYPES if n != "Result")  # one scheme
+
+
+@pytest.mark.parametrize("old", sorted(RENAMED))
+def test_old_names_warn_and_still_work(old):
+    new = RENAMED[old]
+    with pytest.warns(DeprecationWarning, match=rf"kincas\.{old} is deprecated: use kincas\.{new}"):
+        top = getattr(kincas, old)
+    module = importlib.import_module(HOMES[old])
+    with pytest.warns(DeprecationWarning, match=rf"{HOMES[old]}\.{old} .* use {HOMES[old]}\.{new}"):
+        inner = getattr(module, old)
+    assert top is inner is getattr(kincas, new)
+
+
+def test_unknown_names_still_raise_attribute_error():
+    with pytest.raises(AttributeError):
+        kincas.NoSuchResult
+    with pytest.raises(AttributeError):
+        importlib.import_module("kincas.synthesis.study").NoSuchResult
+
+
+def test_find_modes_returns_modes_a_list_old_code_indexes():
+    m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+                         links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+                                kincas.Link.bar("rocker", "D", "C", 3)],
+                         inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+    modes = kincas.find_modes(m, {"crank.angle": 0.5}, starts=32)
+    assert isinstance(modes, kincas.Modes) and isinstance(modes, list) and modes.ok
+    ys = sorted(md.points["C"][1] for md in modes)
+    assert modes[0] is list(modes)[0] and len(modes[-2:]) == 2
+    # independent: C on the circles |C - B| = 3.5 and |C - D| = 3, B = (cos .5, sin .5)
+    import math
+    bx, by = math.cos(0.5), math.sin(0.5)
+    for y in ys:
+        x = next(md.points["C"][0] for md in modes if md.points["C"][1] == y)
+        assert abs(math.hypot(x - bx, y - by) - 3.5) < 1e-10 and abs(math.hypot(x - 4, y) - 3) < 1e-10
