@@ -56,3 +56,20 @@ def test_find_modes_returns_modes_a_list_old_code_indexes():
     for y in ys:
         x = next(md.points["C"][0] for md in modes if md.points["C"][1] == y)
         assert abs(math.hypot(x - bx, y - by) - 3.5) < 1e-10 and abs(math.hypot(x - 4, y) - 3) < 1e-10
+
+
+def test_compile_is_deprecated_for_model_of():
+    import numpy as np
+    with pytest.warns(DeprecationWarning, match=r"kincas\.compile is deprecated: use kincas\.model_of"):
+        old = kincas.compile
+    assert old is kincas.model_of and "compile" not in kincas.__all__
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        exec("from kincas import *", {})  # the star import names only current names
+    # it still works: a crank O-A of length 2 at angle 0 puts A at (2, 0)
+    m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
+                         inputs=[kincas.Input.angle("crank")])
+    with pytest.warns(DeprecationWarning):
+        model = kincas.compile(m)
+    sol = model.newton(model.initial_q(np.zeros(1), np.zeros(0), {}, 2.0), np.zeros(1), np.zeros(0), 2.0)
+    assert sol.ok

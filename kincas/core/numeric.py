@@ -1,6 +1,6 @@
 """Numeric evaluation of a mechanism's symbolic model: residuals, Newton, placement, IPOPT.
 
-`model_of(m)` (also `kincas.compile`, its first name) gives the `Model` of m's structure, built once and cached (parameter values are
+`model_of(m)` (`kincas.model_of`; 0.1 called it `kincas.compile`, now deprecated) gives the `Model` of m's structure, built once and cached (parameter values are
 numeric inputs, so changing them does not rebuild it). Every CasADi call on a hot path goes
 through zero-copy numpy buffers (one set per thread). Newton solves the Assur groups of the
 structure one after another (kincas/core/structure.py), each until its next step is below
