@@ -2,6 +2,7 @@
 and Pose), reachable as `kincas.<Name>`; 0.1's names still work one release, with a
 DeprecationWarning that names the new one; new names never warn."""
 import importlib
+import math
 import warnings
 
 import pytest
@@ -73,3 +74,45 @@ def test_compile_is_deprecated_for_model_of():
         model = kincas.compile(m)
     sol = model.newton(model.initial_q(np.zeros(1), np.zeros(0), {}, 2.0), np.zeros(1), np.zeros(0), 2.0)
     assert sol.ok
+
+
+def _crank():
+    return kincas.Mechanism(parameters={"a": 2.0}, ground={"O": (0, 0)},
+                            links=[kincas.Link.bar("crank", "O", "A", "a")],
+                            inputs=[kincas.Input.angle("crank")])
+
+
+def test_analyse_counts_draws_and_the_old_samples_keyword_warns():
+    # first order: std(A.x) = |cos t| sigma, whatever the count of draws
+    new = kincas.analyse(_crank(), {"crank.angle": [0.3]}, {"a": 0.01}, ["A.x"], draws=30, seed=2)
+    with pytest.warns(DeprecationWarning, match=r"analyse\(samples=...\) is deprecated: use analyse\(draws=...\)"):
+        old = kincas.analyse(_crank(), {"crank.angle": [0.3]}, {"a": 0.01}, ["A.x"], samples=30, seed=2)
+    assert abs(new.first_order["A.x"][0] - 0.01 * math.cos(0.3)) < 1e-15
+    assert new.samples == old.samples == 30 and new.monte_carlo["A.x"][0] == old.monte_carlo["A.x"][0]
+    with pytest.raises(kincas.ModelError, match="draws: given twice"):
+        kincas.analyse(_crank(), {"crank.angle": [0.3]}, {"a": 0.01}, ["A.x"], draws=30, samples=40)
+
+
+def test_study_counts_designs_and_the_old_samples_keyword_warns():
+    import numpy as np
+    args = (_crank(), {"a": (1.0, 3.0)}, {"crank.angle": [0.0, 0.5]}, ["max(A.x)"])
+    new = kincas.study(*args, designs=4, seed=1, workers=1)
+    with pytest.warns(DeprecationWarning, match=r"study\(samples=...\) is deprecated: use study\(designs=...\)"):
+        old = kincas.study(*args, samples=4, seed=1, workers=1)
+    a = new.params[:, 0]
+    assert np.array_equal(a, old.params[:, 0]) and len(a) == 4
+    assert sorted(np.floor((a - 1.0) / 0.5).astype(int)) == [0, 1, 2, 3]  # one per stratum
+    assert np.allclose(new.values["max(A.x)"], a, rtol=0, atol=1e-12)  # A.x = a cos t, largest at t = 0
+
+
+def test_optimize_takes_inputs_and_the_old_samples_keyword_warns():
+    # the minimum of (a cos 0.5 - 1)^2 is at a = 1 / cos 0.5
+    kw = {"vary": {"a": (1.0, 3.0)}, "minimize": "sum((A.x - 1)^2)"}
+    new = kincas.optimize(_crank(), inputs={"crank.angle": [0.5]}, **kw)
+    with pytest.warns(DeprecationWarning, match=r"optimize\(samples=...\) is deprecated: use optimize\(inputs=...\)"):
+        old = kincas.optimize(_crank(), samples={"crank.angle": [0.5]}, **kw)
+    positional = kincas.optimize(_crank(), {"crank.angle": [0.5]}, kw["vary"], kw["minimize"])
+    for r in (new, old, positional):
+        assert r.ok and abs(r.varied["a"] - 1 / math.cos(0.5)) < 1e-8
+    with pytest.raises(kincas.ModelError, match="inputs: missing"):
+        kincas.optimize(_crank(), **kw)

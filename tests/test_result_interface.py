@@ -40,7 +40,7 @@ EXAMPLES = {
     "study": lambda: kincas.study(crank(), {"a": (1.0, 3.0)}, {"crank.angle": T}, ["max(A.x)"],
                                   grid=[2], workers=1),
     "sensitivities": lambda: kincas.sensitivities(crank(), {"crank.angle": T}, of=["A.x"], to=["a"]),
-    "analyse": lambda: kincas.analyse(crank(), {"crank.angle": T}, {"a": 0.01}, ["A.x"], samples=20),
+    "analyse": lambda: kincas.analyse(crank(), {"crank.angle": T}, {"a": 0.01}, ["A.x"], draws=20),
     "optimize": lambda: kincas.optimize(crank(), {"crank.angle": T}, {"a": (1.0, 3.0)}, "sum((A.x - 1.5)^2)"),
     "find_modes": lambda: kincas.find_modes(four_bar(), {"crank.angle": 0.5}, starts=32),
     "input_range": lambda: kincas.input_range(four_bar(), {"crank.angle": 0.5}),

@@ -25,7 +25,7 @@ reported beside the Monte-Carlo sampling error, 1 / sqrt(2 (N - 1)) relative.
 ...            kincas.Link.bar("rocker", "D", "C", 3)],
 ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
 >>> r = analyse(m, {"crank.angle": np.array([0.5, 1.0])}, std={"a": 0.01, "b": 0.01},
-...             report=["C.y"], samples=400, seed=1)
+...             report=["C.y"], draws=400, seed=1)
 >>> r.failed.tolist(), bool(np.all(np.abs(r.agreement["C.y"] - 1) < 0.2))
 ([0, 0], True)
 """
@@ -39,7 +39,7 @@ import numpy as np
 from ..errors import ModelError, SceneError
 from ..core.numeric import model_of
 from ..model.mechanism import Mechanism
-from .._deprecated import renamed
+from .._deprecated import keyword, renamed
 from ..result_base import Result
 
 FEW_POSES = 16  # up to this many poses, each is solved from the nominal's (not swept to)
@@ -124,8 +124,8 @@ class ToleranceAnalysis(Result):
 
 
 def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | None = None, *,
-            samples: int = 2000, seed: int | None = 0, rates=None, accelerations=None,
-            progress=None, workers: int | None = None) -> ToleranceAnalysis:
+            draws: int = 2000, seed: int | None = 0, rates=None, accelerations=None,
+            progress=None, workers: int | None = None, samples: int | None = None) -> ToleranceAnalysis:
     """Spread of the `report` quantities over `inputs` from independent normal parameter
     errors with standard deviations `std` (parameter name -> sigma, in its own unit). The
     samples run in chunks on `workers` threads (default: every core); the numbers do not
@@ -140,14 +140,17 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
         Parameter name -> standard deviation.
     report : list of str, optional
         Quantity names (default: points and link angles).
-    samples : int
-        Monte-Carlo designs.
+    draws : int
+        Monte-Carlo draws: manufactured designs, each with random parameter errors.
     seed : int, optional
     rates, accelerations : dict, optional
         As for `kincas.sweep`.
     progress : callable, optional
     workers : int, optional
-        Threads for the samples (default: every core).
+        Threads for the draws (default: every core).
+    samples : int, optional
+        Deprecated name of `draws` (kincas 0.1; a DeprecationWarning). A scene's
+        `[tolerance] samples` is unchanged.
 
     Returns
     -------
@@ -163,7 +166,7 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
     ...     links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", 3.5),
     ...            kincas.Link.bar("rocker", "D", "C", 3)],
     ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
-    >>> t = analyse(m, {"crank.angle": [0.0]}, {"a": 0.001}, ["C.x"], samples=400)
+    >>> t = analyse(m, {"crank.angle": [0.0]}, {"a": 0.001}, ["C.x"], draws=400)
     >>> round(float(t.first_order["C.x"][0]), 12), round((1 / 2 + 3.25 / 18) * 0.001, 12)
     (0.000680555556, 0.000680555556)
     >>> bool(abs(t.monte_carlo["C.x"][0] / t.first_order["C.x"][0] - 1) < 0.15)  # 400 samples
@@ -172,12 +175,13 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
     from .sensitivity import sensitivities
     from ..core.symbolic import default_report, parse_quantity
 
+    draws = keyword("analyse", "samples", "draws", samples, draws, 2000)
     report = list(default_report(m) if report is None else report)
     problems = _check_std(m, std, "std")
     problems += [f"report: {n!r}: a sensitivity has no spread to analyse" for n in report
                  if parse_quantity(n)[0] == "sens"]
-    if not isinstance(samples, int) or isinstance(samples, bool) or samples < 2:
-        problems.append(f"samples: expected a whole number >= 2, got {samples!r}")
+    if not isinstance(draws, int) or isinstance(draws, bool) or draws < 2:
+        problems.append(f"draws: expected a whole number >= 2, got {draws!r}")
     if problems:
         raise ModelError(problems)
     to = list(std)
@@ -187,11 +191,11 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
     sw = sens.sweep
     fo = np.sqrt(np.einsum("ijk,k->ij", sens.matrix ** 2, sig ** 2))  # poses x outputs
     rng = np.random.default_rng(seed)
-    dp = rng.standard_normal((samples, len(to))) * sig  # one row per manufactured mechanism
+    dp = rng.standard_normal((draws, len(to))) * sig  # one row per manufactured mechanism
     mc, shift, failed, retried = _monte_carlo(m, sw, report, to, dp, workers)
     nominal = {n: sw[n] for n in report}
     return ToleranceAnalysis(
-        names=report, std={p: float(std[p]) for p in to}, samples=samples, seed=seed,
+        names=report, std={p: float(std[p]) for p in to}, samples=draws, seed=seed,
         inputs=sw.inputs, status=sw.status, nominal=nominal,
         first_order={n: fo[:, j] for j, n in enumerate(report)},
         monte_carlo={n: mc[:, j] for j, n in enumerate(report)},

@@ -131,7 +131,7 @@ def cli_run(args) -> int:
     sc.refuse_jerks(kw["report"], "[study] report")
     try:
         r = study(sc.mechanism, kw["vary"], st.inputs, kw["report"], grid=kw["grid"],
-                  samples=kw["samples"], seed=kw["seed"], rates=st.rates,
+                  designs=kw["samples"], seed=kw["seed"], rates=st.rates,
                   accelerations=st.accelerations, degrees=st.deg, client=client,
                   workers=args.workers, progress=progress_for(args), backend=args.backend)
     finally:

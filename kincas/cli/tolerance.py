@@ -35,6 +35,7 @@ def cli_run(args) -> int:
         raise SceneError(f"--samples: expected a whole number >= 2, got {kw['samples']}")
     st = sc.study
     sc.refuse_jerks(sc.quantities, "[tolerance]")
+    kw["draws"] = kw.pop("samples")  # the scene's `[tolerance] samples`: analyse's draws
     r = analyse(sc.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
                 progress=progress_for(args), **kw)
     user = lambda n, v: np.degrees(v) if is_angular(n, sc.mechanism) and st.deg else np.asarray(v, float)

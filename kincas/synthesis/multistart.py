@@ -1,6 +1,6 @@
 """Multistart synthesis: the same optimisation from many starting designs, best optima kept.
 
-IPOPT finds a local optimum near its start. `multistart(m, samples, vary, ...)` draws
+IPOPT finds a local optimum near its start. `multistart(m, inputs, vary, ...)` draws
 `starts` starting designs in the bounds of `vary` (a Latin hypercube: one start in each of
 `starts` strata of every range, from `seed`), runs `kincas.optimize` from each (every answer
 checked as a single run checks it: assembly at every sample on the start's branch, the path
@@ -25,8 +25,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import ModelError
 from ..model.mechanism import Mechanism
-from .._deprecated import renamed
+from .._deprecated import keyword, renamed
 from ..result_base import Result
 from .study import latin_hypercube
 
@@ -93,13 +94,17 @@ class _Start:
             return start, e
 
 
-def multistart(m: Mechanism, samples, vary: dict, minimize: str | None = None, constraints=(),
-               *, starts: int = 8, seed=0, keep: int = 3, same: float = SAME, client=None,
-               workers: int | None = 1, progress=None, **kw) -> Multistart:
+def multistart(m: Mechanism, inputs=None, vary: dict | None = None, minimize: str | None = None,
+               constraints=(), *, starts: int = 8, seed=0, keep: int = 3, same: float = SAME,
+               client=None, workers: int | None = 1, progress=None, samples=None,
+               **kw) -> Multistart:
     """Optimise from `starts` designs drawn in the bounds (see the module's text); `kw` are
     `kincas.optimize`'s keywords. `workers` defaults to 1: IPOPT's linear solver is not
     re-entrant, so one process runs one optimisation at a time (a Dask cluster's worker
-    processes run theirs side by side)."""
+    processes run theirs side by side). `samples` is the deprecated name of `inputs`."""
+    samples = keyword("multistart", "samples", "inputs", samples, inputs)
+    if samples is None or vary is None:
+        raise ModelError([f"{k}: missing" for k, v in (("inputs", samples), ("vary", vary)) if v is None])
     names = list(vary)
     ranges = [tuple(float(v) for v in vary[k]) for k in names]
     X = latin_hypercube(ranges, int(starts), seed)

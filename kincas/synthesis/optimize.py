@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.mechanism import Mechanism
-from .._deprecated import renamed
+from .._deprecated import keyword, renamed
 from ..result_base import Result
 from ..errors import ModelError
 from ..results import Sweep
@@ -154,14 +154,15 @@ def _as_constraint(c, i) -> Constraint:
 
 
 
-def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, constraints=(), *, data=None,
-             rates=None, accelerations=None, deg: bool = False, check_path: bool = True,
-             max_iter: int = 1000, tol: float = 1e-12) -> Optimization:
+def optimize(m: Mechanism, inputs=None, vary: dict | None = None, minimize: str | None = None,
+             constraints=(), *, data=None, rates=None, accelerations=None, deg: bool = False,
+             check_path: bool = True, max_iter: int = 1000, tol: float = 1e-12,
+             samples=None) -> Optimization:
     """Vary the parameters `vary` (name -> (low, high)) to minimise `minimize` subject to
     `constraints` (Constraint, dict {expr, min, max} or tuple (expr, min, max)), with the
-    mechanism posed at the `samples` inputs (key -> array, as for `kincas.sweep`).
+    mechanism posed at the `inputs` (key -> array, as for `kincas.sweep`): the samples.
 
-    `samples` may instead be a `Curve` (see `kincas.curve`): targets for a point without
+    `inputs` may instead be a `Curve` (see `kincas.curve`): targets for a point without
     prescribed inputs. Then the input at each target is a variable too (`samples` of the
     result gives the fitted ones), the objective is the sum of squared distances from the
     point to the targets, plus `minimize` if given, and `data` has one value per target.
@@ -174,7 +175,7 @@ def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, con
     ----------
     m : Mechanism
         The initial design; its guess picks the assembly branch kept at every sample.
-    samples : dict or Curve
+    inputs : dict or Curve
         Input key -> values of the samples; or target points (`kincas.curve.Curve`).
     vary : dict
         Parameter name -> (low, high).
@@ -192,6 +193,8 @@ def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, con
         Sweep the optimised design through the samples to check its branch.
     max_iter, tol : int, float
         IPOPT's iterations and tolerance.
+    samples : dict or Curve, optional
+        Deprecated keyword name of `inputs` (kincas 0.1; a DeprecationWarning).
 
     Returns
     -------
@@ -212,6 +215,10 @@ def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, con
     >>> r.ok, round(r.parameters["c"], 9), round(float(np.hypot(np.sqrt(10) - 4, 2.5)), 9)
     (True, 2.636622597, 2.636622597)
     """
+    samples = keyword("optimize", "samples", "inputs", samples, inputs)
+    problems = [f"{k}: missing" for k, v in (("inputs", samples), ("vary", vary)) if v is None]
+    if problems:
+        raise ModelError(problems)
     first = _once(m, samples, vary, minimize, constraints, data, rates, accelerations, deg,
                   check_path, max_iter, tol)
     r, rounds = first, 1

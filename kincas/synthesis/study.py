@@ -1,8 +1,8 @@
 """Design studies: many designs of one mechanism, one row of results per design.
 
 `study(m, vary, inputs, report)` makes designs from ranges of some parameters (`grid`: a full
-grid; `samples`: a Latin hypercube, one sample in each of `samples` equal strata of every
-range, with a seed), sweeps each over the inputs on the branch of m's guess
+grid; `designs`: a Latin hypercube, one design in each of `designs` equal strata of every
+range, with a seed; the scene's `[study] samples`), sweeps each over the inputs on the branch of m's guess
 (`kincas.sweep_designs`), and evaluates the `report` expressions over each design's sweep.
 The expressions are those of `[optimize]` (kincas.synthesis.expressions), evaluated on the
 swept poses: `max(E)` and `min(E)` are the extremes over the poses of the sweep, `sum` and
@@ -34,7 +34,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import Mechanism
-from .._deprecated import renamed
+from .._deprecated import keyword, renamed
 from ..result_base import Result
 from .expressions import AGGREGATE, CONST, SAMPLE, TOTAL, parse, quantity_name
 
@@ -247,10 +247,10 @@ class _Chunk:
         return idx, code, pose, vals
 
 
-def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, seed=0,
+def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, designs=None, seed=0,
           rates=None, accelerations=None, degrees: bool = False, client=None,
           workers: int | None = None, chunk: int | None = None, compile: bool | None = None,
-          progress=None, backend: str = "casadi") -> Study:
+          progress=None, backend: str = "casadi", samples=None) -> Study:
     """Sweep many designs of `m` and evaluate `report` over each (see the module's text).
 
     Parameters
@@ -264,7 +264,9 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, 
     report : list of str
         Expressions in the `[optimize]` language, each one number per design.
     grid : sequence of int, optional
-        Values per parameter of a full grid; or `samples` (with `seed`) for a Latin hypercube.
+        Values per parameter of a full grid; or:
+    designs : int, optional
+        How many designs, drawn as a Latin hypercube (with `seed`).
     degrees : bool
         Quantities, trigonometric functions and input values in the messages in degrees.
     client : dask.distributed.Client, optional
@@ -275,6 +277,9 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, 
         to 4096 designs a chunk).
     backend : {"casadi", "jax"}
         The designs' fast pass, as for `kincas.sweep_designs`.
+    samples : int, optional
+        Deprecated name of `designs` (kincas 0.1; a DeprecationWarning). A scene's
+        `[study] samples` is unchanged.
 
     Returns
     -------
@@ -303,12 +308,13 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, 
 
     names = list(vary)
     ranges = [tuple(float(x) for x in vary[k]) for k in names]
-    if (grid is None) == (samples is None):
-        raise ModelError("give either grid (values per parameter) or samples (Latin hypercube)")
+    designs = keyword("study", "samples", "designs", samples, designs)
+    if (grid is None) == (designs is None):
+        raise ModelError("give either grid (values per parameter) or designs (a count, for a Latin hypercube)")
     if grid is not None:
         X = grid_designs(ranges, list(grid))
     else:
-        X = latin_hypercube(ranges, int(samples), seed)
+        X = latin_hypercube(ranges, int(designs), seed)
     design_table(m, X, names)  # names checked
     parse_report(m, report)
     U = _input_table(m, inputs, "inputs", None)
