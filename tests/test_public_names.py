@@ -116,3 +116,17 @@ def test_optimize_takes_inputs_and_the_old_samples_keyword_warns():
         assert r.ok and abs(r.varied["a"] - 1 / math.cos(0.5)) < 1e-8
     with pytest.raises(kincas.ModelError, match="inputs: missing"):
         kincas.optimize(_crank(), **kw)
+
+
+def test_newton_ignores_L_as_documented():
+    import numpy as np
+    m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+                         links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+                                kincas.Link.bar("rocker", "D", "C", 3)],
+                         inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+    model, u, p = kincas.model_of(m), np.array([0.5]), np.zeros(0)
+    q0 = model.initial_q(u, p, dict(m.guess), m.size()) + 0.05  # off the solution
+    sols = [model.newton(q0, u, p)] + [model.newton(q0, u, p, L) for L in (None, 1e-9, 1.0, 1e9)]
+    sols.append(model.newton(q0, u, p, L=7.0, max_iter=60))
+    assert all(s.ok for s in sols)
+    assert all(np.array_equal(s.q, sols[0].q) and s.residual == sols[0].residual for s in sols)
