@@ -2,7 +2,10 @@
 
 Scripts written against the first README import `kincas.modes`, `kincas.plot`, ...; those
 modules now live in subpackages. A meta-path finder resolves the old names lazily, so
-`import kincas` stays cheap and `import kincas.modes` still works.
+`import kincas` stays cheap and `import kincas.modes` still works, for one more release: it
+warns (DeprecationWarning) and names the new path. `kincas.optimize` (the function itself) and
+`kincas.scene`, `kincas.plot`, `kincas.outputs` (the README's entry points for scenes and
+drawings) stay quiet.
 """
 from __future__ import annotations
 
@@ -10,6 +13,7 @@ import importlib
 import importlib.abc
 import importlib.util
 import sys
+import warnings
 
 OLD = {
     "symbolic": "core.symbolic", "numeric": "core.numeric", "fast": "core.fast",
@@ -21,17 +25,23 @@ OLD = {
     "checks": "synthesis.checks", "scene": "cli.scene", "outputs": "cli.outputs",
     "plot": "cli.plot", "progress": "cli.progress",
 }
+QUIET = {"optimize", "scene", "plot", "outputs"}  # current entry points: no warning
 
 
 class _Loader(importlib.abc.Loader):
-    def __init__(self, target: str):
-        self.target = target
+    def __init__(self, target: str, old: str | None = None):
+        self.target, self.old = target, old
 
     def create_module(self, spec):
-        return importlib.import_module(self.target)  # the real module, under both names
+        if self.old is not None:
+            warnings.warn(f"{self.old} moved to {self.target}; the old path goes in the next release",
+                          DeprecationWarning, stacklevel=2)  # the importer (import frames are skipped)
+        module = importlib.import_module(self.target)  # the real module, under both names
+        self.spec = module.__spec__
+        return module
 
     def exec_module(self, module):
-        pass  # already executed under its new name
+        module.__spec__ = self.spec  # the import machinery set the alias's: the real one back
 
 
 class _Finder(importlib.abc.MetaPathFinder):
@@ -39,7 +49,8 @@ class _Finder(importlib.abc.MetaPathFinder):
         head, _, tail = fullname.partition(".")
         if head != "kincas" or tail not in OLD:
             return None
-        return importlib.util.spec_from_loader(fullname, _Loader(f"kincas.{OLD[tail]}"))
+        old = None if tail in QUIET else fullname
+        return importlib.util.spec_from_loader(fullname, _Loader(f"kincas.{OLD[tail]}", old))
 
 
 def install() -> None:
@@ -59,5 +70,8 @@ def attribute(name: str):
     if name in FUNCTIONS:
         return getattr(importlib.import_module(f"kincas.{FUNCTIONS[name]}"), name)
     if name in OLD:
+        if name not in QUIET:
+            warnings.warn(f"kincas.{name} moved to kincas.{OLD[name]}; the old path goes in the "
+                          f"next release", DeprecationWarning, stacklevel=3)  # kincas.__getattr__'s caller
         return importlib.import_module(f"kincas.{OLD[name]}")
     raise AttributeError(f"module 'kincas' has no attribute {name!r}")

@@ -130,3 +130,26 @@ def test_newton_ignores_L_as_documented():
     sols.append(model.newton(q0, u, p, L=7.0, max_iter=60))
     assert all(s.ok for s in sols)
     assert all(np.array_equal(s.q, sols[0].q) and s.residual == sols[0].residual for s in sols)
+
+
+@pytest.mark.parametrize("old", sorted(importlib.import_module("kincas._aliases").OLD))
+def test_old_module_paths_warn_naming_the_new_one(old, monkeypatch):
+    from kincas import _aliases
+    new = f"kincas.{_aliases.OLD[old]}"
+    real = importlib.import_module(new)
+    import sys
+    monkeypatch.delitem(sys.modules, f"kincas.{old}", raising=False)  # a first import again
+    monkeypatch.delitem(vars(kincas), old, raising=False)
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        mod = importlib.import_module(f"kincas.{old}")
+        attr = getattr(kincas, old)
+    assert mod is real and attr is real and real.__spec__.name == new
+    texts = [str(w.message) for w in seen if issubclass(w.category, DeprecationWarning)]
+    if old in _aliases.QUIET:  # the function kincas.optimize, the README's scene and drawings
+        assert not texts
+    else:
+        assert texts == [f"kincas.{old} moved to {new}; the old path goes in the next release"]
+        monkeypatch.delitem(vars(kincas), old, raising=False)
+        with pytest.warns(DeprecationWarning, match=f"kincas.{old} moved to {new}"):
+            getattr(kincas, old)  # the attribute, without an import, warns too

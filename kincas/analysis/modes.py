@@ -14,7 +14,7 @@ basin of attraction under a trust-region Newton is rarely small: with a few hund
 the six assemblies of the class-III triad are found from every seed in the tests.
 
 >>> import numpy as np, kincas
->>> from kincas.modes import find_modes
+>>> from kincas.analysis.modes import find_modes
 >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
 ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
 ...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
