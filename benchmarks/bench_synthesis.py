@@ -7,7 +7,7 @@ The study is examples/synthesis_path.toml: six dimensions of a crank-rocker four
 crank, coupler, rocker, coupler point x and y) so that the coupler point passes near twelve
 target points, one every 30 deg of the crank; objective: the sum of squared distances (mm^2).
 
-* kincas: `kincas.synthesis.optimize.run_scene` on the scene, timed whole (NLP construction, IPOPT,
+* kincas: `kincas.cli.scene_optimize.run_scene` on the scene, timed whole (NLP construction, IPOPT,
   the checks of the answer: polishing, branch, sweep between samples). Also timed in a fresh
   process from `import kincas` (reading the scene and building the model included), and
   the first call in this process apart from later ones.
@@ -41,7 +41,7 @@ ROOT = HERE.parent
 sys.path.insert(0, str(ROOT))
 
 import kincas  # noqa: E402
-from kincas.synthesis.optimize import run_scene  # noqa: E402
+from kincas.cli.scene_optimize import run_scene  # noqa: E402
 from kincas.cli.scene import load  # noqa: E402
 
 SCENE = ROOT / "examples" / "synthesis_path.toml"
@@ -99,7 +99,7 @@ def score_kincas(S, p):
 def cold_kincas():
     """Seconds for import + scene + optimise in a fresh process (interpreter start excluded)."""
     code = ("import time; t = time.perf_counter(); from kincas.cli.scene import load; "
-            "from kincas.synthesis.optimize import run_scene; r = run_scene(load(%r)); "
+            "from kincas.cli.scene_optimize import run_scene; r = run_scene(load(%r)); "
             "print(time.perf_counter() - t)" % str(SCENE))
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     return float(out.stdout.split()[-1]) if out.returncode == 0 else math.nan

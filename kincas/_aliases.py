@@ -1,11 +1,13 @@
-"""Old module paths (kincas 0.1's flat layout) as aliases of their new homes.
+"""Old module paths as aliases of their new homes.
 
 Scripts written against the first README import `kincas.modes`, `kincas.plot`, ...; those
 modules now live in subpackages. A meta-path finder resolves the old names lazily, so
 `import kincas` stays cheap and `import kincas.modes` still works, for one more release: it
 warns (DeprecationWarning) and names the new path. `kincas.optimize` (the function itself) and
 `kincas.scene`, `kincas.plot`, `kincas.outputs` (the README's entry points for scenes and
-drawings) stay quiet.
+drawings) stay quiet. The presentation modules that left `kincas/cli` for `kincas/views`
+(`kincas.cli.plot`, `kincas.cli.svg`, `kincas.notebook`, ...) still import under their old
+paths for one release, with a DeprecationWarning naming the new one.
 """
 from __future__ import annotations
 
@@ -23,9 +25,14 @@ OLD = {
     "optimize": "synthesis.optimize", "simultaneous": "synthesis.simultaneous",
     "expressions": "synthesis.expressions", "curve": "synthesis.curve",
     "checks": "synthesis.checks", "scene": "cli.scene", "outputs": "cli.outputs",
-    "plot": "cli.plot", "progress": "cli.progress",
+    "plot": "views.plot", "progress": "cli.progress",
 }
 QUIET = {"optimize", "scene", "plot", "outputs"}  # current entry points: no warning
+# paths of this release's predecessor: warned (DeprecationWarning), removed in the next release
+MOVED = {f"cli.{m}": f"views.{m}" for m in ("plot", "svg", "picture", "draw_joints",
+                                           "draw_geometry", "dxf", "html", "mapplot", "numbers",
+                                           "atomic")}
+MOVED["notebook"] = "views.notebook"
 
 
 class _Loader(importlib.abc.Loader):
@@ -47,15 +54,17 @@ class _Loader(importlib.abc.Loader):
 class _Finder(importlib.abc.MetaPathFinder):
     def find_spec(self, fullname, path=None, target=None):
         head, _, tail = fullname.partition(".")
-        if head != "kincas" or tail not in OLD:
+        if head != "kincas" or (tail not in OLD and tail not in MOVED):
             return None
+        if tail in MOVED:
+            return importlib.util.spec_from_loader(fullname, _Loader(f"kincas.{MOVED[tail]}", fullname))
         old = None if tail in QUIET else fullname
         return importlib.util.spec_from_loader(fullname, _Loader(f"kincas.{OLD[tail]}", old))
 
 
 def install() -> None:
     if not any(isinstance(f, _Finder) for f in sys.meta_path):
-        sys.meta_path.append(_Finder())
+        sys.meta_path.insert(0, _Finder())  # only its own old names: before another copy's finder
 
 
 # functions exported from `kincas`, loaded on first use (`kincas.optimize` is the module of
@@ -74,4 +83,6 @@ def attribute(name: str):
             warnings.warn(f"kincas.{name} moved to kincas.{OLD[name]}; the old path goes in the "
                           f"next release", DeprecationWarning, stacklevel=3)  # kincas.__getattr__'s caller
         return importlib.import_module(f"kincas.{OLD[name]}")
+    if name in MOVED:
+        return importlib.import_module(f"kincas.{name}")  # through the finder: warned
     raise AttributeError(f"module 'kincas' has no attribute {name!r}")

@@ -298,11 +298,6 @@ class Sweep(Result):
         out.append(f"  reported: {_names(self.values, 8) or 'nothing'}")
         return out
 
-    def _repr_html_(self) -> str:
-        """Jupyter's display: the summary and small plots of the quantities."""
-        from .notebook import sweep_html
-        return sweep_html(self)
-
     # --- in the data tools (extra kincas[data]) ---
     def to_pandas(self, length: str = ""):
         """A DataFrame: one row per pose, the inputs as index, a column per quantity, then

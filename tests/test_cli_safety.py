@@ -290,7 +290,7 @@ def test_modes_write_on_a_full_disk(capsys, tmp_path, monkeypatch):
 
 
 def test_the_atomic_writer_removes_its_file_on_any_failure(tmp_path):
-    from kincas.cli.atomic import replacing
+    from kincas.views.atomic import replacing
 
     target = tmp_path / "t.csv"
     for error in (OSError(errno.ENOSPC, "full"), KeyboardInterrupt(), ValueError("bad")):
@@ -315,7 +315,7 @@ def _umask() -> int:
 
 def test_writing_to_a_device_writes_through(tmp_path):
     """/dev/null (or /dev/stdout) is not a file to replace: written as it is."""
-    from kincas.cli.atomic import replacing
+    from kincas.views.atomic import replacing
 
     with replacing("/dev/null") as tmp:
         assert tmp == "/dev/null"

@@ -1,4 +1,4 @@
-"""Evolutes and centrodes drawn by `--plot --evolute P --centrodes L` (kincas/cli/draw_geometry.py):
+"""Evolutes and centrodes drawn by `--plot --evolute P --centrodes L` (kincas/views/draw_geometry.py):
 the curves' defining properties, and the CLI's options."""
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 pytest.importorskip("matplotlib")
 
 import kincas
-from kincas.cli.draw_geometry import curves
+from kincas.views.draw_geometry import curves
 from conftest import EXAMPLES, run_cli
 
 

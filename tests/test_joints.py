@@ -357,7 +357,7 @@ def _line(ax, label):
 def test_pictures_of_gears_racks_and_cams():
     pytest.importorskip("matplotlib")
     from matplotlib.figure import Figure
-    from kincas.cli.plot import draw
+    from kincas.views.plot import draw
     from kincas.cli.scene import load
 
     def drawn(name, pose, report):
@@ -391,7 +391,7 @@ def test_vector_pictures_draw_the_joints():
     roller's circle on layer "joints"."""
     import xml.etree.ElementTree as ET
     from kincas.cli.scene import load
-    from kincas.cli.svg import svg_text
+    from kincas.views.svg import svg_text
     sc = load(EXAMPLES / "planetary.toml")
     sw = kincas.sweep(sc.mechanism, sc.study.inputs, report=["C.x", "C.y"])
     root = ET.fromstring(svg_text(sc.mechanism, sw, pose=4))
@@ -403,7 +403,7 @@ def test_vector_pictures_draw_the_joints():
         found |= e.get("data-joint") == "planet_ring pitch circle" and np.allclose(np.hypot(*(pts - c).T), 15, atol=1e-8)
     assert found
     pytest.importorskip("ezdxf")
-    from kincas.cli.dxf import dxf_document
+    from kincas.views.dxf import dxf_document
     sc = load(EXAMPLES / "roller_cam.toml")
     sw = kincas.sweep(sc.mechanism, sc.study.inputs, report=["F.x", "F.y"])
     doc = dxf_document(sc.mechanism, sw, pose=2)

@@ -16,7 +16,8 @@ import kincas
 import kincas.cli.scene
 from conftest import EXAMPLES, run_cli, write_scene
 from kincas import Input, Link, Mechanism, ModelError, Slide
-from kincas.analysis.modes import Mode, find_modes, scene_with_guess
+from kincas.analysis.modes import Mode, find_modes
+from kincas.cli.scene_guess import scene_with_guess
 from test_class3 import POSITION_TOL, circles, match, track, triad_assemblies
 
 TRIAD = EXAMPLES / "assur_triad.toml"

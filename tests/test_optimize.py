@@ -21,7 +21,8 @@ import kincas
 from kincas import Input, Link, Mechanism, ModelError, Slide
 from kincas.cli import main
 from kincas.synthesis.expressions import parse
-from kincas.synthesis.optimize import Constraint, Curve, optimize, run_scene
+from kincas.cli.scene_optimize import run_scene
+from kincas.synthesis.optimize import Constraint, Curve, optimize
 from kincas.cli.scene import load, loads
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"

@@ -140,7 +140,7 @@ def test_missing_matplotlib_is_one_line_and_status_2(capsys, tmp_path, monkeypat
 
 def test_the_library_imports_and_writes_csv_without_matplotlib():
     code = ("import sys; sys.modules['matplotlib'] = None\n"
-            "import io, kincas, kincas.cli.plot, kincas.cli.outputs, kincas.cli.progress\n"
+            "import io, kincas, kincas.views.plot, kincas.cli.outputs, kincas.cli.progress\n"
             "m = kincas.Mechanism(ground={'O': (0, 0)}, links=[kincas.Link.bar('c', 'O', 'A', 1),"
             " kincas.Link.bar('r', 'A', 'B', 3)], slides=[kincas.Slide('B', 'ground')],"
             " inputs=[kincas.Input.angle('c')], guess={'B': (4, 0)})\n"

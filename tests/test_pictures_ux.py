@@ -29,7 +29,7 @@ def _cross(p, q, a, b) -> bool:
 @pytest.mark.parametrize("e", [0.0, 0.5, -0.5], ids=["centric", "offset", "offset-below"])
 def test_no_link_crosses_a_hatched_guide(e):
     from matplotlib.figure import Figure
-    from kincas.cli.plot import Drawing, geometry
+    from kincas.views.plot import Drawing, geometry
     m = slider_crank(e)
     sw = kincas.sweep(m, {"crank.angle": np.linspace(0, 2 * np.pi, 73)})
     d = Drawing(Figure().subplots(), m, geometry(m, sw), [], False)
@@ -66,7 +66,7 @@ def test_a_near_constant_quantity_is_plotted_flat():
 
 def test_paths_are_smooth_and_solved():
     from matplotlib.figure import Figure
-    from kincas.cli.plot import draw
+    from kincas.views.plot import draw
     m = slider_crank(0.0)
     sw = kincas.sweep(m, {"crank.angle": np.linspace(0, 2 * np.pi, 12)})
     ax = draw(m, sw, ax=Figure().subplots(), paths=["A"])

@@ -17,7 +17,7 @@ matplotlib.use("Agg", force=True)
 
 import kincas  # noqa: E402
 from kincas.cli.outputs import animate  # noqa: E402
-from kincas.cli.plot import draw, geometry, new_figure  # noqa: E402
+from kincas.views.plot import draw, geometry, new_figure  # noqa: E402
 from kincas.cli.scene import load  # noqa: E402
 
 SIZE, DPI = (4.0, 3.0), 80

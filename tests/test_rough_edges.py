@@ -184,3 +184,24 @@ def test_range_of_a_structure_without_inputs_says_so(capsys, tmp_path):
     text = text[:text.index("[[inputs]]")] + text[text.index("\n[guess]"):]
     code, out, err = run_cli(capsys, "range", write_scene(tmp_path, text))
     one_line_exit_2(code, err, "[[inputs]]", "range")
+
+
+def test_the_size_checks_build_no_model(capsys, tmp_path, monkeypatch):
+    """--starts and --samples are checked against the declarations' count of the unknowns
+    (Mechanism.structure less the driven angles), the model's count: no CasADi model is built
+    to refuse a size."""
+    import kincas
+    import kincas.core.numeric as numeric
+    from kincas.cli.scene import loads
+    from kincas.model.mechanism import solved_unknowns
+    from conftest import EXAMPLES
+    for path in sorted(EXAMPLES.glob("*.toml")):  # the same count as the model's own
+        m = loads(path.read_text(encoding="utf-8")).mechanism
+        assert solved_unknowns(m) == kincas.model_of(m).nq, path.name
+    built = []
+    monkeypatch.setattr(numeric, "_CACHE", {})
+    monkeypatch.setattr(numeric.Model, "__init__", lambda self, *a, **k: built.append(1) or 1 / 0)
+    text = FAIRBAIRN + "\n[tolerance]\nstd = { a1 = 0.1 }\nsamples = 100000000\n"
+    code, out, err = run_cli(capsys, "tolerance", write_scene(tmp_path, text))
+    one_line_exit_2(code, err, "samples", "GB")
+    assert built == []

@@ -70,7 +70,7 @@ def test_dxf_read_back(capsys, tmp_path):
 
 def test_svg_and_dxf_from_python(tmp_path):
     import kincas
-    from kincas.cli.svg import svg_text
+    from kincas.views.svg import svg_text
     sc = kincas.scene.load(EXAMPLES / "slider_crank.toml")
     sw = sc.run()
     root = ET.fromstring(svg_text(sc.mechanism, sw, pose=0))
@@ -83,3 +83,37 @@ def test_dxf_without_ezdxf_is_one_line(capsys, tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "ezdxf", None)
     code, _, err = run_cli(capsys, "solve", EXAMPLES / "slider_crank.toml", "--dxf", tmp_path / "x.dxf")
     assert code == 2 and 'pip install "kincas[cad]"' in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("steps,flags,fine", [(13, ("png", "svg", "html", "dxf"), [12 * 17 + 1]),  # 16 between poses
+                                              (73, ("png", "svg", "html", "dxf"), [72 * 5 + 1]),  # 4 between
+                                              (73, ("png",), [])])
+def test_pictures_share_one_solve_of_their_paths(capsys, tmp_path, monkeypatch, steps, flags, fine):
+    """--plot, --svg, --html and --dxf draw from the sweep already solved; the extra poses
+    that smooth their paths are solved once for all of them (as many as the most demanding
+    needs: about 360 points a path for a drawing, 4 between two poses for vector pictures),
+    and a drawing of more than 60 poses is drawn as it is."""
+    pytest.importorskip("matplotlib")
+    pytest.importorskip("ezdxf")
+    import kincas.analysis.sweeps as sweeps
+    from conftest import write_scene
+    calls, real = [], sweeps.sweep
+
+    def counted(*a, **k):
+        calls.append(len(next(iter(a[1].values()))))
+        return real(*a, **k)
+    monkeypatch.setattr(sweeps, "sweep", counted)
+    text = (EXAMPLES / "slider_crank.toml").read_text(encoding="utf-8").replace("steps = 73", f"steps = {steps}")
+    out = {k: tmp_path / f"x.{k}" for k in flags}
+    flag = {"png": "--plot", "svg": "--svg", "html": "--html", "dxf": "--dxf"}
+    code, _, err = run_cli(capsys, "solve", write_scene(tmp_path, text),
+                           *[a for k in flags for a in (flag[k], out[k])])
+    assert code == 0, err
+    assert calls == [steps] + fine  # the sweep, then at most one solve of the paths
+    if "svg" not in flags:
+        return
+    root = ET.parse(out["svg"]).getroot()
+    (path_a,) = [e for e in root.iter(SVG + "polyline") if e.get("data-path") == "A"]
+    xy = np.array([[float(v) for v in p.split(",")] for p in path_a.get("points").split()])
+    assert len(xy) == fine[0]  # the shared paths
+    assert np.allclose(np.hypot(xy[:, 0], xy[:, 1]), R, atol=1e-6)  # solved: on the crank's circle

@@ -128,7 +128,7 @@ def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:
 
 
 def _scaled_norm(model: Model, dq, L) -> float:
-    return float(np.abs(dq / np.where(model.sym.is_length, L, 1.0)).max(initial=0.0))
+    return float(np.abs(dq / np.where(model.is_length, L, 1.0)).max(initial=0.0))
 
 
 def _continue(model: Model, q0, u0, u1, p, L, depth: int, prev=None, reach=None) -> Solution | None:

@@ -54,7 +54,7 @@ from ..core.compiled import ptr, rows
 from ..core.designs_kernel import MAX_STEPS, NEWTON, STEP, designs_loop_for
 from ..core.fast import FastRun
 from ..core.numeric import ACCEPT, compile as compile_model
-from ..core.symbolic import default_report
+from ..model.names import default_report
 from ..model.mechanism import Mechanism, as_param
 from ..core.assembly import modes
 from ..core.blocks import numeric_signs
@@ -402,7 +402,7 @@ class _Job:
         model, P, Ls = self.model, self.P[idx], self.Ls[idx]
         nd, u = P.shape[0], np.repeat(self.U[:1], P.shape[0], axis=0)
         ev = BatchEvaluator(model)
-        scale = np.where(model.sym.is_length[None, :], 1.0, 1.0 / Ls[:, None])
+        scale = np.where(model.is_length[None, :], 1.0, 1.0 / Ls[:, None])
         dP = P - p0
         # Steps of at most STEP * size in every parameter, counted per design, so that a
         # design's numbers do not depend on the others computed with it (chunks on a cluster).
@@ -476,7 +476,7 @@ class _Job:
         stops = np.full(len(todo), n)
         live = np.arange(len(todo))  # positions in todo still advancing
         d = todo
-        D = np.where(model.sym.is_length[None, :], self.Ls[d][:, None], 1.0)
+        D = np.where(model.is_length[None, :], self.Ls[d][:, None], 1.0)
         q = self.Q[d, 0]
         _, J, Ju, _ = ev.derivatives(q, np.repeat(U[:1], len(d), 0), self.P[d])
         T = -_solve(J, Ju)

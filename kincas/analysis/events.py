@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.assembly import NEAR, group_links, modes, polish_singular, refine
-from ..core.symbolic import parse_quantity
+from ..model.names import parse_quantity
 from .singular import FLAG_SIGMA, classify, locate_singular, scaled_jacobians
 
 MAX_GROUPS_AT_GAP = 8  # groups tried for a limit next to a gap (the worst conditioned first)
@@ -219,7 +219,7 @@ def null_derivatives(model, report, values, Q, U, p, at) -> None:
     plain = []
     for r, name in enumerate(report):
         kind, obj, attr = parse_quantity(name)
-        _, order = model.sym.position_expr(obj, attr) if kind == "plain" else (None, None)
+        order = model.derivative_order(obj, attr) if kind == "plain" else None
         plain.append(order == 0)
     plain = np.array(plain)
     if plain.any():

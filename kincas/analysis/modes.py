@@ -30,13 +30,11 @@ True
 from __future__ import annotations
 
 import math
-import re
-import tomllib
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ModelError, SceneError
+from ..errors import ModelError
 from ..model.mechanism import Mechanism
 from ..results import wrap_angle
 from ..core.turns import tied, turns
@@ -162,7 +160,7 @@ def _scatter(m: Mechanism, model, n: int, L: float, seed: int) -> np.ndarray:
     """n starts over the reachable workspace: angles uniform in (-pi, pi]; the origin of a
     floating link uniform in a square of half-side L around a randomly chosen ground point."""
     rng = np.random.default_rng(seed)
-    names = [nm for nm, _ in model.sym.unknowns]
+    names = model.unknown_names
     Q = rng.uniform(-math.pi, math.pi, size=(n, len(names)))
     ground = np.array([(m.value(x), m.value(y)) for _, (x, y) in m.ground]).reshape(-1, 2)
     if len(ground) == 0:
@@ -180,12 +178,7 @@ def _scatter(m: Mechanism, model, n: int, L: float, seed: int) -> np.ndarray:
 
 def _point_rows(model, Q, u, p) -> np.ndarray:
     """The moving points of every row of Q, one row (x1, y1, x2, y2, ...) per start."""
-    n = Q.shape[0]
-    if n == 0:
-        return np.zeros((0, 0))
-    f = model.sym.f_points.map(n)
-    pts = np.asarray(f(Q.T, np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)))
-    return pts.reshape(2, -1, n, order="F").transpose(2, 1, 0).reshape(n, -1)
+    return model.points_many(Q, u, p)
 
 
 def _unique(rows: np.ndarray, tol: float) -> list[int]:
@@ -200,7 +193,7 @@ def _unique(rows: np.ndarray, tol: float) -> list[int]:
 def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
     """One Mode per distinct assembly: two solutions are the same mode when all their moving
     points agree to SAME * L (the points fix every link's angle modulo 2 pi)."""
-    sym, names = model.sym, m.moving_points
+    names = m.moving_points
     picked = None if picked_q is None else model.points(picked_q, u, p).T.ravel()
     Q = np.array(found).reshape(len(found), model.nq)
     rows = _point_rows(model, Q, u, p)
@@ -214,7 +207,7 @@ def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
                                np.ones((1, len(u))), np.zeros((1, len(u))))[:, 0]
         det = np.linalg.det(model.jac(q, u, p) * s) if model.nq else 1.0
         res = float(np.abs(model.residual(q, u, p)).max(initial=0.0) / L)
-        out.append(Mode(q=np.array(q), unknowns=tuple(nm for nm, _ in sym.unknowns),
+        out.append(Mode(q=np.array(q), unknowns=tuple(model.unknown_names),
                         points={nm: (float(pts[2 * j]), float(pts[2 * j + 1]))
                                 for j, nm in enumerate(names)},
                         angles={lk: float(wrap_angle(a)) for lk, a in zip(links, ang)},
@@ -222,45 +215,3 @@ def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
                         from_guess=bool(picked is not None and np.abs(pts - picked).max() <= SAME * L),
                         inputs={i.key: float(v) for i, v in zip(m.inputs, u)}))
     return [md for md in out if md.residual <= ACCEPT]  # each checked by its residual
-
-
-# --- scenes with a mode's guess ---
-
-_GUESS_HEADER = re.compile(r"^\s*\[\s*guess\s*\]\s*(#.*)?$")
-_ANY_HEADER = re.compile(r"^\s*\[")
-_FILLER = re.compile(r"^\s*(#.*)?$")
-
-
-def scene_with_guess(text: str, mode: Mode, note: str = "") -> str:
-    """The scene's TOML text with its `[guess]` table replaced by the mode's (appended when
-    the scene has none); everything else is kept as written.
-
-    >>> md = Mode(np.zeros(1), ("a",), {"C": (3.5, -2.0)}, {}, 0.0, 1)
-    >>> print(scene_with_guess('a = 1\\n[guess]\\nC = [1, 2]\\n\\n[output]\\n', md), end="")
-    a = 1
-    [guess]
-    C = [3.5, -2]
-    <BLANKLINE>
-    [output]
-    """
-    lines = text.splitlines(keepends=True)
-    if lines and not lines[-1].endswith("\n"):
-        lines[-1] += "\n"
-    block = ([f"# {note}\n"] if note else []) + mode.guess_block().splitlines(keepends=True)
-    start = next((i for i, ln in enumerate(lines) if _GUESS_HEADER.match(ln)), None)
-    if start is None:
-        lines += ["\n"] + block
-    else:
-        end = next((j for j in range(start + 1, len(lines)) if _ANY_HEADER.match(lines[j])), len(lines))
-        while end > start + 1 and _FILLER.match(lines[end - 1]):
-            end -= 1  # blank lines and comments before the next table belong to it
-        lines[start:end] = block
-    out = "".join(lines)
-    try:
-        written = tomllib.loads(out).get("guess", {})
-    except tomllib.TOMLDecodeError:
-        written = None
-    if written is None or set(written) != set(mode.points):
-        raise SceneError("[guess]: not written as a [guess] table, so it cannot be replaced; "
-                         "copy the printed [guess] block into the scene instead")
-    return out

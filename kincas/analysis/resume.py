@@ -58,7 +58,11 @@ def larger_groups(model) -> list[int]:
     Examples
     --------
     >>> import kincas
-    >>> larger_groups(kincas.compile(_fourbar()))  # a four-bar's one group is a dyad
+    >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},     # the examples' triple rocker
+    ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 1.9),
+    ...            kincas.Link.bar("rocker", "D", "C", 3)],
+    ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.2, 2.5)})
+    >>> larger_groups(kincas.model_of(m))  # a four-bar's one group is a dyad
     []
     """
     if not model.square:
@@ -101,7 +105,10 @@ def resume_label(model, U, p, L, j, qj, k, qk, carried=None) -> dict:
     the side it left (the sign of its block, which is a dyad's mode):
 
     >>> import numpy as np, kincas
-    >>> m = _fourbar()
+    >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},     # the examples' triple rocker
+    ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 1.9),
+    ...            kincas.Link.bar("rocker", "D", "C", 3)],
+    ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.2, 2.5)})
     >>> U = np.radians([[140.0], [180.0], [220.0]])
     >>> sw = kincas.sweep(m, {"crank.angle": U[:, 0]}, report=["C.y"])
     >>> sw.status.tolist()
@@ -188,7 +195,10 @@ def carry_groups(model, U, p, L, j, qj, k, groups, memo=None) -> dict:
     The triple rocker's dyad cannot be carried through the inputs where it has no assembly:
 
     >>> import numpy as np, kincas
-    >>> m = _fourbar()
+    >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},     # the examples' triple rocker
+    ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 1.9),
+    ...            kincas.Link.bar("rocker", "D", "C", 3)],
+    ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.2, 2.5)})
     >>> U = np.radians([[140.0], [180.0], [220.0]])
     >>> q0 = kincas.sweep(m, {"crank.angle": U[:1, 0]}).q[0]
     >>> carry_groups(kincas.model_of(m), U, np.zeros(0), m.size(), 0, q0, 2, [0])
@@ -214,7 +224,7 @@ def _carry(model, U, p, L, j, qj, k, i, memo):
     bl = blocks(model)
     R = np.concatenate([bl[b][0] for b in range(i + 1)])
     C = np.concatenate([bl[b][1] for b in range(i + 1)])
-    scale = np.where(model.sym.is_length, L, 1.0)[C]
+    scale = np.where(model.is_length, L, 1.0)[C]
     signs = modes(model, model.jac(qj, U[j], p), L)[0][:i + 1]
     if np.any(signs == 0):
         return None
@@ -264,7 +274,7 @@ def _same(model, qa, qb, L, i) -> bool:
     """Whether groups 0..i have the same assembly in qa and qb (angles modulo a turn)."""
     cols = np.concatenate([blocks(model)[b][1] for b in range(i + 1)])
     d = (np.asarray(qa) - np.asarray(qb))[cols]
-    is_len = model.sym.is_length[cols]
+    is_len = model.is_length[cols]
     d = np.where(is_len, d / L, np.angle(np.exp(1j * d)))
     return bool(np.abs(d).max(initial=0.0) <= SAME)
 
@@ -316,7 +326,10 @@ def unlabelled_resumes(model, U, p, L, Q, ok, events) -> list[dict]:
     Examples
     --------
     >>> import numpy as np, kincas
-    >>> m = _fourbar()
+    >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},     # the examples' triple rocker
+    ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 1.9),
+    ...            kincas.Link.bar("rocker", "D", "C", 3)],
+    ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.2, 2.5)})
     >>> U = np.radians([[140.0], [180.0], [220.0]])
     >>> sw = kincas.sweep(m, {"crank.angle": U[:, 0]}, report=["C.y"])
     >>> unlabelled_resumes(kincas.model_of(m), U, np.zeros(0), m.size(), sw.q, sw.ok, sw.events)
@@ -335,12 +348,3 @@ def unlabelled_resumes(model, U, p, L, Q, ok, events) -> list[dict]:
         if int(k) not in have:
             out.append({"kind": "resume", "pose": int(k)} | resume_label(model, U, p, L, j, Q[j], k, Q[k]))
     return out
-
-
-def _fourbar():
-    """The examples' triple rocker (1, 1.9, 3, 4): the crank turns back at +-151.2 deg."""
-    import kincas
-    return kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
-                            links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 1.9),
-                                   kincas.Link.bar("rocker", "D", "C", 3)],
-                            inputs=[kincas.Input.angle("crank")], guess={"C": (3.2, 2.5)})

@@ -57,7 +57,7 @@ class Sensitivities(Result):
     def __getitem__(self, key) -> np.ndarray:
         """`s["C.x", "a"]` or `s["d(C.x)/d(a)"]`: d(C.x)/d(a) over the poses."""
         if isinstance(key, str):
-            from ..core.symbolic import parse_quantity
+            from ..model.names import parse_quantity
             kind, q, p = parse_quantity(key)
             if kind != "sens" or q not in self.of or p not in self.to:
                 raise KeyError(f"{key!r} is not one of these sensitivities ({', '.join(self)})")

@@ -24,7 +24,8 @@ from ..core.fast import sweeper_for
 from ..model.mechanism import Mechanism
 from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
-from ..core.symbolic import default_report, needs_jerk
+from ..core.symbolic import needs_jerk
+from ..model.names import default_report
 from .choice import choose_assembly
 from .continuation import careful_pose
 from .resume import unlabelled_resumes
@@ -152,9 +153,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     if Uddd is not None:  # the inputs' jerks enter only the third derivatives
         third = [i for i, nm in enumerate(report) if needs_jerk(nm)]
         if third and ok.any():
-            f = model.sym.quantity_function([report[i] for i in third], jerk=True).map(int(ok.sum()))
-            rep = np.repeat(p.reshape(-1, 1), int(ok.sum()), axis=1)
-            got = np.asarray(f(Q[ok].T, U[ok].T, rep, Ud[ok].T, Udd[ok].T, Uddd[ok].T))
+            got = model.third_derivatives([report[i] for i in third], Q[ok], U[ok], p, Ud[ok], Udd[ok], Uddd[ok])
             values = np.array(values, dtype=float)
             values[np.ix_(third, np.flatnonzero(ok))] = got
     null_derivatives(model, report, values, Q, U, p, at)  # no wrong number at a singular pose
@@ -168,7 +167,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
                  status=status, flags=flags,
                  values={nm: values[i] for i, nm in enumerate(report)},
                  q=Q, residual=res, iterations=its,
-                 unknowns=[nm for nm, _ in model.sym.unknowns], size=L, events=events)
+                 unknowns=model.unknown_names, size=L, events=events)
     if g:
         return out  # the guess picks the assembly, whatever poses its branch loses
     # no guess: where the default assembly loses poses, one of the first pose's others that

@@ -36,8 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ModelError, SceneError
-from ..core.numeric import model_of
+from ..errors import ModelError
 from ..model.mechanism import Mechanism
 from .._deprecated import keyword, renamed
 from ..result_base import Result
@@ -173,11 +172,11 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
     True
     """
     from .sensitivity import sensitivities
-    from ..core.symbolic import default_report, parse_quantity
+    from ..model.names import default_report, parse_quantity
 
     draws = keyword("analyse", "samples", "draws", samples, draws, 2000)
     report = list(default_report(m) if report is None else report)
-    problems = _check_std(m, std, "std")
+    problems = check_std(m, std, "std")
     problems += [f"report: {n!r}: a sensitivity has no spread to analyse" for n in report
                  if parse_quantity(n)[0] == "sens"]
     if not isinstance(draws, int) or isinstance(draws, bool) or draws < 2:
@@ -203,7 +202,8 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
         info={"retried": retried})
 
 
-def _check_std(m: Mechanism, std, where: str) -> list[str]:
+def check_std(m: Mechanism, std, where: str) -> list[str]:
+    """Problems with `std` (parameter -> standard deviation) for `m`, each naming `where`."""
     out = []
     driven = {i.target for i in m.inputs if i.kind == "parameter"}
     if not isinstance(std, dict) or not std:
@@ -332,41 +332,6 @@ class _Samples:
             d[bad] = 0.0
             s2[:, i] = np.einsum("ij,ij->j", d, d)
         return c[:, None], mu, s2, restarts
-
-
-# --- scenes: the [tolerance] section ---
-
-
-def read_section(sc) -> dict:
-    """The `[tolerance]` section as analyse()'s keywords; SceneError naming the field."""
-    from ..core.symbolic import parse_quantity
-
-    t = sc.study.raw.get("tolerance")
-    if not isinstance(t, dict):
-        raise SceneError("[tolerance]: missing or not a table (give at least "
-                         "std = { PARAMETER = standard deviation, ... })")
-    problems = [f"[tolerance]: unknown field {k!r} (expected one of "
-                f"['report', 'samples', 'seed', 'std'])" for k in t
-                if k not in ("std", "samples", "seed", "report")]
-    if "std" not in t:
-        problems.append("[tolerance] std: missing (std = { PARAMETER = standard deviation, ... })")
-    else:
-        problems += _check_std(sc.mechanism, t["std"], "[tolerance] std")
-    samples, seed = t.get("samples", 2000), t.get("seed", 0)
-    for k, v, lo in (("samples", samples, 2), ("seed", seed, 0)):
-        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-            problems.append(f"[tolerance] {k}: expected a whole number >= {lo}, got {v!r}")
-    report = t.get("report", [n for n in sc.study.report if parse_quantity(n)[0] != "sens"])
-    if not isinstance(report, list) or not all(isinstance(n, str) for n in report):
-        problems.append("[tolerance] report: expected a list of quantity names")
-    else:
-        problems += model_of(sc.mechanism, check=False).sym.check_names(report, "[tolerance] report")
-        problems += [f"[tolerance] report: {n!r}: a sensitivity has no spread to analyse"
-                     for n in report if parse_quantity(n)[0] == "sens"]
-    if problems:
-        raise SceneError(problems)
-    return {"std": {k: float(v) for k, v in t["std"].items()}, "samples": samples,
-            "seed": seed, "report": report}
 
 
 # the name of 0.1 (results are named by what they hold, as Sweep and Pose are)

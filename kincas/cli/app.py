@@ -120,13 +120,14 @@ def _check_args(args) -> None:
     starts, samples = getattr(args, "starts", None), getattr(args, "samples", None)
     if not (starts or args.command in ("tolerance", "range")):
         return
+    from ..model.mechanism import solved_unknowns
     from .scene import load
-    from ..core.numeric import compile
     sc = load(args.scene)
     if args.command == "range" and not sc.study.inputs:
         raise OutputError("[[inputs]]: none declared, so there is no range of motion to find "
                           "(kincas range ranges an input; kincas solve solves a structure)")
-    nq, nrep = compile(sc.mechanism).sym.nq, len(sc.quantities)
+    # the declarations' count of the unknowns, so that a size check builds no model
+    nq, nrep = solved_unknowns(sc.mechanism), len(sc.quantities)
     try:
         if starts:
             bounds.check("--starts", starts, bounds.per_sample(nq, 0, 0))
@@ -152,7 +153,7 @@ OUTPUT_OPTIONS = {"csv": "--csv", "plot": "--plot", "animate": "--animate",
 
 def _not_the_scene(args) -> None:
     """No output may be the scene file itself (by any spelling or link): it would be lost."""
-    from .atomic import same_file
+    from ..views.atomic import same_file
     scene = getattr(args, "scene", None)
     for attr, flag in OUTPUT_OPTIONS.items():
         path = getattr(args, attr, None)

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import OutputError, SceneError
-from .atomic import open_replacing
+from ..views.atomic import open_replacing
 from ..synthesis.cam_design import Segment, design_cam
 
 FIELDS = {"base_radius", "roller_radius", "offset", "samples", "segments", "name", "body", "follower"}

@@ -7,9 +7,10 @@ import math
 import sys
 from pathlib import Path
 
-from ..analysis.modes import find_modes, scene_with_guess
+from ..analysis.modes import find_modes
 from ..errors import OutputError, SceneError
 from .scene import load
+from .scene_guess import scene_with_guess
 
 
 def cli_arguments(parser) -> None:
@@ -89,7 +90,7 @@ def _solve_starts_on(sc, modes):
 
 def _write_scenes(path, directory, modes) -> list[Path]:
     """DIR/<scene>_mode<k>.toml for every mode: the scene as written, with that mode's guess."""
-    from .atomic import open_replacing
+    from ..views.atomic import open_replacing
     src, out = Path(path), Path(directory)
     text = src.read_text(encoding="utf-8")
     written = []

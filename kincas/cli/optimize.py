@@ -9,9 +9,10 @@ import sys
 import numpy as np
 
 from ..model.names import is_angular
-from ..synthesis.optimize import Optimization, run_scene
+from ..synthesis.optimize import Optimization
 from .common import _list, _param_unit, _unit
 from .scene import load
+from .scene_optimize import run_scene
 
 
 def cli_arguments(parser) -> None:
@@ -156,7 +157,7 @@ def _multistart_run(sc, args) -> int:
 
     from ..errors import ModelError, OutputError, SceneError
     from ..synthesis.multistart import multistart
-    from ..synthesis.optimize import read_section
+    from .scene_optimize import read_section
 
     if args.starts < 1:
         raise OutputError(f"--starts: expected a whole number >= 1, got {args.starts}")

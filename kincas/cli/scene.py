@@ -102,7 +102,7 @@ class Scene:
 
     def user_values(self, s: Sweep) -> dict[str, np.ndarray]:
         """Reported quantities in the scene's units (degrees where the scene says so)."""
-        from ..core.symbolic import is_angular
+        from ..model.names import is_angular
         return {k: self._to_user(k, v, angle=is_angular(k, self.mechanism)) for k, v in s.values.items()}
 
     def _to_user(self, name, v, angle):
@@ -284,7 +284,7 @@ class _Reader:
         except KincasError as e:
             raise SceneError(e.problems) from None
         if report is None:
-            from ..core.symbolic import default_report
+            from ..model.names import default_report
             report = default_report(m)
         self.check_quantities(m, report, sens)
         study = Study(title=title if isinstance(title, str) else "", units=self.units,
@@ -448,7 +448,7 @@ class _Reader:
         if all(plain_quantity(m, n) for n in [*report, *sens]):
             return
         from ..core.numeric import model_of
-        sym = model_of(m, check=False).sym
+        sym = model_of(m, check=False)
         bad = sym.check_names(report)
         # each `of` name and each `to` name once, under the field they were written in
         of = list(dict.fromkeys(parse_quantity(n)[1] for n in sens))

@@ -45,7 +45,7 @@ def cli_run(args) -> int:
         from .outputs import check_outputs
         check_outputs(args, sc.mechanism, len(next(iter(sc.study.inputs.values()))))
     sw = sc.run(progress=progress_for(args))
-    from .numbers import clean  # zero to the solve's accuracy is printed as 0, not as noise
+    from ..views.numbers import clean  # zero to the solve's accuracy is printed as 0, not as noise
     inputs, values = sc.user_inputs(sw), clean(sc.user_values(sw), sc, sw)
     if args.json:
         doc = {"title": sc.study.title, "units": sc.study.units,

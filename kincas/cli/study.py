@@ -120,7 +120,7 @@ def cli_run(args) -> int:
     if args.out:
         _check_writer(Path(args.out).suffix.lower())
     if args.plot:
-        from .mapplot import check_plot
+        from ..views.mapplot import check_plot
         check_plot(args.plot, kw["vary"])
     if args.workers is not None and args.workers < 1:
         raise OutputError(f"--workers: expected a whole number >= 1, got {args.workers}")
@@ -140,7 +140,7 @@ def cli_run(args) -> int:
     if args.out:
         write(r, args.out)
     if args.plot:
-        from .mapplot import plot_map
+        from ..views.mapplot import plot_map
         plot_map(r, args.plot, title=st.title)
     _summary(st.title, r, args.out, args.plot)
     return 0 if all(s == "ok" for s in r.status) else 3
@@ -151,14 +151,14 @@ def _check_size(sc, kw, workers) -> None:
     naming the grid or the samples, the memory, and the ways round)."""
     from . import bounds
     from ..analysis.executor import default_workers
-    from ..core.numeric import compile
+    from ..model.mechanism import solved_unknowns
     from ..synthesis.expressions import parse
     grid, n = kw["grid"], kw["samples"]
     designs = math.prod(grid) if grid is not None else n
     field = f"[study] grid = {grid}" if grid is not None else f"[study] samples = {n}"
     poses = max((len(v) for v in sc.study.inputs.values()), default=1)
     wanted = {q for t in kw["report"] for q in parse(t, "report").quantities}
-    need = bounds.study_bytes(designs, poses, compile(sc.mechanism).sym.nq, len(wanted),
+    need = bounds.study_bytes(designs, poses, solved_unknowns(sc.mechanism), len(wanted),
                               len(kw["vary"]), len(kw["report"]), workers or default_workers())
     try:
         bounds.check_total(f"{field} ({designs:,} designs x {poses} poses)", need,
@@ -211,13 +211,13 @@ def _has(mod) -> bool:
 
 def write(r: Study, path) -> None:
     """Write the study's rows to .nc, .csv or .parquet (chosen by the suffix)."""
-    from .atomic import replacing
+    from ..views.atomic import replacing
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise OutputError(f"--out: {str(path)!r}: expected a file ending in {', '.join(FORMATS)}")
     try:
-        with replacing(path) as tmp:  # whole or not at all (kincas/cli/atomic.py)
+        with replacing(path) as tmp:  # whole or not at all (kincas/views/atomic.py)
             if suffix == ".csv":
                 _write_csv(r, tmp)
             elif suffix == ".parquet":

@@ -1,5 +1,5 @@
 """`kincas tolerance SCENE.toml`: first-order and Monte-Carlo spread of the outputs from the
-scene's [tolerance] section (kincas/analysis/tolerance.py does the work)."""
+scene's [tolerance] section (read here; kincas/analysis/tolerance.py does the work)."""
 from __future__ import annotations
 
 import json
@@ -8,9 +8,10 @@ import sys
 
 import numpy as np
 
-from ..analysis.tolerance import ToleranceAnalysis, analyse, read_section
+from ..analysis.tolerance import ToleranceAnalysis, analyse, check_std
+from ..core.numeric import model_of
 from ..errors import SceneError
-from ..model.names import is_angular
+from ..model.names import is_angular, parse_quantity
 from .common import _list, _unit, progress_for
 from .scene import load
 
@@ -40,7 +41,7 @@ def cli_run(args) -> int:
                 progress=progress_for(args), **kw)
     user = lambda n, v: np.degrees(v) if is_angular(n, sc.mechanism) and st.deg else np.asarray(v, float)
     inputs = {k: user(k, v) for k, v in r.inputs.items()}
-    from .numbers import snap  # a spread that is zero to rounding is printed as 0
+    from ..views.numbers import snap  # a spread that is zero to rounding is printed as 0
     fo = {n: snap(user(n, r.first_order[n]), 0.0) for n in r.names}
     mc = {n: snap(user(n, r.monte_carlo[n]), 0.0) for n in r.names}
     if args.json:
@@ -79,3 +80,33 @@ def _print(sc, r: ToleranceAnalysis, inputs, fo, mc, unit):
     verdict = "agree" if r.agrees() else "differ (the outputs are not linear over the tolerances)"
     print(f"Monte Carlo and first order {verdict}: sampling error {100 * r.standard_error:.2g} %; "
           f"{int(r.failed.sum())} sample poses did not assemble on the nominal branch")
+
+
+def read_section(sc) -> dict:
+    """The `[tolerance]` section as analyse()'s keywords; SceneError naming the field."""
+    t = sc.study.raw.get("tolerance")
+    if not isinstance(t, dict):
+        raise SceneError("[tolerance]: missing or not a table (give at least "
+                         "std = { PARAMETER = standard deviation, ... })")
+    problems = [f"[tolerance]: unknown field {k!r} (expected one of "
+                f"['report', 'samples', 'seed', 'std'])" for k in t
+                if k not in ("std", "samples", "seed", "report")]
+    if "std" not in t:
+        problems.append("[tolerance] std: missing (std = { PARAMETER = standard deviation, ... })")
+    else:
+        problems += check_std(sc.mechanism, t["std"], "[tolerance] std")
+    samples, seed = t.get("samples", 2000), t.get("seed", 0)
+    for k, v, lo in (("samples", samples, 2), ("seed", seed, 0)):
+        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+            problems.append(f"[tolerance] {k}: expected a whole number >= {lo}, got {v!r}")
+    report = t.get("report", [n for n in sc.study.report if parse_quantity(n)[0] != "sens"])
+    if not isinstance(report, list) or not all(isinstance(n, str) for n in report):
+        problems.append("[tolerance] report: expected a list of quantity names")
+    else:
+        problems += model_of(sc.mechanism, check=False).check_names(report, "[tolerance] report")
+        problems += [f"[tolerance] report: {n!r}: a sensitivity has no spread to analyse"
+                     for n in report if parse_quantity(n)[0] == "sens"]
+    if problems:
+        raise SceneError(problems)
+    return {"std": {k: float(v) for k, v in t["std"].items()}, "samples": samples,
+            "seed": seed, "report": report}

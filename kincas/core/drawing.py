@@ -1,6 +1,6 @@
 """World coordinates of what a drawing shows, at every pose of a sweep: points, slides'
-lines, bodies' frames and cams' contacts (the pictures in kincas/cli/plot.py and
-kincas/cli/draw_joints.py draw them; they get numpy arrays from here).
+lines, bodies' frames and cams' contacts (the pictures in kincas/views/plot.py and
+kincas/views/draw_joints.py draw them; they get numpy arrays from here).
 
 A body's frame is its origin (ox, oy) and angle th: a local vector v maps to
 origin + R(th) v. The CasADi functions are built once per model (`Model.memo`: threads

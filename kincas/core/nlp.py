@@ -30,10 +30,16 @@ from .symbolic import is_angular
 class SampledNLP:
     """The symbolic NLP of `kincas.synthesis.simultaneous.Problem` (a base class of it).
 
-    It needs of the problem: m, model, sym, L, p0, vary, pscale, data, deg, qs, K, U, Ud,
+    It needs of the problem: m, model, L, p0, vary, pscale, data, deg, qs, K, U, Ud,
     Udd, D, path, ref, Q0, us, ulo, uhi, urows, u_at(k), sign(q, u, p), dense(mech) and the
     evaluator class (`evaluator`) of the expression language.
     """
+
+    @property
+    def sym(self):
+        """The model's symbolic form: the NLP is built here, in the core; the synthesis holds
+        only the model."""
+        return self.model.sym
 
     # --- the variables ---
     def make_symbols(self):
@@ -140,6 +146,15 @@ class SampledNLP:
                                   start=float(U[:, 0].min()) if periodic else None,
                                   sign=self.sign(d0.q[i], U[i], self.p0))
         return value
+
+    def extreme_values(self, e, Q, U, p, Ud, Udd) -> np.ndarray:
+        """The expression a max()/min() tracks (`e`, from `extreme`), at N poses: rows of Q,
+        U, Ud, Udd, parameters p; numbers for the checks, which hold no CasADi object."""
+        Q, U, Ud, Udd = (np.atleast_2d(np.asarray(a, float)) for a in (Q, U, Ud, Udd))
+        n = len(Q)
+        f = e["F"].map(n)
+        return np.asarray(f(Q.T, U.T, np.repeat(np.reshape(p, (-1, 1)), n, 1), Ud.T, Udd.T,
+                            np.zeros((len(self.data), n)))).ravel()
 
     def squared_distances(self, point, targets):
         """sum_k |P(q_k, u_k) - T_k|^2 of a point P and targets T (K x 2): a curve's objective."""

@@ -29,7 +29,6 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from ..model import mechanism as _mechanism
 from ..model.mechanism import Mechanism, needs_rank_test
 from . import joints as _joints
 from .cancel import interruptible
@@ -100,11 +99,11 @@ def model_of(m: Mechanism, check: bool = True) -> "Model":
 compile = model_of  # its first name (kincas 0.1): it compiles nothing
 
 
-def _redundant(m: Mechanism) -> int:
+def redundant_equations(m: Mechanism) -> int:
+    """The number of equations of `m` implied by the others (kincas/core/redundant.py), on the
+    model of its structure; what `Mechanism.redundant` answers (the package's face hands it
+    to the model)."""
     return decide(m, model_of(m, check=False))
-
-
-_mechanism._rank_decision = _redundant  # `Mechanism.redundant` asks the core (kincas/model)
 
 
 class _Call:
@@ -424,3 +423,46 @@ class Model:
         f = self.quantity_function(tuple(names)).map(n)
         rep = lambda a: np.repeat(np.reshape(a, (-1, 1)), n, axis=1)
         return np.asarray(f(Q.T, U.T, rep(P), Ud.T, Udd.T))
+
+    def third_derivatives(self, names, Q, U, P, Ud, Udd, Uddd) -> np.ndarray:
+        """Quantities that need the inputs' jerks (len(names) x N) at N solved poses."""
+        n = Q.shape[0]
+        if n == 0 or not names:
+            return np.zeros((len(names), n))
+        f = self.memo(("jerk", tuple(names)), lambda: self.sym.quantity_function(list(names), jerk=True)).map(n)
+        rep = lambda a: np.repeat(np.reshape(a, (-1, 1)), n, axis=1)
+        return np.asarray(f(Q.T, U.T, rep(P), Ud.T, Udd.T, Uddd.T))
+
+    # --- the structure as plain values: the other floors never hold a CasADi object ---
+    @property
+    def mech(self) -> Mechanism:
+        """The mechanism the model was built from (its structure; values may differ)."""
+        return self.sym.mech
+
+    @property
+    def unknown_names(self) -> list[str]:
+        """The names of the unknowns, in the order of q (`crank.angle`, `L.x`, ...)."""
+        return [nm for nm, _ in self.sym.unknowns]
+
+    @property
+    def is_length(self) -> np.ndarray:
+        """Per unknown: True for a length (a floating link's origin), False for an angle."""
+        return self.sym.is_length
+
+    def check_names(self, names, where: str = "[output] report") -> list[str]:
+        """Problems with quantity names this model cannot give, each naming `where`."""
+        return self.sym.check_names(names, where)
+
+    def derivative_order(self, obj: str, attr: str) -> int:
+        """The time derivative a plain quantity `obj.attr` is of a position (0: a position)."""
+        return self.sym.position_expr(obj, attr)[1]
+
+    def points_many(self, Q, u, p) -> np.ndarray:
+        """The moving points at each row of Q (one input u, parameters p), one row
+        (x1, y1, x2, y2, ...) per row of Q."""
+        n = Q.shape[0]
+        if n == 0:
+            return np.zeros((0, 0))
+        f = self.sym.f_points.map(n)
+        pts = np.asarray(f(Q.T, np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)))
+        return pts.reshape(2, -1, n, order="F").transpose(2, 1, 0).reshape(n, -1)

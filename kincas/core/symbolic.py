@@ -33,7 +33,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import GROUND, Mechanism, as_param
-from ..model.names import LINK_Q, POINT_Q, SENS, SLIDE_Q, is_angular, parse_quantity  # noqa: F401
+from ..model.names import LINK_Q, POINT_Q, SENS, SLIDE_Q, default_report, is_angular, parse_quantity  # noqa: F401
 from . import joints as _joints
 
 # --- quantity names (kincas/model/names.py: parsed without the solver) ---
@@ -54,11 +54,6 @@ def needs_jerk(name: str) -> bool:
     if kind == "sens":
         return needs_jerk(a)
     return b in ("jx", "jy", "jerk")
-
-
-def default_report(m: Mechanism) -> list[str]:
-    """Positions of all moving points and angles of all links."""
-    return [f"{p}.{c}" for p in m.moving_points for c in "xy"] + [f"{lk.name}.angle" for lk in m.links]
 
 
 class Symbolic:

@@ -30,8 +30,9 @@ from .loads import Load, check_loads
 from .parts import Input, Link, Num, Param, Slide, _pair, _table, as_number, as_param, is_number  # noqa: F401
 
 GROUND = "ground"
-# How a mechanism whose count falls short learns its redundant equations: kincas.core
-# installs its rank test here when it is imported (declarations never import the solver).
+# How a mechanism whose count falls short learns its redundant equations: the rank test of
+# kincas.core, handed over by the package's face (`import kincas` calls use_rank_test);
+# declarations never import the solver, and the solver never edits the declarations.
 _rank_decision = None
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
 NAME_RULE = "a name starts with an ASCII letter or _, then ASCII letters, digits, _ or -"
@@ -195,7 +196,7 @@ class Mechanism:
         """
         if not needs_rank_test(self):
             return 0
-        if _rank_decision is None:  # pragma: no cover - kincas/__init__ installs it
+        if _rank_decision is None:  # pragma: no cover - kincas/__init__ hands it over
             raise ModelError("[inputs]: the rank test needs kincas.core (import kincas)")
         return _rank_decision(self)
 
@@ -358,15 +359,6 @@ class Mechanism:
             xs, ys = zip(*pts)
             extent = max(extent, math.hypot(max(xs) - min(xs), max(ys) - min(ys)))
         return extent if extent > 0 else 1.0
-
-    def _repr_svg_(self) -> str | None:
-        """Jupyter's display: the mechanism drawn at its first pose (`kincas.notebook`; the
-        drawing solves it, so it is built only when a notebook asks)."""
-        try:
-            from ..notebook import mechanism_svg
-            return mechanism_svg(self)
-        except Exception:  # a display must never raise: Jupyter falls back to repr
-            return None
 
     # --- new values ---
     def with_parameters(self, **values: float) -> "Mechanism":
@@ -579,6 +571,27 @@ def _check(m: Mechanism) -> list[str]:
 def counted_freedoms(m: Mechanism) -> int:
     """Degrees of freedom by counting: unknowns minus equations, plus driven parameters."""
     return m.structure.mobility + sum(inp.kind == "parameter" for inp in m.inputs)
+
+
+def solved_unknowns(m: Mechanism) -> int:
+    """The unknowns the solver finds at each pose: the structure's coordinates less the link
+    angles that inputs drive (a driven angle is given, not solved for); the size of q.
+
+    >>> m = Mechanism(ground={"O": (0, 0)}, links=[Link.bar("crank", "O", "A", 1)],
+    ...               inputs=[Input.angle("crank")])
+    >>> m.structure.n_unknowns, solved_unknowns(m)
+    (1, 0)
+    """
+    links = {lk.name for lk in m.links}
+    driven = {i.target for i in m.inputs if i.kind == "angle" and i.target in links}
+    return m.structure.n_unknowns - len(driven)
+
+
+def use_rank_test(decide) -> None:
+    """Let `Mechanism.redundant` ask `decide(mechanism) -> int` (the core's rank test, given by
+    `import kincas`) where counting cannot tell the redundant equations."""
+    global _rank_decision
+    _rank_decision = decide
 
 
 def needs_rank_test(m: Mechanism) -> bool:

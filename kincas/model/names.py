@@ -66,3 +66,15 @@ def plain_quantity(m, name: str) -> bool:
     points = set(m.ground_points) | {p for lk in m.links for p in lk.point_names}
     return ((b in POINT_Q and a in points) or (b in LINK_Q and a in {lk.name for lk in m.links})
             or (b in SLIDE_Q and a in {s.name for s in m.slides}))
+
+
+def default_report(m) -> list[str]:
+    """What a solve reports when asked for nothing: positions of all moving points and angles
+    of all links.
+
+    >>> from kincas.model import Mechanism, Link, Input
+    >>> default_report(Mechanism(ground={"O": (0, 0)}, links=[Link.bar("crank", "O", "A", 1)],
+    ...                          inputs=[Input.angle("crank")]))
+    ['A.x', 'A.y', 'crank.angle']
+    """
+    return [f"{p}.{c}" for p in m.moving_points for c in "xy"] + [f"{lk.name}.angle" for lk in m.links]

@@ -31,7 +31,7 @@ class Checks:
                                accelerations={k: self.Udd[:, j] for j, k in enumerate(self.keys)},
                                report=list(self.used))
             at = np.arange(self.K)
-        angle = ~self.sym.is_length
+        angle = ~self.model.is_length
         for k in range(self.K):
             if not check_path and not sw.ok[at[k]]:
                 continue  # reported by the polishing already
@@ -53,16 +53,15 @@ class Checks:
     def check_extremes(self, sw, p, problems):
         """Each tracked max()/min() must be the extreme of the checking sweep as well."""
         out, (U, Ud, Udd) = [], self.path
-        ok, zero = np.flatnonzero(sw.ok), np.zeros(len(self.data))
+        ok = np.flatnonzero(sw.ok)
         for e in self.extremes.values():
-            F, fn = e["F"], e["fn"]
-            value = float(F(e["q"], e["u"], p, e["rate"][0], e["rate"][1], zero))
+            fn = e["fn"]
+            value = float(self.extreme_values(e, e["q"], [e["u"]], p, e["rate"][0], e["rate"][1])[0])
             u = e["u"] if e["start"] is None else e["start"] + (e["u"] - e["start"]) % (2 * math.pi)
             out.append({"kind": fn, "expr": e["text"], "input": float(u), "value": value})
             if not len(ok):
                 continue
-            v = np.asarray(F.map(len(ok))(sw.q[ok].T, U[ok].T, np.repeat(p[:, None], len(ok), 1),
-                                          Ud[ok].T, Udd[ok].T, np.zeros((len(zero), len(ok))))).ravel()
+            v = self.extreme_values(e, sw.q[ok], U[ok], p, Ud[ok], Udd[ok])
             j = int(np.argmax(v) if fn == "max" else np.argmin(v))
             slack = 1e-6 * max(float(np.ptp(v)), abs(value), 1e-300)
             if (v[j] > value + slack) if fn == "max" else (v[j] < value - slack):

@@ -31,7 +31,7 @@ class Problem(Checks, SampledNLP):
     evaluator = Evaluator  # the expression language, for SampledNLP
 
     def __init__(self, m: Mechanism, model, vary, data, deg):
-        self.m, self.model, self.sym = m, model, model.sym
+        self.m, self.model = m, model
         self.deg, self.L = deg, m.size()
         self.p0 = np.array([v for _, v in m.parameters], dtype=float)
         driven = {i.target for i in m.inputs if i.kind == "parameter"}
@@ -67,7 +67,7 @@ class Problem(Checks, SampledNLP):
             raise ModelError(problems)
         self.pscale = np.array([max(abs(m.parameter(p)), hi - lo) for p, (lo, hi) in self.vary.items()])
         self.make_symbols()
-        self.qs = np.where(self.sym.is_length, self.L, 1.0)  # unknowns scaled to O(1)
+        self.qs = np.where(self.model.is_length, self.L, 1.0)  # unknowns scaled to O(1)
         self.extremes: dict[tuple, dict] = {}
         self.used: list[str] = []
         self.Uv = None  # the sample inputs as variables (a curve: see kincas.curve)
@@ -75,7 +75,7 @@ class Problem(Checks, SampledNLP):
     # --- parsing ---
     def parse(self, text, where):
         e = parse(text, where, data=self.data)
-        bad = self.sym.check_names(e.quantities, where)
+        bad = self.model.check_names(e.quantities, where)
         bad += [f"{where}: unknown name {n!r} (not a parameter, a data array or pi)"
                 for n in e.names if n not in self.m.param_values]
         if bad:
@@ -98,7 +98,7 @@ class Problem(Checks, SampledNLP):
 
     # --- the samples, their starting poses, the checking path ---
     def set_samples(self, sw0: Sweep, sweep_fn):
-        sym, model, m = self.sym, self.model, self.m
+        model, m = self.model, self.m
         self.sweep_fn, self.keys = sweep_fn, list(sw0.inputs)
         col = lambda d: np.stack([d[k] for k in self.keys], axis=1)
         self.U, self.Ud, self.Udd = col(sw0.inputs), col(sw0.rates), col(sw0.accelerations)
@@ -114,7 +114,7 @@ class Problem(Checks, SampledNLP):
         for k in np.flatnonzero(~ok):  # start where it did not assemble from a neighbour
             Q0[k] = (Q0[solved[np.argmin(np.abs(solved - k))]] if len(solved)
                      else model.initial_q(self.U[k], self.p0, guess, self.L))
-        angle = ~sym.is_length
+        angle = ~model.is_length
         Q0[:, angle] = wrap_angle(Q0[:, angle])  # expressions see angles as reported
         self.Q0, self.initial_status = Q0, list(sw0.status)
         self.ref = np.array([self.sign(Q0[k], self.U[k], self.p0) if ok[k] else 0.0
@@ -150,7 +150,7 @@ class Problem(Checks, SampledNLP):
 
     def sign(self, q, u, p) -> float:
         """Sign of det(g_q) with columns scaled to O(1): it tells the assembly branch."""
-        if not self.sym.nq:
+        if not self.model.nq:
             return 1.0
         return float(np.sign(np.linalg.det(self.model.jac(q, u, p) * (1.0 / self.qs))))
 
@@ -163,15 +163,15 @@ class Problem(Checks, SampledNLP):
 
     # --- the checks: a design is optimal only if it really is one ---
     def check(self, x, fg, f0, rows, stats, check_path) -> dict:
-        sym, K, model, nv = self.sym, self.K, self.model, len(self.vary)
+        K, model, nv = self.K, self.model, len(self.vary)
         problems = []
         # IPOPT may relax a bound by a few 1e-9: the design is clipped into its bounds
         varied = {p: float(np.clip(x[j] * self.pscale[j], *self.vary[p]))
                   for j, p in enumerate(self.vary)}
         mech = self.m.with_parameters(**varied)
         p = np.array([v for _, v in mech.parameters])
-        Q = x[nv:nv + sym.nq * K].reshape(K, sym.nq) * self.qs
-        at = nv + sym.nq * K
+        Q = x[nv:nv + model.nq * K].reshape(K, model.nq) * self.qs
+        at = nv + model.nq * K
         if self.Uv is not None:  # fitted inputs: the checks and the report follow them
             self.U = x[at:at + K, None] * self.us
             self.U = self.U if self.unormal is None else self.unormal(self.U)
@@ -188,9 +188,9 @@ class Problem(Checks, SampledNLP):
                                 f"branch than the initial one")
         xs = [x[:nv], (Q / self.qs).ravel(), *([self.U[:, 0] / self.us] if self.Uv is not None else [])]
         for e in self.extremes.values():
-            q, u = x[at:at + sym.nq] * self.qs, x[at + sym.nq]
+            q, u = x[at:at + model.nq] * self.qs, x[at + model.nq]
             sol = model.newton(q, np.array([u]), p, self.L)
-            e["u"], e["q"], at = u, sol.q, at + sym.nq + 1
+            e["u"], e["q"], at = u, sol.q, at + model.nq + 1
             if not sol.ok:
                 problems.append(f"{e['fn']}({e['text']}): the design does not assemble at its extreme")
             xs.append(np.r_[sol.q / self.qs, u])

@@ -137,7 +137,7 @@ def parse_report(m: Mechanism, report, where: str = "report") -> list:
     out, problems = [], []
     if isinstance(report, str) or not isinstance(report, (list, tuple)) or not report:
         raise ModelError(f"{where}: expected a list of expressions")
-    sym = compile(m).sym
+    sym = compile(m)
     for text in report:
         try:
             e = parse(text, f"{where}: {text!r}")
@@ -223,7 +223,7 @@ class _Chunk:
     def __call__(self, part):
         """(design indices, failure code and pose per design, values (n, len(report)))."""
         from ..analysis.designs import sweep_designs
-        from ..core.symbolic import is_angular
+        from ..model.names import is_angular
 
         idx, X = part
         exprs = [parse(t, "report") for t in self.report]

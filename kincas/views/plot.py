@@ -19,13 +19,12 @@ shows exactly the poses that were solved; poses not "ok" are left out of paths.
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.drawing import pose_values
 from ..model.mechanism import GROUND, Mechanism
 from ..results import Sweep
+from .poses import Geometry, _hull, check_paths, default_pose, geometry  # noqa: F401  (their old home)
 
 PLOT_EXTRA = 'pip install "kincas[plot]"'
 
@@ -41,83 +40,7 @@ def require_matplotlib(what: str = "kincas.plot") -> None:
         raise ModuleNotFoundError(f"{what} needs matplotlib: {PLOT_EXTRA}", name="matplotlib") from None
 
 
-# --- geometry of every pose ---
-
-
-@dataclass
-class Geometry:
-    """World positions over a sweep: `xy[i, k]` is point `names[k]` at pose i (NaN when the
-    pose was not solved); each slide's line at each pose as a point `through` (N x 2), a unit
-    direction `direction` (N x 2) and the slide coordinate `s` (N,) of its point.
-
-    >>> import numpy as np, kincas
-    >>> m = kincas.Mechanism(ground={"O": (0, 0)},
-    ...     links=[kincas.Link.bar("crank", "O", "A", 1), kincas.Link.bar("rod", "A", "B", 3)],
-    ...     slides=[kincas.Slide("B", "ground", name="slider")],
-    ...     inputs=[kincas.Input.angle("crank")], guess={"B": (3.5, 0)})
-    >>> g = geometry(m, kincas.sweep(m, {"crank.angle": [0.0, np.pi / 2]}))
-    >>> np.round(g.point("B"), 6).tolist(), np.round(g.slides["slider"][2], 6).tolist()
-    ([[4.0, 0.0], [2.828427, 0.0]], [4.0, 2.828427])
-    """
-
-    names: list[str]
-    xy: np.ndarray
-    slides: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]
-    ok: np.ndarray
-    joints: object = field(default=None, repr=False)  # gears, racks, cams: cli/draw_joints.py
-
-    def point(self, name: str) -> np.ndarray:
-        """(N x 2) positions of one point."""
-        return self.xy[:, self.names.index(name)]
-
-
-def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
-    """Positions of all points and the lines of all slides at every pose of `sweep`."""
-    from ..core.numeric import compile
-    model = compile(m)
-    keys = [i.key for i in m.inputs]
-    missing = [k for k in keys if k not in sweep.inputs]
-    if missing:
-        raise ValueError(f"the sweep has no values for the inputs {missing}: was it made with this mechanism?")
-    n, ok = len(sweep), sweep.ok
-    names = list(m.ground_points) + list(m.moving_points)
-    U = np.stack([np.asarray(sweep.inputs[k], float) for k in keys], axis=1).reshape(n, len(keys))
-    p = np.array([v for _, v in m.parameters], float)
-    Q = np.where(ok[:, None], sweep.q, 0.0)  # what depends on q is masked below
-    raw = pose_values(model, Q, U, p)
-    ng = len(m.ground_points)
-    xy = raw[:, :2 * len(names)].reshape(n, len(names), 2).copy()
-    xy[~ok, ng:] = np.nan  # ground points are known at every pose, moving ones when solved
-    slides = {}
-    for k, sl in enumerate(m.slides):
-        c = 2 * len(names) + 3 * k
-        through, angle = raw[:, c:c + 2].copy(), raw[:, c + 2].copy()
-        if sl.along != GROUND:
-            through[~ok], angle[~ok] = np.nan, np.nan
-        d = np.stack([np.cos(angle), np.sin(angle)], axis=1)
-        s = np.einsum("ij,ij->i", xy[:, names.index(sl.point)] - through, d)  # signed distance
-        slides[sl.name] = (through, d, s)
-    from .draw_joints import joint_geometry
-    return Geometry(names, xy, slides, ok, joint_geometry(model, Q, U, p, ok))
-
-
 # --- shapes ---
-
-
-def _hull(pts: np.ndarray) -> list[int]:
-    """Indices of the convex hull of 2-D points, counter-clockwise (Andrew's monotone chain)."""
-    def turn(o, a, b):  # z of (a - o) x (b - o): positive when o -> a -> b turns left
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    def chain(idx):  # keep only left turns
-        out: list[int] = []
-        for i in idx:
-            while len(out) >= 2 and turn(pts[out[-2]], pts[out[-1]], pts[i]) <= 0:
-                out.pop()
-            out.append(i)
-        return out
-    order = sorted(range(len(pts)), key=lambda i: tuple(pts[i]))
-    return chain(order)[:-1] + chain(order[::-1])[:-1]
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -360,16 +283,11 @@ def caption(sweep: Sweep, i: int) -> str:
     return text + ("" if sweep.status[i] == "ok" else f" ({sweep.status[i]})")
 
 
-def default_pose(sweep: Sweep | np.ndarray) -> int:
-    """The pose drawn when none is asked for: the first one solved (0 when none was)."""
-    k = np.flatnonzero(sweep.ok if isinstance(sweep, Sweep) else sweep)
-    return int(k[0]) if k.size else 0
-
-
 def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=None,
-         labels: bool = True, title: str | None = None, units: str = ""):
+         labels: bool = True, title: str | None = None, units: str = "", path_xy=None):
     """Draw `m` at pose `pose` of `sweep` (default: the first solved) with the paths of
     `paths` (default: every moving point) over the sweep; returns the matplotlib Axes.
+    `path_xy`: those paths already solved (point -> M x 2, `smooth_paths`), else solved here.
 
     Links with two points are bars, links with three or more are filled polygons, ground
     pivots stand on hatched bases, slides show their guide and block; axes have equal scales.
@@ -380,38 +298,21 @@ def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=
         ax = plt.subplots(figsize=(6.4, 4.8))[1]
     paths = check_paths(m, paths)
     i = default_pose(sweep) if pose is None else int(pose) % max(len(sweep), 1)  # -1: the last
-    d = Drawing(ax, m, geometry(m, sweep), paths, labels, units, smooth_paths(m, sweep, paths))
+    smooth = smooth_paths(m, sweep, paths) if path_xy is None else {p: path_xy[p] for p in paths}
+    d = Drawing(ax, m, geometry(m, sweep), paths, labels, units, smooth)
     d.update(i, caption(sweep, i) if title is None else title)
     return ax
 
 
 def smooth_paths(m: Mechanism, sweep: Sweep, paths: list[str]) -> dict | None:
     """Paths through about 360 poses, the extra ones SOLVED between the sweep's (see
-    `kincas.cli.picture.dense_paths`), so that a 12-pose sweep does not draw a 12-gon; None
+    `kincas.views.picture.dense_paths`), so that a 12-pose sweep does not draw a 12-gon; None
     for sweeps of more than 60 poses (their poses are dense enough)."""
-    n = len(sweep)
-    if n < 2 or n > 60 or not paths:
+    from .picture import dense_paths, smooth_steps
+    per_step = smooth_steps(len(sweep))
+    if per_step == 0 or not paths:
         return None
-    per_step = int(min(16, max(0, -(-360 // (n - 1)) - 1)))
-    if per_step == 0:
-        return None
-    from .picture import dense_paths
     return dense_paths(m, sweep, paths, per_step)
-
-
-def check_paths(m: Mechanism, paths) -> list[str]:
-    """The points whose paths are drawn: `paths`, checked, or every moving point (None).
-
-    >>> import kincas
-    >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("c", "O", "A", 1)],
-    ...                      inputs=[kincas.Input.angle("c")])
-    >>> check_paths(m, None), check_paths(m, ["O"])
-    (['A'], ['O'])
-    """
-    bad = [p for p in paths or () if p not in m.moving_points + m.ground_points]
-    if bad:
-        raise ValueError(f"paths: unknown point(s) {bad} (points: {m.ground_points + m.moving_points})")
-    return list(m.moving_points if paths is None else paths)
 
 
 def new_figure(size=(6.4, 4.8)):

@@ -84,7 +84,7 @@ def dxf_document(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=N
     for name, a in pic.paths.items():
         for run in _runs(a):
             msp.add_lwpolyline([tuple(q) for q in run], dxfattribs={"layer": "paths"})
-    curves = pic.joint_curves(i)  # gears, racks, cams (cli/draw_joints.py): layer "joints"
+    curves = pic.joint_curves(i)  # gears, racks, cams (views/draw_joints.py): layer "joints"
     if curves:
         doc.layers.add("joints")
     for label, body, a in curves:

@@ -48,7 +48,7 @@ def _arr(a, digits=9):
 
 def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0) -> dict:
     """Everything the page draws, as JSON-ready lists (scene units when a scene is given)."""
-    from .outputs import heading, user_columns, _abscissa
+    from .columns import heading, user_columns, _abscissa
     pic = picture(m, sweep, paths, dense)
     n = len(sweep)
     keep = np.unique(np.round(np.linspace(0, n - 1, min(n, MAX_FRAMES))).astype(int)) if n else np.zeros(0, int)
@@ -78,7 +78,7 @@ def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0
 
 
 def _joints(pic, keep) -> list:
-    """Per kept pose, the gears', racks' and cams' polylines (cli/draw_joints.py), coarser
+    """Per kept pose, the gears', racks' and cams' polylines (views/draw_joints.py), coarser
     than in the other pictures so that the page stays small: [{colour, pts}]."""
     colours = {b.name: b.colour for b in pic.bodies}
     return [[{"colour": "#c0392b" if len(a) == 1 else colours.get(body, INK), "pts": _arr(a, 7)}

@@ -1,4 +1,5 @@
-"""Files written whole or not at all: every file the command line writes goes through here.
+"""Files written whole or not at all: every file kincas writes (the views' writers, the
+command line's outputs and scenes) goes through here.
 
 `replacing(path)` gives a temporary name in the same folder (so that the final rename stays
 on one file system, where it is atomic); the writer writes there; when it returns, the
@@ -80,3 +81,9 @@ def _umask() -> int:
     u = os.umask(0o022)
     os.umask(u)
     return u
+
+
+def savefig(fig, path, **kw) -> None:
+    """`fig.savefig(path, **kw)`, the file whole or not at all."""
+    with replacing(path) as tmp:
+        fig.savefig(tmp, **kw)

@@ -109,7 +109,7 @@ def svg_text(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None,
             out.append(f'<line data-link={quoteattr(b.name)} x1="{_f(ax)}" y1="{_f(ay)}" x2="{_f(bx)}" '
                        f'y2="{_f(by)}" stroke="{b.colour}" stroke-width="{_f(1.6 * sw_)}"/>')
     out.append("</g>")
-    out.append('<g id="joints" fill="none">')  # gears, racks, cams: cli/draw_joints.py
+    out.append('<g id="joints" fill="none">')  # gears, racks, cams: views/draw_joints.py
     colours = {b.name: b.colour for b in pic.bodies}
     for label, body, a in pic.joint_curves(i):
         c = colours.get(body, INK)

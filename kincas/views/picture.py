@@ -1,7 +1,7 @@
 """What a vector picture of a sweep shows, independent of the format (SVG, DXF, HTML):
 every body's outline at each pose, the ground pivots, each slide's guide, and the paths.
 
-Positions come from `kincas.plot.geometry` (the solved unknowns through the compiled
+Positions come from `kincas.views.poses.geometry` (the solved unknowns through the compiled
 model), so every format draws exactly the poses that were solved. A body of two points is a
 bar; of three or more, the convex hull of its points at the first solved pose (a bar between
 the two farthest when they are collinear). Paths are densified with the solver
@@ -24,6 +24,7 @@ import numpy as np
 
 from ..model.mechanism import GROUND, Mechanism
 from ..results import Sweep
+from .poses import _hull, check_paths, default_pose, geometry
 
 COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
            "#7f7f7f", "#bcbd22", "#17becf"]  # matplotlib's tab10, as the PNG drawings use
@@ -63,7 +64,7 @@ class Picture:
     paths: dict[str, np.ndarray] = field(default_factory=dict)  # point -> M x 2 (NaN breaks)
     r: float = 1.0  # the picture's unit of size (2 % of its extent)
     first: int = 0  # the first solved pose
-    # pose -> [(label, body, polyline)] of the gears, racks and cams (cli/draw_joints.py)
+    # pose -> [(label, body, polyline)] of the gears, racks and cams (views/draw_joints.py)
     joint_curves: object = field(default=lambda i, fine=121: [], repr=False)
 
     def box(self) -> np.ndarray:
@@ -80,16 +81,11 @@ class Picture:
         return np.array([pts.min(axis=0) - 5 * self.r, pts.max(axis=0) + 5 * self.r])
 
 
-def _hull(pts: np.ndarray) -> list[int]:
-    from .plot import _hull as hull
-    return hull(pts)
-
-
-def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int = 0) -> Picture:
+def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0) -> Picture:
     """The Picture of `sweep`; `paths` names the points whose paths are drawn (default: every
     moving point); `dense` > 0 solves that many extra poses between each two of the sweep's
-    for smooth paths."""
-    from .plot import check_paths, default_pose, geometry
+    for smooth paths, or is those paths already solved (point -> M x 2, from `dense_paths`:
+    several pictures of one sweep share one solve)."""
     geo = geometry(m, sweep)
     names, xy = geo.names, geo.xy
     i0 = default_pose(geo.ok)
@@ -119,7 +115,10 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int = 0) -> Picture:
                             float(sv.max() + 4 * r), sl.along == GROUND,
                             INK if sl.along == GROUND else colour[sl.along]))
     chosen = check_paths(m, paths)
-    path_xy = dense_paths(m, sweep, chosen, dense) if dense > 0 else {p: geo.point(p) for p in chosen}
+    if isinstance(dense, dict):
+        path_xy = {p: dense[p] for p in chosen}
+    else:
+        path_xy = dense_paths(m, sweep, chosen, dense) if dense > 0 else {p: geo.point(p) for p in chosen}
     return Picture(names, xy, geo.ok, [names.index(g) for g in m.ground_points], bodies, guides,
                    path_xy, r, i0, _joint_curves(m, geo, r))
 
@@ -130,12 +129,23 @@ def _joint_curves(m: Mechanism, geo, r: float):
                                 else [])
 
 
+def smooth_steps(n: int) -> int:
+    """The extra poses to solve between two of a sweep of `n` poses for paths through about
+    360 points (at most 16); 0 for more than 60 poses, which are dense enough as they are.
+
+    >>> smooth_steps(13), smooth_steps(60), smooth_steps(361)
+    (16, 6, 0)
+    """
+    if n < 2 or n > 60:
+        return 0
+    return int(min(16, max(0, -(-360 // (n - 1)) - 1)))
+
+
 def dense_paths(m: Mechanism, sweep: Sweep, points: list[str], per_step: int) -> dict[str, np.ndarray]:
     """Paths through `per_step` extra poses between each two solved neighbours of the sweep,
     each SOLVED (a sweep over the finer inputs from the first pose's assembly, so it keeps the
     branch); where the finer sweep fails, its poses are left out (NaN breaks the line)."""
     from ..analysis.sweeps import sweep as run
-    from .plot import geometry
     n = len(sweep)
     if n < 2 or not points:
         return {p: geometry(m, sweep).point(p) for p in points}

@@ -38,7 +38,7 @@ def snap(v, scale: float) -> np.ndarray:
 def scale_of(name: str, scene, sweep) -> float:
     """The natural scale of quantity `name` in the scene's units (0 when unknown: then only
     the column's own largest value sets it)."""
-    from ..core.symbolic import parse_quantity
+    from ..model.names import parse_quantity
     try:
         kind, obj, attr = parse_quantity(name)
     except Exception:  # a quantity kind this module does not know

@@ -59,8 +59,8 @@ def first_inputs(m) -> dict[str, float]:
 
 def mechanism_svg(m, width: float = 420) -> str:
     """The mechanism drawn at its first pose (see the module), as SVG text."""
-    from .analysis.sweeps import sweep
-    from .cli.svg import svg_text
+    from ..analysis.sweeps import sweep
+    from .svg import svg_text
     sw = sweep(m, {k: np.array([v]) for k, v in first_inputs(m).items()}, report=[])
     return svg_text(m, sw, 0, width=width)
 

@@ -1,4 +1,4 @@
-"""Pictures of gears, racks and cams on a mechanism drawing (kincas/cli/plot.py).
+"""Pictures of gears, racks and cams on a mechanism drawing (kincas/views/plot.py).
 
 Gears: each pitch circle about its body's frame origin, with a radius drawn at the body's
 angle so that the rotation shows. Racks: the pitch line, `radius` from the line the pinion's
@@ -11,7 +11,7 @@ the contact points; `JointArtists` makes the artists once and moves them to any 
 
 >>> import numpy as np, kincas
 >>> from matplotlib.figure import Figure
->>> from kincas.cli.plot import draw
+>>> from kincas.views.plot import draw
 >>> from kincas.model import Cam, Circle
 >>> m = kincas.Mechanism(ground={"O": (0, 0)},
 ...     links=[kincas.Link.bar("shaft", "O", "K", 10), kincas.Link.bar("arm", "O", "F", 45)],
@@ -45,7 +45,7 @@ class JointGeometry:
 
 def joint_geometry(model, Q, U, p, ok) -> JointGeometry | None:
     """Frames and contact points at every pose (Q, U: N rows; p: parameter values)."""
-    m = model.sym.mech
+    m = model.mech
     if not (m.gears or m.racks or m.cams):
         return None
     raw, nums = joint_values(model, Q, U, p)

@@ -58,7 +58,7 @@ def plot_map(r, path, title: str = "") -> None:
         fig.suptitle(title)
     fig.tight_layout()
     try:
-        from .outputs import savefig
+        from .atomic import savefig
         savefig(fig, path, dpi=110)
     except OSError as e:
         raise OutputError(f"--plot: cannot write {str(path)!r}: {e.strerror or e}") from None

@@ -1,0 +1,108 @@
+"""World positions of every pose of a sweep, as every picture (matplotlib, SVG, DXF, HTML)
+draws them: points and slide lines from the solved unknowns `sweep.q` through the compiled
+model, so a picture shows exactly the poses that were solved (NaN where a pose was not).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.drawing import pose_values
+from ..model.mechanism import GROUND, Mechanism
+from ..results import Sweep
+
+
+@dataclass
+class Geometry:
+    """World positions over a sweep: `xy[i, k]` is point `names[k]` at pose i (NaN when the
+    pose was not solved); each slide's line at each pose as a point `through` (N x 2), a unit
+    direction `direction` (N x 2) and the slide coordinate `s` (N,) of its point.
+
+    >>> import numpy as np, kincas
+    >>> m = kincas.Mechanism(ground={"O": (0, 0)},
+    ...     links=[kincas.Link.bar("crank", "O", "A", 1), kincas.Link.bar("rod", "A", "B", 3)],
+    ...     slides=[kincas.Slide("B", "ground", name="slider")],
+    ...     inputs=[kincas.Input.angle("crank")], guess={"B": (3.5, 0)})
+    >>> g = geometry(m, kincas.sweep(m, {"crank.angle": [0.0, np.pi / 2]}))
+    >>> np.round(g.point("B"), 6).tolist(), np.round(g.slides["slider"][2], 6).tolist()
+    ([[4.0, 0.0], [2.828427, 0.0]], [4.0, 2.828427])
+    """
+
+    names: list[str]
+    xy: np.ndarray
+    slides: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]
+    ok: np.ndarray
+    joints: object = field(default=None, repr=False)  # gears, racks, cams: views/draw_joints.py
+
+    def point(self, name: str) -> np.ndarray:
+        """(N x 2) positions of one point."""
+        return self.xy[:, self.names.index(name)]
+
+
+def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
+    """Positions of all points and the lines of all slides at every pose of `sweep`."""
+    from ..core.numeric import compile
+    model = compile(m)
+    keys = [i.key for i in m.inputs]
+    missing = [k for k in keys if k not in sweep.inputs]
+    if missing:
+        raise ValueError(f"the sweep has no values for the inputs {missing}: was it made with this mechanism?")
+    n, ok = len(sweep), sweep.ok
+    names = list(m.ground_points) + list(m.moving_points)
+    U = np.stack([np.asarray(sweep.inputs[k], float) for k in keys], axis=1).reshape(n, len(keys))
+    p = np.array([v for _, v in m.parameters], float)
+    Q = np.where(ok[:, None], sweep.q, 0.0)  # what depends on q is masked below
+    raw = pose_values(model, Q, U, p)
+    ng = len(m.ground_points)
+    xy = raw[:, :2 * len(names)].reshape(n, len(names), 2).copy()
+    xy[~ok, ng:] = np.nan  # ground points are known at every pose, moving ones when solved
+    slides = {}
+    for k, sl in enumerate(m.slides):
+        c = 2 * len(names) + 3 * k
+        through, angle = raw[:, c:c + 2].copy(), raw[:, c + 2].copy()
+        if sl.along != GROUND:
+            through[~ok], angle[~ok] = np.nan, np.nan
+        d = np.stack([np.cos(angle), np.sin(angle)], axis=1)
+        s = np.einsum("ij,ij->i", xy[:, names.index(sl.point)] - through, d)  # signed distance
+        slides[sl.name] = (through, d, s)
+    from .draw_joints import joint_geometry
+    return Geometry(names, xy, slides, ok, joint_geometry(model, Q, U, p, ok))
+
+
+def _hull(pts: np.ndarray) -> list[int]:
+    """Indices of the convex hull of 2-D points, counter-clockwise (Andrew's monotone chain)."""
+    def turn(o, a, b):  # z of (a - o) x (b - o): positive when o -> a -> b turns left
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    def chain(idx):  # keep only left turns
+        out: list[int] = []
+        for i in idx:
+            while len(out) >= 2 and turn(pts[out[-2]], pts[out[-1]], pts[i]) <= 0:
+                out.pop()
+            out.append(i)
+        return out
+    order = sorted(range(len(pts)), key=lambda i: tuple(pts[i]))
+    return chain(order)[:-1] + chain(order[::-1])[:-1]
+
+
+
+def default_pose(sweep: Sweep | np.ndarray) -> int:
+    """The pose drawn when none is asked for: the first one solved (0 when none was)."""
+    k = np.flatnonzero(sweep.ok if isinstance(sweep, Sweep) else sweep)
+    return int(k[0]) if k.size else 0
+
+
+def check_paths(m: Mechanism, paths) -> list[str]:
+    """The points whose paths are drawn: `paths`, checked, or every moving point (None).
+
+    >>> import kincas
+    >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("c", "O", "A", 1)],
+    ...                      inputs=[kincas.Input.angle("c")])
+    >>> check_paths(m, None), check_paths(m, ["O"])
+    (['A'], ['O'])
+    """
+    bad = [p for p in paths or () if p not in m.moving_points + m.ground_points]
+    if bad:
+        raise ValueError(f"paths: unknown point(s) {bad} (points: {m.ground_points + m.moving_points})")
+    return list(m.moving_points if paths is None else paths)
