@@ -228,11 +228,11 @@ class Modes(list, Result):
     def summary(self) -> str:
         return f"{len(self)} assembly modes" + ("" if self else " (none found)")
 
-    def to_pandas(self, length: str = ""):
-        return modes_to_pandas(self, length)
+    def to_pandas(self, length: str = "", angle: str = "rad"):
+        return in_angle(modes_to_pandas(self, length), angle)
 
-    def to_xarray(self, length: str = ""):
-        return modes_to_xarray(self, length)
+    def to_xarray(self, length: str = "", angle: str = "rad"):
+        return in_angle(modes_to_xarray(self, length), angle)
 
 
 # --- designs' sweeps (design x pose) and studies (one row per design) ---
@@ -319,3 +319,62 @@ def multistart_to_pandas(r, length: str = ""):
     df = pd.DataFrame(cols, index=pd.RangeIndex(len(r.results), name="start"))
     df.attrs["units"] = {n: unit_of(n, length) for n in r.names}
     return df
+
+
+# --- angles in degrees on request (every result's `angle="deg"`) ---
+
+
+def _angle_factor(unit: str, angle: str) -> float:
+    """What turns a value of `unit` (as recorded, radians) into `angle`'s unit: 180/pi for a
+    unit whose numerator is radians (rad, rad/s, rad/mm), 1 otherwise."""
+    return 180.0 / np.pi if angle == "deg" and unit.split("/")[0] == "rad" else 1.0
+
+
+def _deg_unit(unit: str) -> str:
+    return "deg" + unit[3:] if unit.split("/")[0] == "rad" else unit
+
+
+def in_angle(table, angle: str = "rad"):
+    """`table` (a DataFrame or Dataset made above, in radians) with its angles, angular rates
+    and derivatives of angles in `angle` ("rad" : as it is, "deg" : degrees), units renamed.
+
+    >>> import pandas as pd
+    >>> df = pd.DataFrame({"L.angle": [np.pi]}); df.attrs["units"] = {"L.angle": "rad"}
+    >>> t = in_angle(df, "deg"); float(t["L.angle"][0]), t.attrs["units"]
+    (180.0, {'L.angle': 'deg'})
+    """
+    if angle not in ("rad", "deg"):
+        from .errors import ModelError
+        raise ModelError(f"angle: expected 'rad' or 'deg', got {angle!r}")
+    if angle == "rad":
+        return table
+    table = table.copy()
+    if hasattr(table, "data_vars"):  # an xarray Dataset: units on each variable and coordinate
+        for name in [*table.data_vars, *table.coords]:
+            unit = table[name].attrs.get("units", "")
+            k = _angle_factor(unit, angle)
+            if k != 1.0:
+                table[name] = table[name] * k
+                table[name].attrs["units"] = _deg_unit(unit)
+        if "units" in table.coords and "quantity" in table.dims:  # per quantity (tolerances)
+            k = np.array([_angle_factor(str(u), angle) for u in table["units"].values])
+            for name in table.data_vars:
+                if "quantity" in table[name].dims and table[name].dtype.kind == "f":
+                    table[name] = table[name] * table["units"].copy(data=k)
+            table = table.assign_coords(units=("quantity", [_deg_unit(str(u)) for u in table["units"].values]))
+        return table
+    units = dict(table.attrs.get("units", {}))  # a DataFrame: units by column (or index) name
+    for col in table.columns:
+        key = next((col[len(p):] for p in ("std ", "mc ") if str(col).startswith(p)), col)
+        k = _angle_factor(units.get(key, ""), angle)
+        if k != 1.0:
+            table[col] = table[col] * k
+    names = list(table.index.names)
+    if any(_angle_factor(units.get(n, ""), angle) != 1.0 for n in names if n):
+        levels = [table.index.get_level_values(i) * _angle_factor(units.get(n, ""), angle)
+                  for i, n in enumerate(names)]
+        import pandas as pd
+        table.index = (pd.MultiIndex.from_arrays(levels, names=names) if len(names) > 1
+                       else pd.Index(levels[0], name=names[0]))
+    table.attrs["units"] = {n: _deg_unit(u) for n, u in units.items()}
+    return table

@@ -5,8 +5,9 @@ analysis, sensitivities and an optimisation each return an object that
 
 - says whether it succeeded in itself (`ok`: a bool, or one per pose / design): a failure is
   reported in the result, never raised (as scipy's OptimizeResult does);
-- converts to pandas and xarray with the same keywords (`to_pandas(length="")`,
-  `to_xarray(length="")`: `length` names the unit of lengths in the units recorded);
+- converts to pandas and xarray with the same keywords (`to_pandas(length="", angle="rad")`,
+  `to_xarray(...)`: `length` names the unit of lengths in the units recorded, `angle="deg"`
+  converts angles, angular rates and derivatives of angles to degrees);
 - prints as one line saying what it holds (`repr`, built from `summary()`).
 
 >>> import kincas
@@ -31,8 +32,8 @@ class Result(abc.ABC):
     >>> class Tiny(Result):
     ...     ok = True
     ...     def summary(self): return "one number"
-    ...     def to_pandas(self, length=""): return None
-    ...     def to_xarray(self, length=""): return None
+    ...     def to_pandas(self, length="", angle="rad"): return None
+    ...     def to_xarray(self, length="", angle="rad"): return None
     >>> Tiny()
     <Tiny: one number>
     """
@@ -47,12 +48,14 @@ class Result(abc.ABC):
         """A short description of what the result holds (the body of its `repr`)."""
 
     @abc.abstractmethod
-    def to_pandas(self, length: str = ""):
-        """A pandas DataFrame; `length` names the unit of lengths in `df.attrs["units"]`."""
+    def to_pandas(self, length: str = "", angle: str = "rad"):
+        """A pandas DataFrame; `length` names the unit of lengths in `df.attrs["units"]`;
+        `angle="deg"` gives angles, angular rates and derivatives of angles in degrees."""
 
     @abc.abstractmethod
-    def to_xarray(self, length: str = ""):
-        """An xarray Dataset; `length` names the unit of lengths in each variable's units."""
+    def to_xarray(self, length: str = "", angle: str = "rad"):
+        """An xarray Dataset; `length` names the unit of lengths in each variable's units;
+        `angle="deg"` gives angles, angular rates and derivatives of angles in degrees."""
 
     def __repr__(self) -> str:
         return f"<{type(self).__name__}: {self.summary()}>"

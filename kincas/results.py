@@ -101,13 +101,15 @@ class Pose(Result):
         """
         return f"{self.status}{f' ({self.flag})' if self.flag else ''}; {len(self.values)} values"
 
-    def to_pandas(self, length: str = ""):
+    def to_pandas(self, length: str = "", angle: str = "rad"):
         """A one-row DataFrame: the inputs as index, a column per value, `status`, `flag`.
 
         Parameters
         ----------
         length : str
             The unit of lengths, recorded in `df.attrs["units"]` ("" : none).
+        angle : {"rad", "deg"}
+            Angles, angular rates and derivatives of angles in radians (as held) or degrees.
 
         Returns
         -------
@@ -118,16 +120,18 @@ class Pose(Result):
         >>> Pose({"crank.angle": 0.0}, "ok", None, {"C.x": 1.5}, 0.0).to_pandas("mm").attrs["units"]["C.x"]
         'mm'
         """
-        from .frames import pose_to_pandas
-        return pose_to_pandas(self, length)
+        from .frames import pose_to_pandas, in_angle
+        return in_angle(pose_to_pandas(self, length), angle)
 
-    def to_xarray(self, length: str = ""):
+    def to_xarray(self, length: str = "", angle: str = "rad"):
         """A Dataset along `pose` (of length 1), as `Sweep.to_xarray` gives.
 
         Parameters
         ----------
         length : str
             The unit of lengths, recorded in each variable's units ("" : none).
+        angle : {"rad", "deg"}
+            Angles, angular rates and derivatives of angles in radians (as held) or degrees.
 
         Returns
         -------
@@ -138,8 +142,8 @@ class Pose(Result):
         >>> float(Pose({"crank.angle": 0.0}, "ok", None, {"C.x": 1.5}, 0.0).to_xarray()["C.x"][0])
         1.5
         """
-        from .frames import pose_to_xarray
-        return pose_to_xarray(self, length)
+        from .frames import pose_to_xarray, in_angle
+        return in_angle(pose_to_xarray(self, length), angle)
 
 
 @dataclass(repr=False)
@@ -299,7 +303,7 @@ class Sweep(Result):
         return out
 
     # --- in the data tools (extra kincas[data]) ---
-    def to_pandas(self, length: str = ""):
+    def to_pandas(self, length: str = "", angle: str = "rad"):
         """A DataFrame: one row per pose, the inputs as index, a column per quantity, then
         `status` and `flag`; units (radians, and `length` if named) in `df.attrs["units"]`.
         A reported quantity that is also an input (the driven link's angle) is the index, as
@@ -309,6 +313,8 @@ class Sweep(Result):
         ----------
         length : str
             The unit of lengths, recorded in the units ("" : none).
+        angle : {"rad", "deg"}
+            Angles, angular rates and derivatives of angles in radians (as held) or degrees.
 
         Returns
         -------
@@ -324,10 +330,10 @@ class Sweep(Result):
         >>> list(df.columns), df.attrs["units"]["A.x"]
         (['A.x', 'A.y', 'status', 'flag'], 'm')
         """
-        from .frames import sweep_to_pandas
-        return sweep_to_pandas(self, length)
+        from .frames import sweep_to_pandas, in_angle
+        return in_angle(sweep_to_pandas(self, length), angle)
 
-    def to_xarray(self, length: str = ""):
+    def to_xarray(self, length: str = "", angle: str = "rad"):
         """A Dataset along the dimension `pose`: inputs as coordinates, each quantity a variable
         with `attrs["units"]`, and `status`, `flag`, `ok`, `residual`.
 
@@ -335,6 +341,8 @@ class Sweep(Result):
         ----------
         length : str
             The unit of lengths, recorded in the units ("" : none).
+        angle : {"rad", "deg"}
+            Angles, angular rates and derivatives of angles in radians (as held) or degrees.
 
         Returns
         -------
@@ -350,8 +358,8 @@ class Sweep(Result):
         >>> ds["A.x"].attrs["units"], ds.sizes["pose"]
         ('m', 2)
         """
-        from .frames import sweep_to_xarray
-        return sweep_to_xarray(self, length)
+        from .frames import sweep_to_xarray, in_angle
+        return in_angle(sweep_to_xarray(self, length), angle)
 
     @property
     def ok(self) -> np.ndarray:

@@ -73,14 +73,23 @@ def test_result_round_trips(name):
     assert r.summary()
     df, ds = r.to_pandas(length="mm"), r.to_xarray(length="mm")
     assert isinstance(df, pd.DataFrame) and isinstance(ds, xr.Dataset)
-    sig = [inspect.signature(f).parameters["length"].default for f in (type(r).to_pandas, type(r).to_xarray)]
-    assert sig == ["", ""]
+    sig = [(inspect.signature(f).parameters["length"].default, inspect.signature(f).parameters["angle"].default)
+           for f in (type(r).to_pandas, type(r).to_xarray)]
+    assert sig == [("", "rad"), ("", "rad")]
+    assert isinstance(r.to_pandas(angle="deg"), pd.DataFrame) and isinstance(r.to_xarray(angle="deg"), xr.Dataset)
+    with pytest.raises(kincas.ModelError, match="angle: expected 'rad' or 'deg'"):
+        r.to_pandas(angle="grad")
     if name in ("solve", "sweep"):
         ts = T[1:] if name == "solve" else T
         for q, f in CLOSED.items():
             assert np.allclose(df[q].to_numpy(), [f(2.0, t) for t in ts], rtol=0, atol=1e-12)
             assert np.allclose(ds[q].values, [f(2.0, t) for t in ts], rtol=0, atol=1e-12)
             assert df.attrs["units"][q] == ds[q].attrs["units"] == "mm"
+        deg, dsd = r.to_pandas(angle="deg"), r.to_xarray(angle="deg")
+        assert np.allclose(deg.index.to_numpy(), [t * 180 / math.pi for t in ts], rtol=1e-15)
+        assert np.allclose(dsd["crank.angle"].values, [t * 180 / math.pi for t in ts], rtol=1e-15)
+        assert deg.attrs["units"]["crank.angle"] == dsd["crank.angle"].attrs["units"] == "deg"
+        assert np.array_equal(deg["A.x"], df["A.x"])  # lengths untouched
     if name == "sweep_designs":
         for d, a in enumerate([1.0, 3.0]):
             for k, t in enumerate(T):
@@ -98,7 +107,26 @@ def test_result_round_trips(name):
     if name == "optimize":  # minimum of (a - 1.5)^2 + (a cos 0.5 - 1.5)^2
         c = math.cos(0.5)
         assert abs(r.varied["a"] - 1.5 * (1 + c) / (1 + c * c)) < 1e-6
-    if name == "find_modes":
+    if name == "find_modes":  # a four-bar's link angles, in degrees on request
+        assert np.allclose(r.to_pandas(angle="deg")["rocker.angle"], np.degrees(df["rocker.angle"]), rtol=1e-15)
         assert len(df) == 2 and ds.sizes["mode"] == 2 and r[0] is list(r)[0]  # still a list
     if name == "input_range":
         assert r.full_turn and len(df) == 0 and ds.attrs["full_turn"] == 1
+
+
+def test_tolerance_spreads_of_angles_in_degrees():
+    # first order, the spread of an angle scales by 180/pi and a length's does not
+    r = kincas.analyse(four_bar_a(), {"crank.angle": [0.0, 0.5]}, {"a": 0.01}, ["rocker.angle", "C.x"], draws=20)
+    rad, deg = r.to_pandas(), r.to_pandas(angle="deg")
+    assert np.allclose(deg["std rocker.angle"], rad["std rocker.angle"] * 180 / math.pi, rtol=1e-15)
+    assert np.array_equal(deg["std C.x"], rad["std C.x"])
+    x, y = r.to_xarray(), r.to_xarray(angle="deg")
+    assert np.allclose(y.first_order.values, x.first_order.values * [180 / math.pi, 1.0], rtol=1e-15)
+    assert list(y["units"].values) == ["deg", ""]
+
+
+def four_bar_a():
+    return kincas.Mechanism(parameters={"a": 1.0}, ground={"A": (0, 0), "D": (4, 0)},
+                            links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", 3.5),
+                                   kincas.Link.bar("rocker", "D", "C", 3)],
+                            inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})

@@ -114,7 +114,7 @@ class DesignSweep(Result):
         return (f"{nd} designs x {npose} poses, {int(self.design_ok.sum())} solved at every pose; "
                 f"varied {', '.join(self.names) or 'none'}; reported {', '.join(self.values) or 'none'}")
 
-    def to_pandas(self, length: str = ""):
+    def to_pandas(self, length: str = "", angle: str = "rad"):
         """A DataFrame indexed by (design, pose): the varied parameters, the inputs, each
         quantity and `status`; units in `df.attrs["units"]` (`length` names lengths').
 
@@ -128,14 +128,14 @@ class DesignSweep(Result):
         >>> df.loc[(1, 0), "A.x"], df.attrs["units"]["a"]
         (np.float64(3.0), 'mm')
         """
-        from ..frames import designs_to_pandas
-        return designs_to_pandas(self, length)
+        from ..frames import designs_to_pandas, in_angle
+        return in_angle(designs_to_pandas(self, length), angle)
 
-    def to_xarray(self, length: str = ""):
+    def to_xarray(self, length: str = "", angle: str = "rad"):
         """An xarray Dataset with dimensions (design, pose): the varied parameters along
         design, the inputs along pose, each quantity and `status` over both."""
-        from ..frames import designs_to_xarray
-        return designs_to_xarray(self, length)
+        from ..frames import designs_to_xarray, in_angle
+        return in_angle(designs_to_xarray(self, length), angle)
 
 
 # --- the designs' table ---

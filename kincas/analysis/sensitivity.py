@@ -77,16 +77,16 @@ class Sensitivities(Result):
         return (f"{len(self.of)} quantities x {len(self.to)} parameters over "
                 f"{self.matrix.shape[0]} poses: {', '.join(list(self)[:3])}{' ...' if len(list(self)) > 3 else ''}")
 
-    def to_pandas(self, length: str = ""):
+    def to_pandas(self, length: str = "", angle: str = "rad"):
         """A DataFrame per pose (inputs as index) with a column `d(Q)/d(p)` per pair, then
         `status` and `flag`; units in `df.attrs["units"]` (`length` names lengths')."""
-        from ..frames import sensitivities_to_pandas
-        return sensitivities_to_pandas(self, length)
+        from ..frames import sensitivities_to_pandas, in_angle
+        return in_angle(sensitivities_to_pandas(self, length), angle)
 
-    def to_xarray(self, length: str = ""):
+    def to_xarray(self, length: str = "", angle: str = "rad"):
         """A Dataset along `pose`, a variable `d(Q)/d(p)` per pair, as `Sweep.to_xarray`."""
-        from ..frames import sensitivities_to_xarray
-        return sensitivities_to_xarray(self, length)
+        from ..frames import sensitivities_to_xarray, in_angle
+        return in_angle(sensitivities_to_xarray(self, length), angle)
 
     @property
     def ok(self) -> np.ndarray:

@@ -82,16 +82,16 @@ class Range(Result):
         span = "full turn" if self.full_turn else f"{self.low:.6g} to {self.high:.6g}"
         return f"{self.key} {span}; {len(self.limits)} limits met"
 
-    def to_pandas(self, length: str = ""):
+    def to_pandas(self, length: str = "", angle: str = "rad"):
         """A DataFrame of the limits met (kind, input value); key, low, high, full_turn and
         start in `df.attrs`."""
-        from ..frames import range_to_pandas
-        return range_to_pandas(self, length)
+        from ..frames import range_to_pandas, in_angle
+        return in_angle(range_to_pandas(self, length), angle)
 
-    def to_xarray(self, length: str = ""):
+    def to_xarray(self, length: str = "", angle: str = "rad"):
         """A Dataset along `limit` (kind, value); key, low, high, full_turn, start as attributes."""
-        from ..frames import range_to_xarray
-        return range_to_xarray(self, length)
+        from ..frames import range_to_xarray, in_angle
+        return in_angle(range_to_xarray(self, length), angle)
 
 
 def input_range(m: Mechanism, inputs: dict, key: str | None = None, *, max_steps: int = 20000) -> Range:

@@ -95,15 +95,15 @@ class ToleranceAnalysis(Result):
         """Relative sampling error of a Monte-Carlo standard deviation, 1 / sqrt(2 (n - 1))."""
         return 1.0 / math.sqrt(2.0 * max(self.samples - 1, 1))
 
-    def to_pandas(self, length: str = ""):
+    def to_pandas(self, length: str = "", angle: str = "rad"):
         """A DataFrame per pose: each output's nominal value, `std Q` and `mc Q`, status, failed."""
-        from ..frames import tolerance_to_pandas
-        return tolerance_to_pandas(self, length)
+        from ..frames import tolerance_to_pandas, in_angle
+        return in_angle(tolerance_to_pandas(self, length), angle)
 
-    def to_xarray(self, length: str = ""):
+    def to_xarray(self, length: str = "", angle: str = "rad"):
         """A Dataset (pose x quantity): nominal, first_order, monte_carlo; status, failed."""
-        from ..frames import tolerance_to_xarray
-        return tolerance_to_xarray(self, length)
+        from ..frames import tolerance_to_xarray, in_angle
+        return in_angle(tolerance_to_xarray(self, length), angle)
 
     def agrees(self, k: float = 4.0) -> bool:
         """Whether, at every solved pose, |Monte Carlo - first order| is within k sampling

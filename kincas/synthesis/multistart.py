@@ -64,15 +64,15 @@ class Multistart(Result):
         best = f"; best objective {self.best.objective:.6g}" if self.best is not None else ""
         return f"{self.runs} starts, {len(self.optima)} distinct optima{best}"
 
-    def to_pandas(self, length: str = ""):
+    def to_pandas(self, length: str = "", angle: str = "rad"):
         """A DataFrame, one row per start: its starting values, `objective`, `ok`, `status`
         and the varied parameters it reached (`length`: the unit of lengths, in the units)."""
-        from ..frames import multistart_to_pandas
-        return multistart_to_pandas(self, length)
+        from ..frames import multistart_to_pandas, in_angle
+        return in_angle(multistart_to_pandas(self, length), angle)
 
-    def to_xarray(self, length: str = ""):
+    def to_xarray(self, length: str = "", angle: str = "rad"):
         """A Dataset along `start`, the columns of `to_pandas`."""
-        return self.to_pandas(length).to_xarray()
+        return self.to_pandas(length, angle).to_xarray()
 
 
 @dataclass

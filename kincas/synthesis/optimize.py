@@ -101,16 +101,16 @@ class Optimization:
         return (f"{'ok' if self.ok else 'not ok'} ({self.status}); objective {self.objective:.6g}"
                 f" after {self.iterations} iterations; {varied}")
 
-    def to_pandas(self, length: str = ""):
+    def to_pandas(self, length: str = "", angle: str = "rad"):
         """A DataFrame per sample (inputs as index, the expressions' quantities as columns),
         the parameters, objective and status in `df.attrs`."""
-        from ..frames import optimize_to_pandas
-        return optimize_to_pandas(self, length)
+        from ..frames import optimize_to_pandas, in_angle
+        return in_angle(optimize_to_pandas(self, length), angle)
 
-    def to_xarray(self, length: str = ""):
+    def to_xarray(self, length: str = "", angle: str = "rad"):
         """A Dataset along `sample`; parameters, objective and status as attributes."""
-        from ..frames import optimize_to_xarray
-        return optimize_to_xarray(self, length)
+        from ..frames import optimize_to_xarray, in_angle
+        return in_angle(optimize_to_xarray(self, length), angle)
 
     # --- scipy.optimize.OptimizeResult's familiar names ---
     @property

@@ -193,17 +193,17 @@ class Study(Result):
         return (f"{len(self.status)} designs, {int(self.ok.sum())} ok; varied "
                 f"{', '.join(self.names) or 'none'}; report {', '.join(self.report) or 'none'}")
 
-    def to_xarray(self, length: str = ""):
+    def to_xarray(self, length: str = "", angle: str = "rad"):
         """An xarray Dataset along the dimension `design` (`length`: the unit of lengths,
         recorded in the varied parameters' units)."""
-        from ..frames import study_to_xarray
-        return study_to_xarray(self, length)
+        from ..frames import study_to_xarray, in_angle
+        return in_angle(study_to_xarray(self, length), angle)
 
-    def to_pandas(self, length: str = ""):
+    def to_pandas(self, length: str = "", angle: str = "rad"):
         """A pandas DataFrame, one row per design; the varied parameters' units in
         `df.attrs["units"]` (`length` names the unit of lengths)."""
-        from ..frames import study_to_pandas
-        return study_to_pandas(self, length)
+        from ..frames import study_to_pandas, in_angle
+        return in_angle(study_to_pandas(self, length), angle)
 
 
 @dataclass
