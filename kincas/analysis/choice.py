@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.assembly import ambiguous, first_pose, group_links, modes
-from ..core.tolerances import CHOICE_STARTS, CHOICE_TRIES
+from ..core.tolerances import CHOICE_STARTS, CHOICE_TRIES, SAME_ASSEMBLY
 from ..errors import ModelError
 
 
@@ -64,7 +64,7 @@ def choose_assembly(model, m, U, p, L, default, rerun):
     others = []
     for k, md in enumerate(found):
         pts = np.ravel([md.points[nm] for nm in m.moving_points])
-        if np.abs(pts - pts0).max() <= 1e-6 * L:
+        if np.abs(pts - pts0).max() <= SAME_ASSEMBLY * L:
             continue  # the default itself
         changed = np.flatnonzero(modes(model, model.jac(md.q, u0, p), L)[0] != sign0)
         others.append((len(changed), k, md, changed))

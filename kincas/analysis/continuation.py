@@ -10,15 +10,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.assembly import NEAR, assemble, modes, polish_singular
+from ..core.assembly import NEAR, assemble, modes
 # the first pose of a sweep (its home is the core: `kincas modes` and `range` start there too)
 from ..core.assembly import ambiguous as _ambiguous, first_pose as _first, no_assembly as _no_assembly  # noqa: F401
+from ..core import branch
 from ..core.numeric import Model, Solution
+from ..core.limits import on_step, polish_singular
+from ..core.tolerances import BRANCH, STRAIGHT, WATCH
 from ..model.mechanism import Mechanism
 from .resume import carry_groups, larger_groups, resume_label
 
 
-WATCH = 0.5  # a group conditioned below this at either end of a step is checked for a crossing
 MAX_GROUPS = 8  # groups searched for a limit where continuation of a step failed (the worst conditioned first)
 
 # --- a pose of a sweep on the careful path ---
@@ -61,12 +63,12 @@ def careful_pose(model: Model, m: Mechanism, U, p, L, guess, k: int, j: int | No
     if sol.ok and not fresh:  # back in range: in the modes it left where they assemble
         before = modes(model, model.jac(run.Q[j], U[j], p), L)[0]
         after = modes(model, sol.J, L)[0]
-        changed = np.flatnonzero((before != after) & (before != 0) & (after != 0))
+        changed = np.flatnonzero(branch.changed(before, after))
         if changed.size:  # first the modes it left, group by group
             alt = assemble(model, u, p, L, want=before, near=run.Q[j])
             if alt is not None:
                 got = modes(model, alt.J, L)[0]
-                moved = np.flatnonzero((before != got) & (before != 0) & (got != 0))
+                moved = np.flatnonzero(branch.changed(before, got))
                 if moved.size < changed.size:
                     sol = alt
         events.append({"kind": "resume", "pose": int(k)}
@@ -110,7 +112,7 @@ def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:
 
     def keeps(sol):
         got = modes(model, sol.J, L)[0]
-        return not np.any((got != want) & (got != 0) & (want != 0))
+        return not branch.changed(got, want).any()
     sol = model.newton(last[0], u, p, L)
     if sol.ok and keeps(sol):
         return sol
@@ -185,7 +187,7 @@ def _gap_inside(model: Model, run, U, p, L, j, k, sol: Solution, reach) -> bool:
     cond = modes(model, model.jac(near_j[0], near_j[1], p), L)[1]
     for i in np.argsort(cond, kind="stable")[:MAX_GROUPS]:
         found = locate_singular(model, *near_j, p, L, d, group=int(i), window=(-0.5, 1.5))
-        if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
+        if on_step(found):
             back = []  # and from pose k back towards pose j: the other end of the gap
             _continue(model, sol.q, U[k], U[j], p, L, depth=8, reach=back)
             near_k = back[-1] if back else (sol.q, U[k])
@@ -217,12 +219,12 @@ def _crossed(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
     from .singular import locate_singular
     s0, c0 = modes(model, J0, L)
     s1, c1 = modes(model, sol.J, L)
-    for i in np.flatnonzero((s0 != s1) & (s0 != 0) & (s1 != 0)):
+    for i in np.flatnonzero(branch.changed(s0, s1)):
         start, d = ((q0, u0), u1 - u0) if c0[i] <= c1[i] else ((sol.q, u1), u0 - u1)
         if min(c0[i], c1[i]) < NEAR and polish_singular(model, *start, p, L, [int(i)]) is not None:
             continue  # that end is the singular position (within rounding)
         found = locate_singular(model, start[0], start[1], p, L, d, group=int(i))
-        if found is None or not -1e-9 <= found[2] <= 1 + 1e-9:
+        if not on_step(found):
             return False
     return True
 
@@ -247,7 +249,7 @@ def _secant(q0, u0, u1, prev):
     if n0 == 0.0:
         return None
     t = float(d1 @ d0) / n0
-    if np.linalg.norm(d1 - t * d0) > 1e-9 * np.linalg.norm(d1):
+    if np.linalg.norm(d1 - t * d0) > STRAIGHT * np.linalg.norm(d1):
         return None  # the inputs turned: no straight line to follow
     return q0 + (q0 - qp) * t
 
@@ -271,8 +273,8 @@ def _same_branch(model: Model, J0, sol: Solution, L) -> bool:
     crossed, exactly as det g_q's sign change does for a square system."""
     if model.square:
         s0, s1 = modes(model, J0, L)[0], modes(model, sol.J, L)[0]
-        return not np.any((s0 != s1) & (s0 != 0) & (s1 != 0))
+        return not branch.changed(s0, s1).any()
     c = model.column_scale(L)
     Q0, R0 = np.linalg.qr(J0 * c)
     d0, d1 = float(np.prod(np.diag(R0))), float(np.linalg.det(Q0.T @ (sol.J * c)))
-    return np.sign(d0) == np.sign(d1) or min(abs(d0), abs(d1)) < 1e-8
+    return np.sign(d0) == np.sign(d1) or min(abs(d0), abs(d1)) < BRANCH

@@ -33,7 +33,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.assembly import NEAR, group_links, modes, polish_singular, refine
+from ..core import branch
+from ..core.assembly import NEAR, group_links, modes, refine
+from ..core.limits import on_step, polish_singular
+from ..core.tolerances import CLASSIFY, REACHED, SAME_INPUT
 from ..model.names import parse_quantity
 from .singular import FLAG_SIGMA, classify, locate_singular, scaled_jacobians
 
@@ -97,7 +100,7 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
         events.append({"kind": kind, "pose": int(pose),
                        "inputs": {k: float(v) for k, v in zip(keys, u)}, "group": names[group]})
 
-    def kind_at(q, u, tol=1e-6):
+    def kind_at(q, u, tol=CLASSIFY):
         return classify(*scaled_jacobians(model, q, u, p, L), tol=tol) or "singular"
 
     # poses at a singular position: exactly onto it, flagged, one event per group
@@ -113,7 +116,7 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
             step = U[k + 1] - U[k] if k + 1 < n else U[k] - U[k - 1] if k else None
             for i in groups if step is not None and np.any(step) else ():
                 found = locate_singular(model, Q[k], U[k], p, L, step, group=i)
-                if found is not None and abs(found[2]) <= 1e-3:  # the pose all but reached it
+                if found is not None and abs(found[2]) <= REACHED:  # the pose all but reached it
                     event(kind_at(found[0], found[1]), k, found[1], i)
             continue
         Q[k], at[k] = q, True
@@ -132,13 +135,13 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
     # a group changing mode between two solved poses crossed a singular position of its own
     # (the changes found for all poses at once: a Python loop over every pose cost more than
     # the compiled solve of a long sweep)
-    flips = (signs[:-1] != signs[1:]) & (signs[:-1] != 0) & (signs[1:] != 0)
+    flips = branch.changed(signs[:-1], signs[1:])
     for k in np.flatnonzero(ok[:-1] & ok[1:] & flips.any(axis=1)):
         for i in np.flatnonzero(flips[k]):
             c0, c1 = measure(k)[1][i], measure(k + 1)[1][i]
             start, other = (k, k + 1) if c0 <= c1 else (k + 1, k)
             found = locate_singular(model, Q[start], U[start], p, L, U[other] - U[start], group=int(i))
-            if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
+            if on_step(found):
                 pose = start if found[2] <= 0.5 else other
                 event(kind_at(found[0], found[1]), pose, found[1], int(i))
             else:  # crossed, but not located: said all the same
@@ -151,7 +154,7 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
                 continue
             for i in np.argsort(measure(k)[1])[:MAX_GROUPS_AT_GAP]:
                 found = locate_singular(model, Q[k], U[k], p, L, U[nb] - U[k], group=int(i))
-                if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
+                if on_step(found):
                     event(kind_at(found[0], found[1]), k, found[1], int(i))
     # a gap inside one step between two solved poses: its limits, located from the poses
     # nearest it on either side, flag the poses before and after it
@@ -163,7 +166,7 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
             cond = modes(model, model.jac(q, u, p), L)[1]
             for i in np.argsort(cond, kind="stable")[:MAX_GROUPS_AT_GAP]:
                 found = locate_singular(model, q, u, p, L, other - u, group=int(i))
-                if found is not None and -1e-9 <= found[2] <= 1 + 1e-9:
+                if on_step(found):
                     event(kind_at(found[0], found[1]), pose, found[1], int(i))
                     break
         if len(events) == seen:  # crossed, but not located: said all the same
@@ -187,7 +190,7 @@ def _distinct(events):
     out = []
     for e in events:
         if not any(o["kind"] == e["kind"] and o.get("group") == e.get("group") and o["pose"] == e["pose"]
-                   and all(abs(o["inputs"][k] - v) <= 1e-9 * max(1.0, abs(v)) for k, v in e["inputs"].items())
+                   and all(abs(o["inputs"][k] - v) <= SAME_INPUT * max(1.0, abs(v)) for k, v in e["inputs"].items())
                    for o in out):
             out.append(e)
     return out

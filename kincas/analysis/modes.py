@@ -41,11 +41,10 @@ from ..core.turns import tied, turns
 from ..core.assembly import first_pose
 from ..core.scatter import newton_starts
 from ..core.numeric import model_of
-from ..core.tolerances import ACCEPT, BRANCH
+from ..core.tolerances import ACCEPT, BRANCH, SAME_ASSEMBLY as SAME, START_CONVERGED as CONVERGED
 from .inputs import input_table
 
-SAME = 1e-6  # two assemblies are one mode when every point agrees to this times the size
-CONVERGED = 1e-8  # a start whose relative residual reaches this is worth polishing
+# SAME: two assemblies are one mode when every point agrees to this times the size
 
 
 # --- a mode ---

@@ -27,12 +27,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core import branch
 from ..core.assembly import _block_newton, blocks, group_links, modes
-from ..core.limits import locate_singular
-from ..core.tolerances import ACCEPT
+from ..core.limits import locate_singular, on_step
+from ..core.tolerances import ACCEPT, SAME_ASSEMBLY as SAME, SAME_INPUT
 
 WIDE = 2  # a group with more unknowns than this has more assemblies than block signs
-SAME = 1e-6  # two assemblies are one when every unknown agrees to this (lengths over L)
+# SAME: two assemblies are one when every unknown agrees to this (lengths over L)
 DEPTH = 10  # halvings of one input step while carrying groups through a gap
 BUDGET = 200  # Newton solves spent carrying groups across one input step of a gap
 
@@ -118,7 +119,7 @@ def resume_label(model, U, p, L, j, qj, k, qk, carried=None) -> dict:
     """
     before = modes(model, model.jac(qj, U[j], p), L)[0]
     after = modes(model, model.jac(qk, U[k], p), L)[0]
-    changed = {int(i) for i in np.flatnonzero((before != after) & (before != 0) & (after != 0))}
+    changed = {int(i) for i in np.flatnonzero(branch.changed(before, after))}
     unknown = []
     for i in larger_groups(model):
         if i in changed or before[i] == 0 or after[i] == 0:
@@ -290,11 +291,11 @@ def _same_limit(model, U, p, L, j, qj, k, qk, i) -> bool:
     ends = []
     for q, u, nb in ((qj, U[j], U[j + 1]), (qk, U[k], U[k - 1])):
         found = locate_singular(model, q, u, p, L, nb - u, group=i)
-        if found is None or not -1e-9 <= found[2] <= 1 + 1e-9:
+        if not on_step(found):
             return False
         ends.append(found)
     (qa, ua, _), (qb, ub, _) = ends
-    if np.abs(np.asarray(ua) - np.asarray(ub)).max() > 1e-9 * max(1.0, float(np.abs(ua).max())):
+    if np.abs(np.asarray(ua) - np.asarray(ub)).max() > SAME_INPUT * max(1.0, float(np.abs(ua).max())):
         return False
     return _same(model, qa, qb, L, i)
 

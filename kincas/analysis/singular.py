@@ -33,10 +33,9 @@ import numpy as np
 
 from ..core.limits import _scales, locate_singular, scaled_jacobians  # noqa: F401  (their old home)
 from ..core.newton import newton
+from ..core.tolerances import FLAG_SIGMA, MIN_ARC_STEP, ROUNDING_REL
 from ..model.mechanism import Mechanism
 from ..result_base import Result
-
-FLAG_SIGMA = 1e-7  # relative smallest singular value at which a pose *is* singular
 
 
 # --- scaled Jacobians and classification ---
@@ -167,14 +166,14 @@ def _follow(model, q, u, p, L, i, direction, scale, is_angle, max_steps):
     nq = model.nq
     z = np.concatenate([q, [u[i]]]) / scale
     t = _curve_tangent(model, q, u, p, i, scale)
-    t = t if t[-1] * direction > 0 or abs(t[-1]) < 1e-12 else -t
+    t = t if t[-1] * direction > 0 or abs(t[-1]) < ROUNDING_REL else -t
     h, u_start = 0.02, u[i]
     for _ in range(max_steps):
         zp = z + h * t
         zn = _correct(model, zp, t, u, p, L, i, scale)
         if zn is None:
             h /= 2
-            if h < 1e-12:
+            if h < MIN_ARC_STEP:
                 return z[-1] * scale[-1], None
             continue
         qn = zn[:nq] * scale[:nq]

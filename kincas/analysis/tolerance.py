@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError
+from ..core.tolerances import ROUNDING_REL, TINY
 from ..model.mechanism import Mechanism
 from .._deprecated import keyword, renamed
 from ..result_base import Result
@@ -86,7 +87,7 @@ class ToleranceAnalysis(Result):
             fo, mc = self.first_order[n], self.monte_carlo[n]
             with np.errstate(divide="ignore", invalid="ignore"):
                 r = mc / fo
-            tiny = 1e-12 * max(1.0, float(np.nanmax(np.abs(self.nominal[n]), initial=0.0)))
+            tiny = ROUNDING_REL * max(1.0, float(np.nanmax(np.abs(self.nominal[n]), initial=0.0)))
             out[n] = np.where((fo <= tiny) & (mc <= tiny), 1.0, r)
         return out
 
@@ -114,7 +115,7 @@ class ToleranceAnalysis(Result):
         for n in self.names:
             fo, mc = self.first_order[n][ok], self.monte_carlo[n][ok]
             top = float(np.nanmax(fo, initial=0.0))
-            if not np.all(np.abs(mc - fo) <= k * self.standard_error * top + 1e-300):
+            if not np.all(np.abs(mc - fo) <= k * self.standard_error * top + TINY):
                 return False
         return True
 

@@ -16,9 +16,10 @@ is 2 x 2); the equations of block i involve only the unknowns of blocks 0..i. So
   wanted mode (default +1: the mode whose block determinant is positive) nearest a reference
   pose. A group with no solution from any start has no assembly there: that is decided in a
   few block Newton steps, without an optimiser.
-- at a pose at (or within rounding of) a singular position, `polish_singular` puts the
-  unknowns exactly on it: Gauss-Newton on g = 0, g_q[rows, cols] v = 0, v0.v = 1 at fixed
-  inputs, which converges quadratically where plain Newton crawls (g_q singular).
+- at a pose at (or within rounding of) a singular position, `polish_singular`
+  (kincas/core/limits.py) puts the unknowns exactly on it: the extended system g = 0,
+  g_q[rows, cols] v = 0, v0.v = 1 at fixed inputs, which converges quadratically where
+  plain Newton crawls (g_q singular).
 
 >>> import numpy as np, kincas
 >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
@@ -31,21 +32,12 @@ is 2 x 2); the equations of block i involve only the unknowns of blocks 0..i. So
 """
 from __future__ import annotations
 
-import casadi as ca
 import numpy as np
 
 from .newton import newton
 from .turns import nearest, settle, tied, turns, wandered
-from .numeric import Solution, _Call
-from .tolerances import ACCEPT, TOL
-
-SIGN_TOL = 1e-8  # a block whose conditioning is below this has no trustworthy sign (mode 0)
-# Newton converges only linearly onto a singular position, and stops about sqrt(TOL) from
-# it: a group conditioned below NEAR may be *at* one; `polish_singular` decides.
-NEAR = 1e-5
-# A pose is *at* a singular position when one satisfies g = 0 there to rounding: a pose 1e-12
-# of the input away from a limit is 1e-6 of the size away from the limit's positions.
-ROUNDING = 1e-15
+from .numeric import Solution
+from .tolerances import ACCEPT, NEAR_SINGULAR as NEAR, ROUNDING_REL, SIGN_TOL, TOL  # noqa: F401
 
 
 # --- the groups: blocks of g_q ---
@@ -192,12 +184,12 @@ def _dyad(model, q, u, p, L, i):
     b2 = g(0.0, np.pi / 2) - (g00 + g0p) / 2  # M2 e2
     c = (g00 + gp0) / 2 - a2
     M1, M2 = np.column_stack([a1, b1]), np.column_stack([a2, b2])
-    rot = lambda M: abs(M[0, 0] - M[1, 1]) + abs(M[0, 1] + M[1, 0]) <= 1e-12 * (np.abs(M).max() + L)
+    rot = lambda M: abs(M[0, 0] - M[1, 1]) + abs(M[0, 1] + M[1, 0]) <= ROUNDING_REL * (np.abs(M).max() + L)
     if not (rot(M1) and rot(M2)):
         return None  # not two rotations (a reflected frame, a slide): Newton's business
     t = np.array([0.7, -1.9])
     e = lambda a: np.array([np.cos(a), np.sin(a)])
-    if np.abs(c + M1 @ e(t[0]) + M2 @ e(t[1]) - g(*t)).max() > 1e-12 * L:
+    if np.abs(c + M1 @ e(t[0]) + M2 @ e(t[1]) - g(*t)).max() > ROUNDING_REL * L:
         return None
     return c, a1, a2
 
@@ -212,11 +204,11 @@ def _dyad_solutions(model, q, u, p, L, i, near):
     c, m1, m2 = form
     v, r1, r2 = -c, float(np.hypot(*m1)), float(np.hypot(*m2))
     d = float(np.hypot(*v))
-    if d <= 1e-12 * L:
-        return None if abs(r1 - r2) <= 1e-12 * L else []  # concentric: a continuum, or none
+    if d <= ROUNDING_REL * L:
+        return None if abs(r1 - r2) <= ROUNDING_REL * L else []  # concentric: a continuum, or none
     x = (d * d + r1 * r1 - r2 * r2) / (2 * d)
     h2 = r1 * r1 - x * x
-    if h2 < -1e-12 * L * L:
+    if h2 < -ROUNDING_REL * L * L:
         return []  # the circles miss each other: no assembly
     h = np.sqrt(max(h2, 0.0))
     e = v / d
@@ -348,67 +340,6 @@ def refine(model, q, u, p, L):
     eq, qs = model.scales(u, p)
     res = newton(lambda x: model.resjac(x, u, p), np.array(q, float), qs, eq, tol=0.0, max_iter=8)
     return res.x if res.ok else np.array(q, float)
-
-
-def _jv_function(model):
-    """f(q, u, p, v) -> (g, g_q v, d[g; g_q v]/dq, g_q): the singular-pose system's parts."""
-    def build():
-        sym = model.sym
-        v = ca.SX.sym("v", sym.nq)
-        Jv = ca.mtimes(sym.Jq, v)
-        F = ca.vertcat(sym.g, Jv)
-        return _Call(ca.Function("jv", [sym.q, sym.u, sym.p, v], [sym.g, Jv, ca.jacobian(F, sym.q), sym.Jq]))
-    return model.memo("assembly.jv", build)
-
-
-def polish_singular(model, q, u, p, L, groups, max_iter: int = 30):
-    """The pose at inputs u where each group in `groups` (indices) is exactly singular,
-    from q nearby: Gauss-Newton on g(q) = 0 and, per group, g_q[rows, cols] v = 0 with
-    v0.v = 1. Returns q there, or None where no such pose lies within rounding of q (then
-    q is only near a singular position, and an ordinary pose)."""
-    f, bl = _jv_function(model), blocks(model)
-    nq, ng = model.nq, model.ng
-    c = model.column_scale(L)
-    vs, v0s = [], []
-    J = model.jac(q, u, p)
-    for i in groups:
-        rows, cols = bl[i]
-        v = np.linalg.svd(J[np.ix_(rows, cols)] * c[cols])[2][-1] * c[cols]
-        vs.append(v)
-        v0s.append(v / (v @ v))
-    q = np.array(q, float)
-    for it in range(max_iter + 1):
-        F, A = [], []
-        for k, i in enumerate(groups):
-            rows, cols = bl[i]
-            v = np.zeros(nq)
-            v[cols] = vs[k]
-            g, Jv, D, Jq = (np.asarray(a) for a in f(q, u, p, v))
-            if k == 0:
-                F.append(g.ravel() / L)
-                A.append(np.hstack([Jq / L, np.zeros((ng, sum(len(bl[j][1]) for j in groups)))]))
-            row = np.zeros((len(rows) + 1, nq + sum(len(bl[j][1]) for j in groups)))
-            row[:len(rows), :nq] = D[ng + rows]
-            off = nq + sum(len(bl[j][1]) for j in groups[:k])
-            row[:len(rows), off:off + len(cols)] = Jq[np.ix_(rows, cols)]
-            row[len(rows), off:off + len(cols)] = v0s[k]
-            A.append(row)
-            F.append(np.r_[Jv.ravel()[rows], v0s[k] @ vs[k] - 1])
-        F, A = np.concatenate(F), np.vstack(A)
-        if np.abs(F).max() <= 1e-14 or it == max_iter:
-            break
-        step = np.linalg.lstsq(A, -F, rcond=None)[0]
-        if not np.all(np.isfinite(step)):
-            return None
-        q = q + step[:nq]
-        off = nq
-        for k, i in enumerate(groups):
-            n = len(bl[i][1])
-            vs[k] = vs[k] + step[off:off + n]
-            off += n
-    if np.abs(F[:ng]).max() > ROUNDING or np.abs(F[ng:]).max() > 1e-10:
-        return None
-    return q
 
 
 # --- the first pose: from the guess, or group by group ---

@@ -18,6 +18,9 @@ in kincas/core/designs_kernel.py.
 """
 from __future__ import annotations
 
+import threading
+import weakref
+
 import casadi as ca
 import numpy as np
 
@@ -67,3 +70,37 @@ class BatchEvaluator:
             return np.zeros((len(names), n))
         f = self.model.quantity_function(tuple(names))
         return np.asarray(self._mapped(f, n)(Q.T, U.T, P.T, Ud.T, Udd.T))
+
+
+def batched_solve(J, b):
+    """Batched J^-1 b (J: a stack of square matrices; b: a vector or a matrix per J); NaN
+    where J is singular.
+
+    >>> J = np.array([[[2.0, 0.0], [0.0, 4.0]], [[1.0, 1.0], [1.0, 1.0]]])
+    >>> batched_solve(J, np.ones((2, 2))).tolist()
+    [[0.5, 0.25], [nan, nan]]
+    """
+    vec = b.ndim == J.ndim - 1
+    B = b[..., None] if vec else b
+    try:
+        X = np.linalg.solve(J, B)
+    except np.linalg.LinAlgError:
+        X = np.full(B.shape, np.nan)
+        for i in range(len(B)):
+            try:
+                X[i] = np.linalg.solve(J[i], B[i])
+            except np.linalg.LinAlgError:
+                pass
+    return X[..., 0] if vec else X
+
+
+# --- one lock per compiled model for the Python-side numerics (Model keeps work buffers) ---
+
+_LOCKS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_LOCKS_LOCK = threading.Lock()
+
+
+def model_lock(model) -> threading.RLock:
+    """The one lock of `model` (reentrant), for the callers of its numerics on threads."""
+    with _LOCKS_LOCK:
+        return _LOCKS.setdefault(model, threading.RLock())

@@ -46,9 +46,7 @@ from .blocks import block_measures, block_solve, diagonal_blocks
 from .compiled import Backend, Library, ptr, rows
 from .fast import COMPILE_MAX, SWEEP_SIG, sweeper_for
 from .kernel import NEAR, SWEEP_C
-from .tolerances import ACCEPT
-
-STEP = 0.05  # largest parameter change per continuation step, relative to the size
+from .tolerances import ACCEPT, PARAM_STEP as STEP  # largest parameter change per step, over the size
 MAX_STEPS = 64  # continuation steps per design at most
 NEWTON = 8  # Newton steps per continuation step at most
 HALVINGS = 4  # a pose the kernel rejects is tried again in 2, 4, ..., 2^HALVINGS steps

@@ -29,8 +29,8 @@ import re
 import casadi as ca
 
 from ..model.mechanism import GROUND
+from .tolerances import NULL_REL, ROUNDING_REL, TINY
 
-NULL_REL = 1e-9  # at rest / same rate, relative to the speed scale of the inputs
 _PATH = {"curvature", "cx", "cy"}
 _IC = {"icx", "icy"}
 
@@ -73,7 +73,7 @@ class Time:
         sym = self.sym
         xy = [sym.val(v) for _, pt in sym.mech.ground for v in pt]
         xy += [sym.val(v) for lk in sym.mech.links for _, pt in lk.points for v in pt]
-        return ca.fmax(ca.mmax(ca.fabs(ca.vertcat(*xy))), 1e-300)
+        return ca.fmax(ca.mmax(ca.fabs(ca.vertcat(*xy))), TINY)
 
 
 # --- names ---
@@ -134,7 +134,7 @@ def _path(sym, point, attr, t):
     if attr == "curvature":
         return _null_unless(moving, cross / (v2 * ca.sqrt(v2)))
     # a finite centre needs a normal acceleration that rounding cannot fake
-    turning = ca.logic_and(moving, ca.fabs(cross) > 1e-12 * ca.sqrt(v2 * (ax * ax + ay * ay)))
+    turning = ca.logic_and(moving, ca.fabs(cross) > ROUNDING_REL * ca.sqrt(v2 * (ax * ax + ay * ay)))
     k = v2 / cross
     return _null_unless(turning, x - k * vy if attr == "cx" else y + k * vx)
 

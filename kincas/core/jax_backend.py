@@ -43,6 +43,7 @@ import numpy as np
 
 from ..errors import ModelError
 from .fast import sweeper_for
+from .tolerances import TRANSLATION_ATOL, TRANSLATION_RTOL
 
 CPU_CHUNK = 1024  # designs per jitted call on a CPU (one chunk per core at a time)
 GPU_BYTES = 1 << 28  # results per jitted call on a GPU, about (designs x poses x (nq + report))
@@ -153,7 +154,7 @@ def _checked(f: ca.Function) -> str:
     want = f.call(args)
     for k, (a, b) in enumerate(zip(got, want)):
         a, b = np.asarray(a, dtype=float), np.asarray(b).ravel(order="F")
-        if a.shape != b.shape or not np.allclose(a, b, rtol=1e-12, atol=1e-14, equal_nan=True):
+        if a.shape != b.shape or not np.allclose(a, b, rtol=TRANSLATION_RTOL, atol=TRANSLATION_ATOL, equal_nan=True):
             raise ModelError(f"backend \"jax\": the translation of {f.name()} differs from casadi "
                              f"in output {k}")
     return src

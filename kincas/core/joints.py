@@ -39,8 +39,9 @@ from ..model.joints import Circle, split_relative
 from ..model.mechanism import GROUND, as_param
 from .turns import turns
 from ..model.names import ANGULAR_ATTRS  # noqa: F401  (cam quantities: angles, kept here too)
+from .tolerances import MESH, NULL_REL
 
-_PRESSURE_FLOOR = 1e-9  # a follower slower than this times the inputs' speed scale stands
+_PRESSURE_FLOOR = NULL_REL  # a follower slower than this times the inputs' speed scale stands
 
 
 # --- equations ---
@@ -298,7 +299,7 @@ def first_pose_problems(model, q, u, p, L) -> list[str]:
     for i, (g, (x1, y1, x2, y2, r1, r2)) in enumerate(zip(gears, raw)):
         d = math.hypot(x2 - x1, y2 - y1)
         need = abs(r2 - r1) if g.internal else r1 + r2
-        if abs(d - need) > 1e-9 * L:
+        if abs(d - need) > MESH * L:
             k = m.gears.index(g)
             what = "|r2 - r1|" if g.internal else "r1 + r2"
             problems.append(f"[[gears]] {g.name or k + 1}: radii: the centres are {d:.10g} apart at the "

@@ -31,16 +31,13 @@ import casadi as ca
 from .group_kernel import GroupFunctions, _max_abs
 from .structure import Structure
 from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size
-from .tolerances import ACCEPT, TOL
+from .tolerances import ACCEPT, CORRECTION, JAC_CHANGE, KERNEL_NEAR as NEAR, MAX_EVALS, TOL  # noqa: F401
 
 RESIDUAL = ACCEPT  # max |g| / L at an accepted pose, as on the careful path
 # The next Newton step's largest entry (radians, or lengths / L), applied before stopping: the
 # largest entry, not a sum, so that rounding in a long chain of groups does not add up past it
 STEP = TOL
-JAC_CHANGE = 0.9  # per group, sum |entries of D^-1 (A_prev^-1 A - I) D| (below 1 keeps det's sign)
-CORRECTION = 0.25  # max per group of ||D^-1 (q - q_pred)||_1: Newton may not wander far from the prediction
-MAX_EVALS = 5  # kN evaluations per pose at most
-NEAR = 1e-8  # kN's step below which the next is negligible where convergence is quadratic
+# JAC_CHANGE, CORRECTION, MAX_EVALS and NEAR (KERNEL_NEAR): kincas/core/tolerances.py
 # From this many groups on, kN and kF call one small function per kind of group
 # (kincas/core/group_kernel.py) instead of being one expression. Measured on 40 chained
 # four-bars: gcc -O3 takes 1.6 s of CPU instead of 6.3, a pose 7.4 us instead of 5.0 (the

@@ -20,6 +20,11 @@ kept.
 >>> q, u, s = locate_singular(model, q, np.array([2.6]), np.zeros(0), m.size(), [1.0])
 >>> round(math.degrees(u[0]), 9)  # |BD| = 1.9 + 3: the law of cosines
 151.193259668
+>>> p = np.zeros(0)
+>>> polish_singular(model, q + 1e-9, u, p, m.size(), [0]) is not None  # at the limit: onto it
+True
+>>> polish_singular(model, q, u - 1e-6, p, m.size(), [0]) is None  # 1e-6 rad before it: not at one
+True
 """
 from __future__ import annotations
 
@@ -28,7 +33,7 @@ import numpy as np
 
 from .assembly import blocks
 from .newton import newton
-from .tolerances import MAX_ITER
+from .tolerances import MAX_ITER, NULL_RESIDUAL, ROUNDING, STEP_SLACK, TINY
 
 
 # --- scaled Jacobians ---
@@ -75,6 +80,62 @@ def _extended(model):
         z = ca.vertcat(sym.q, sym.u, v)
         return _Call(ca.Function("extended", [sym.q, sym.u, sym.p, v, v0], [F, ca.jacobian(F, z)]))
     return model.memo("singular.extended", build)
+
+
+def null_direction(J, rows, cols, cq) -> np.ndarray:
+    """The null direction of the block J[rows, cols] of a column-scaled g_q (J = g_q cq), in
+    unscaled unknowns (the right singular vector of its smallest singular value, times cq):
+    the one null-vector routine of `locate_singular` and `polish_singular`."""
+    return np.linalg.svd(J[np.ix_(rows, cols)])[2][-1] * cq[cols]
+
+
+def _singular_system(model, q, u, p, L, parts, d=None, scales=None):
+    """The extended system of the module's text at the pose (q, u), for the blocks `parts`
+    ((rows, cols) each) singular together, the inputs moving along u + s d (d None: the
+    inputs fixed, no unknown s). Unknowns x = [q, (s), v_1[cols_1], ...]: v_k the null
+    direction of block k, nonzero on its own unknowns only; residuals [g; per block
+    (g_q v_k)[rows_k], v0_k . v_k - 1]. Returns (F, x0, step_scale, res_scale) for the one
+    Newton (kincas/core/newton.py): q scaled per group as every solve scales it, s in the
+    input's unit (radians, or lengths over L), v as the null direction of the column-scaled
+    g_q it is; g over its group's length, g_q v and v0 . v - 1 the pure numbers they are."""
+    nq, ng = model.nq, model.ng
+    f = _extended(model)
+    J, _ = scaled_jacobians(model, q, u, p, L)
+    cq, cu = _scales(model, L)
+    v0s = []
+    for rows, cols in parts:
+        v0 = np.zeros(nq)
+        v0[cols] = null_direction(J, rows, cols, cq)
+        v0s.append(v0)
+    x0 = np.r_[np.asarray(q, float), [0.0] if d is not None else [], *(v[cols] for v, (_, cols) in zip(v0s, parts))]
+    v0s = [v / (v @ v) for v in v0s]
+    u0 = np.array(u, float)
+    eq, qs = model.scales(u0, p) if scales is None else scales
+    ns = 0 if d is None else 1
+    offs = np.cumsum([nq + ns] + [len(cols) for _, cols in parts])
+    step_scale = np.r_[qs, [] if d is None else [1.0 / max(np.abs(d * cu * L).max(initial=0.0), TINY)],
+                       *(cq[cols] for _, cols in parts)]
+    # s moves the inputs by s d: its unit is the step that moves them by one radian, or by L
+    res_scale = np.r_[eq, *(np.ones(len(rows) + 1) for rows, _ in parts)]
+
+    def F(x):
+        uu = u0 if d is None else u0 + x[nq] * d
+        Fs, As = [], []
+        for k, (rows, cols) in enumerate(parts):
+            vv = np.zeros(nq)
+            vv[cols] = x[offs[k]:offs[k + 1]]
+            Fx, JF = f(x[:nq], uu, p, vv, v0s[k])
+            Fx = Fx.ravel()
+            sel = np.r_[np.arange(ng) if k == 0 else np.arange(0), ng + rows, 2 * ng]
+            A = np.zeros((len(sel), x.size))
+            A[:, :nq] = JF[sel, :nq]
+            if d is not None:
+                A[:, nq] = JF[sel, nq:-nq] @ d
+            A[:, offs[k]:offs[k + 1]] = JF[np.ix_(sel, nq + model.nu + cols)]
+            Fs.append(Fx[sel])
+            As.append(A)
+        return np.concatenate(Fs), np.vstack(As)
+    return F, x0, step_scale, res_scale
 
 
 def locate_singular(model, q, u, p, L, direction, max_iter: int = MAX_ITER, group: int | None = None,
@@ -127,30 +188,9 @@ def locate_singular(model, q, u, p, L, direction, max_iter: int = MAX_ITER, grou
     nq, ng = model.nq, model.ng
     if nq == 0:
         return None
-    f = _extended(model)
-    rows, cols = (np.arange(ng), np.arange(nq)) if group is None else blocks(model)[group]
-    J, _ = scaled_jacobians(model, q, u, p, L)
-    cq, cu = _scales(model, L)
-    v = np.zeros(nq)
-    v[cols] = np.linalg.svd(J[np.ix_(rows, cols)])[2][-1] * cq[cols]  # null direction, unscaled
-    v0 = v / (v @ v)
-    d = np.asarray(direction, float)
-    sel = np.r_[np.arange(ng), ng + rows, 2 * ng]  # g, the group's rows of g_q v, v0.v - 1
-    u0 = np.array(u, float)
-    eq, qs = model.scales(u0, p) if scales is None else scales
-    # s moves the inputs by s d: its unit is the step that moves them by one radian, or by L
-    s_unit = 1.0 / max(np.abs(d * cu * L).max(initial=0.0), 1e-300)
-    step_scale = np.r_[qs, s_unit, cq[cols]]
-    res_scale = np.r_[eq, np.ones(len(rows) + 1)]
-
-    def F(x):
-        vv = v.copy()
-        vv[cols] = x[nq + 1:]
-        Fx, JF = f(x[:nq], u0 + x[nq] * d, p, vv, v0)
-        A = np.hstack([JF[:, :nq], JF[:, nq:-nq] @ d[:, None], JF[:, -nq:][:, cols]])
-        return Fx.ravel()[sel], A[sel]
-
-    x0 = np.r_[np.asarray(q, float), 0.0, v[cols]]
+    part = (np.arange(ng), np.arange(nq)) if group is None else blocks(model)[group]
+    u0, d = np.array(u, float), np.asarray(direction, float)
+    F, x0, step_scale, res_scale = _singular_system(model, q, u0, p, L, [part], d, scales)
     if window is not None and max_iter > 2:  # two iterations first: is s near the window?
         seen = []  # the last point F was evaluated at
 
@@ -174,3 +214,39 @@ def locate_singular(model, q, u, p, L, direction, max_iter: int = MAX_ITER, grou
     if not res.ok or not np.all(np.isfinite(res.x)):
         return None
     return qx, u0 + s * d, s
+
+
+def on_step(found) -> bool:
+    """Whether a singular position `found` by `locate_singular` along a step, (q*, u*, s*),
+    lies on that step: s* in [0, 1] to rounding (STEP_SLACK: a position located exactly at
+    either end pose is on it). False for None (nothing found).
+
+    >>> on_step((None, None, 1.0 + 1e-12)), on_step((None, None, -1e-3)), on_step(None)
+    (True, False, False)
+    """
+    return found is not None and -STEP_SLACK <= found[2] <= 1 + STEP_SLACK
+
+
+def polish_singular(model, q, u, p, L, groups, max_iter: int = 30):
+    """The pose at inputs u where each group in `groups` (indices) is exactly singular, from
+    q nearby: the extended system of the module's text with the inputs fixed (no unknown s)
+    and one null direction per group, solved by the one Newton (kincas/core/newton.py).
+    Returns q there, or None where no such pose lies within rounding of q (then q is only
+    near a singular position, and an ordinary pose): g / L below ROUNDING, the null
+    directions' equations below NULL_RESIDUAL.
+
+    See the module's example: from next to the limit it located, polish_singular reaches
+    it; 1e-6 rad of the crank before it, there is none.
+    """
+    if model.nq == 0 or not len(groups):
+        return None
+    bl, ng = blocks(model), model.ng
+    u = np.array(u, float)
+    F, x0, step_scale, res_scale = _singular_system(model, q, u, p, L, [bl[i] for i in groups])
+    res = newton(F, x0, step_scale, res_scale, max_iter=max_iter)
+    if not np.all(np.isfinite(res.x)):
+        return None
+    Fx = F(res.x)[0]
+    if np.abs(Fx[:ng]).max() / L > ROUNDING or np.abs(Fx[ng:]).max() > NULL_RESIDUAL:
+        return None
+    return res.x[:model.nq]

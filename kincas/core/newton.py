@@ -48,6 +48,27 @@ def lsolve(J, b):
     return np.linalg.lstsq(J, b, rcond=None)[0]
 
 
+def stop_rule(r, size, last=np.inf, *, accept: float = ACCEPT, tol: float = TOL):
+    """The one stopping rule of kincas's Newton iterations, elementwise (a batch of poses, or
+    one): (converged, stalled) for a residual `r` (max |g| over its scale), the next Newton
+    step's `size` (largest scaled entry) and the size of the last full step `last`.
+
+    converged: solved (r <= accept) and the next step negligible (<= tol): apply that step
+    and stop, so a solve ends where quadratic convergence puts it (rounding), as the
+    compiled kernel does (kincas/core/kernel.py). stalled: solved and the step no longer
+    shrinks (not below SHRINK times the last one): rounding, magnified by 1 / sigma_min next
+    to a singular position; stop without it. `newton` below, `scatter.newton_starts` and
+    the designs' batched loops (kincas/analysis/design_job.py) all stop by it.
+
+    >>> [bool(b) for b in stop_rule(1e-12, 1e-14)], [bool(b) for b in stop_rule(1e-12, 1e-9, 1e-9)]
+    ([True, False], [False, True])
+    >>> stop_rule(np.array([1e-12, 1e-6]), np.array([1e-14, 1e-14]))[0].tolist()
+    [True, False]
+    """
+    solved = np.asarray(r) <= accept
+    return solved & (np.asarray(size) <= tol), solved & (np.asarray(size) > SHRINK * np.asarray(last))
+
+
 @dataclass
 class NewtonResult:
     """The last iterate `x`, its relative residual, the iterations taken (`max_iter` when it
@@ -106,12 +127,13 @@ def newton(F, x, step_scale, res_scale, *, tol: float = TOL, accept: float = ACC
         if not np.all(np.isfinite(dz)):
             break
         size = np.abs(dz).max(initial=0.0)
-        if r <= accept and size <= tol:
+        converged, stalled = stop_rule(r, size, last, accept=accept, tol=tol)
+        if converged:
             # the compiled kernel's rule (kincas/core/kernel.py): converged when the next
             # step is negligible; apply it, so a solve ends where quadratic convergence puts
             # it (rounding), not at the residual that passed the test
             return NewtonResult(x + dz * step_scale, r, it + 1, True, g, J)
-        if r <= accept and size > SHRINK * last:
+        if stalled:
             # Solved, and the step no longer shrinks. Steps shrink quadratically at a
             # regular root, by half per step onto a double root (a limit), and stop
             # shrinking only once they are rounding magnified by 1 / sigma_min(g_q) (next

@@ -24,6 +24,7 @@ from ..results import wrap_angle
 from .cancel import interruptible
 from .expressions_sym import CONST, SAMPLE, SYMBOLIC
 from .symbolic import is_angular
+from .tolerances import SAME_INPUT, TINY
 
 
 
@@ -128,12 +129,12 @@ class SampledNLP:
         zero = np.zeros(len(self.data))
         value = F(qe, ux, self.P, Ud[i], Udd[i], zero)
         span = float(U[:, 0].max() - U[:, 0].min())
-        periodic = self.m.inputs[0].is_angle and span >= 2 * math.pi - 1e-9
+        periodic = self.m.inputs[0].is_angle and span >= 2 * math.pi - SAME_INPUT
         end = i in (0, len(U) - 1) and not periodic
         rows = [sym.f_res(qe, ux, self.P) / self.L]
         if not end:  # stationary: dE/du = E_q dq/du + E_u with dq/du = -g_q^-1 g_u
             dE = ca.mtimes(ca.jacobian(E, sym.q), -ca.solve(sym.Jq, sym.Ju)) + ca.jacobian(E, sym.u)
-            scale = max(float(np.ptp(vals)), 1e-9 * float(np.abs(vals).max()), 1e-300)
+            scale = max(float(np.ptp(vals)), SAME_INPUT * float(np.abs(vals).max()), TINY)
             rows.append(self.fn(dE)(qe, ux, self.P, Ud[i], Udd[i], zero) / scale)
         lo, hi = ((U[i, 0], U[i, 0]) if end else (-np.inf, np.inf) if periodic
                   else (U[:, 0].min(), U[:, 0].max()))

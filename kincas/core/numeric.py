@@ -36,7 +36,7 @@ from .newton import lsolve as _lsolve, newton as _newton
 from .redundant import decide
 from .structure import Structure
 from .symbolic import Symbolic
-from .tolerances import ACCEPT, MAX_ITER, MAX_STEP, TOL  # noqa: F401  (their old home)
+from .tolerances import ACCEPT, IPOPT_TOL, MAX_ITER, MAX_STEP, REGULARIZE, TOL  # noqa: F401  (their old home)
 
 
 # --- compiled models, one per structure (parameter values stay numeric inputs) ---
@@ -393,11 +393,11 @@ class Model:
         q = x * qscale
         subst = lambda e: ca.substitute(e, sym.q, q)
         P = subst(sym._point_matrix())
-        obj = ca.mtimes(ca.sum1((P - T) ** 2), W) / Ls ** 2 + 1e-6 * ca.sumsqr(x - x0)
+        obj = ca.mtimes(ca.sum1((P - T) ** 2), W) / Ls ** 2 + REGULARIZE * ca.sumsqr(x - x0)
         par = ca.vertcat(sym.u, sym.p, ca.vec(T), W, x0, Ls)
         nlp = {"x": x, "p": par, "f": obj, "g": subst(sym.g) / Ls}
         opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
-                "ipopt.max_iter": 200, "ipopt.tol": 1e-12, "error_on_fail": False}
+                "ipopt.max_iter": 200, "ipopt.tol": IPOPT_TOL, "error_on_fail": False}
         return ca.nlpsol("assemble", "ipopt", nlp, opts), qscale
 
     def memo(self, key, build):

@@ -54,10 +54,9 @@ import numpy as np
 from ..errors import ModelError
 from ..model import mechanism as _mechanism
 from .newton import newton
-from .tolerances import RANK as RANK_TOL, RANK_GAP, SAME_ASSEMBLY
+from .tolerances import GENERIC_MOVE as MOVE, JITTER, RANK as RANK_TOL, RANK_GAP, SAME_ASSEMBLY
 
 TURNS = 12  # an angle input is tried at this many angles around the circle
-MOVE = 0.1  # the step (rad, or times the size) that takes an assembly to a generic point
 MOVE_ITER = 15  # Gauss-Newton iterations after such a step (quadratic from that close)
 ASSEMBLIES = 8  # distinct assemblies examined at most (a wrong mechanism pays for each)
 
@@ -167,7 +166,7 @@ def _starts(m, chain, rng) -> list[np.ndarray]:
     xs = [np.concatenate([chain.model.initial_q(u, chain.p, guess, chain.L), u]) for u in us]
     xs.sort(key=chain.residual)  # stable: the guess first among equals
     # off any special position the guess may sit on (links in line)
-    return [x + 1e-3 * rng.standard_normal(x.size) * chain.unit for x in xs]
+    return [x + JITTER * rng.standard_normal(x.size) * chain.unit for x in xs]
 
 
 def _inputs_move(chain, x, rng) -> np.ndarray | None:

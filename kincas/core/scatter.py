@@ -18,14 +18,16 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-from .tolerances import MAX_STEP, TOL
+from .newton import stop_rule
+from .tolerances import MAX_STEP
 
 
 # --- Newton from every start at once ---
 
 
 def _step_function(model) -> ca.Function:
-    """(q, u, p, eq_scale, q_scale) -> (q after one Newton step, relative residual at q).
+    """(q, u, p, eq_scale, q_scale) -> (q after one Newton step, relative residual at q, the
+    step's largest entry over its unknown's scale before it is shortened).
 
     The step solves g_q dq = -g with the exact Jacobian and is shortened so that no unknown
     moves by more than MAX_STEP of its scale (radians, or its group's length): a trust region
@@ -35,16 +37,19 @@ def _step_function(model) -> ca.Function:
         sym = model.sym
         eq, qs = ca.SX.sym("eq", sym.ng), ca.SX.sym("qs", sym.nq)
         dq = -ca.solve(sym.Jq, sym.g)
-        shrink = ca.fmax(1, ca.mmax(ca.fabs(dq) / (MAX_STEP * qs))) if sym.nq else ca.SX(1)
+        size = ca.mmax(ca.fabs(dq) / qs) if sym.nq else ca.SX(0)
+        shrink = ca.fmax(1, size / MAX_STEP)
         r = ca.mmax(ca.fabs(sym.g / eq)) if sym.nq else ca.SX(0)
-        return ca.Function("newton_step", [sym.q, sym.u, sym.p, eq, qs], [sym.q + dq / shrink, r])
-    return model.memo("scatter.newton_step", build)
+        return ca.Function("newton_step", [sym.q, sym.u, sym.p, eq, qs], [sym.q + dq / shrink, r, size])
+    return model.memo("scatter.newton_step2", build)
 
 
 def newton_starts(model, Q, u, p, iterations: int):
     """Trust-region Newton on every row of Q (starts, n x nq) at once, at inputs u and
     parameters p; returns the iterates and their relative residuals (NaN where a start
-    diverged). A start stops where its residual reaches TOL.
+    diverged). Each start stops by the one rule of kincas/core/newton.py (`stop_rule`):
+    solved and its next step negligible (applied), or solved and its steps no longer
+    shrinking (rounding next to a singular position).
 
     Parameters
     ----------
@@ -67,13 +72,17 @@ def newton_starts(model, Q, u, p, iterations: int):
         return Q, np.full(n, np.abs(model.residual(np.zeros(0), u, p) / eq).max(initial=0.0))
     step = _step_function(model).map(n)
     U, P = np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)
-    X, r = Q.T.copy(), np.full(n, np.inf)
+    X, last, live = Q.T.copy(), np.full(n, np.inf), np.ones(n, dtype=bool)
     for _ in range(iterations):
-        Xn, rn = (np.asarray(a) for a in step(X, U, P, eq, qs))
-        r = rn.ravel()
-        done = ~np.isfinite(r) | (r <= TOL)
-        X = np.where(done, X, Xn)  # a converged start stays where it is
-        if done.all():
+        Xn, r, size = step(X, U, P, eq, qs)
+        Xn, r, size = np.asarray(Xn), np.asarray(r).ravel(), np.asarray(size).ravel()
+        converged, stalled = stop_rule(r, size, last)
+        bad = ~np.isfinite(r)  # (a NaN step, g_q singular, is taken: the start is dropped)
+        X = np.where(live & ~stalled & ~bad, Xn, X)  # a converged start takes its last step
+        last = np.where(size <= MAX_STEP, size, np.inf)  # a full step: the next should shrink
+        live &= ~(converged | stalled | bad)
+        if not live.any():
             break
+    r = np.asarray(step(X, U, P, eq, qs)[1]).ravel()  # at the iterates returned
     r = np.where(np.all(np.isfinite(X), axis=0), r, np.nan)
     return X.T, r

@@ -35,6 +35,7 @@ from ..errors import ModelError
 from ..model.mechanism import GROUND, Mechanism, as_param
 from ..model.names import LINK_Q, POINT_Q, SENS, SLIDE_Q, default_report, is_angular, parse_quantity  # noqa: F401
 from . import joints as _joints
+from .tolerances import JAMMED
 
 # --- quantity names (kincas/model/names.py: parsed without the solver) ---
 
@@ -244,7 +245,7 @@ class Symbolic:
                 if self.ng > self.nq:  # redundant joints: p must keep g_q dq + g_p dp = 0
                     # solvable, or a change of p jams the chain and there is no derivative
                     miss = ca.mmax(ca.fabs(ca.mtimes(self.Jq, dq_dp[:, j]) + gp[:, j]))
-                    rows[i] = ca.if_else(miss > 1e-8 * (1 + ca.mmax(ca.fabs(gp[:, j]))), np.nan, rows[i])
+                    rows[i] = ca.if_else(miss > JAMMED * (1 + ca.mmax(ca.fabs(gp[:, j]))), np.nan, rows[i])
         out = ca.vertcat(*rows) if rows else ca.SX(0, 1)
         args = [self.q, self.u, self.p, ud, udd] + ([uddd] if jerk else [])
         return ca.Function("quantities", args, [out])

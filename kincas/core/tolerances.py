@@ -22,6 +22,52 @@ BRANCH = 1e-8  # |det| of the column-scaled g_q below this: too close to singula
 RANK = 1e-8  # a scaled singular value below this times the largest counts as zero
 RANK_GAP = 1e-4  # g_q's smallest scaled singular value above this times the largest: a regular assembly
 SAME_ASSEMBLY = 1e-6  # assemblies closer than this (scaled) are one (the redundant-joint test)
+
+# --- rounding ---
+TINY = 1e-300  # floor of a scale against division by zero (not a tolerance: any tiny normal number)
+# A quantity below this times its own scale is zero to the rounding of a solve (positions are
+# right to about 1e-12 of the size): the dyad's closed form, a centre of curvature, a ratio
+ROUNDING_REL = 1e-12
+SAME_INPUT = 1e-9  # two input values (radians, or lengths) are one when they agree to this relatively
+STRAIGHT = 1e-9  # a step whose direction turned by less than this (relatively) continues the previous one
+
+# --- singular positions ---
+SIGN_TOL = 1e-8  # a group whose conditioning is below this has no trustworthy sign (mode 0)
+# Newton converges only linearly onto a singular position, and stops about sqrt(TOL) from
+# it: a group conditioned below NEAR_SINGULAR may be *at* one; `polish_singular` decides.
+NEAR_SINGULAR = 1e-5
+# A pose is *at* a singular position when one satisfies g = 0 there to rounding: a pose 1e-12
+# of the input away from a limit is 1e-6 of the size away from the limit's positions.
+ROUNDING = 1e-15
+NULL_RESIDUAL = 1e-10  # polish_singular accepts null directions whose equations are below this
+FLAG_SIGMA = 1e-7  # relative smallest singular value at which a pose *is* singular
+CLASSIFY = 1e-6  # relative singular value below which a singular position's kind is decided
+REACHED = 1e-3  # a located position this fraction of a step away from a pose: the pose all but reached it
+STEP_SLACK = 1e-9  # a position located at s in [-STEP_SLACK, 1 + STEP_SLACK] of a step lies on it
+MIN_ARC_STEP = 1e-12  # following a branch gives up when its step (scaled) halves below this
+WATCH = 0.5  # a group conditioned below this at either end of a step is checked for a crossing
+
+# --- the compiled kernel (kincas/core/kernel.py) ---
+JAC_CHANGE = 0.9  # per group, sum |entries of D^-1 (A_prev^-1 A - I) D| (below 1 keeps det's sign)
+CORRECTION = 0.25  # max per group of ||D^-1 (q - q_pred)||_1: Newton may not wander far from the prediction
+MAX_EVALS = 5  # kN evaluations per pose at most
+KERNEL_NEAR = 1e-8  # kN's step below which the next is negligible where convergence is quadratic
+PARAM_STEP = 0.05  # designs loop: largest parameter change per continuation step, relative to the size
+
+# --- assembly modes and starts ---
+START_CONVERGED = 1e-8  # a start whose relative residual reaches this is worth polishing
+GENERIC_MOVE = 0.1  # the step (rad, or times the size) that takes an assembly to a generic point
+JITTER = 1e-3  # starts moved off special positions (links in line) by this times the size
+
+# --- derived quantities ---
+NULL_REL = 1e-9  # at rest / same rate, relative to the speed scale of the inputs
+JAMMED = 1e-8  # redundant joints: g_q dq + g_p dp missing 0 by this (relatively): p jams the chain
+MESH = 1e-9  # gears whose centre distance misses r1 +- r2 by this times the size do not mesh
+
+# --- the assembly NLP and the JAX translation ---
+IPOPT_TOL = 1e-12
+REGULARIZE = 1e-6  # weight of ||x - x0||^2 in the assembly NLP: the nearest assembly among equals
+TRANSLATION_RTOL, TRANSLATION_ATOL = 1e-12, 1e-14  # JAX against casadi on random arguments
 FREE_LINKS = 6  # links left free by a guess that are tried in several turns (core/guessed.py), at most
 NEARER = 1e-9  # another start's assembly is nearer the guessed points when its cost is below (1 - this) times
 CHOICE_STARTS = 128  # scattered starts finding a guessless sweep's other assemblies (analysis/choice.py)

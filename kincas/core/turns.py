@@ -35,6 +35,7 @@ import numpy as np
 
 from ..model.joints import split_relative
 from ..model.mechanism import GROUND
+from .tolerances import NEARER, ROUNDING_REL, TINY
 
 TURN = 2 * math.pi
 ROOT_TURNS = 3  # a component of relations tied to no input: its first angle tries this many turns either way
@@ -148,7 +149,7 @@ def turns(model, q, u, p, cols=None, known=(), start=True) -> np.ndarray:
             qt[root] += n * TURN
             qt, ft = _propagate(qt, u, usable, fixed | {root})
             miss = _mismatch(qt, u, usable, ft)
-            if best is None or miss < best[0] * (1 - 1e-9) - 1e-12:
+            if best is None or miss < best[0] * (1 - NEARER) - ROUNDING_REL:
                 best = (miss, qt, ft)
         _, q, fixed = best
 
@@ -183,7 +184,7 @@ def _mismatch(q, u, rels, fixed) -> float:
     out = 0.0
     for terms, a, c in rels:
         if all(s is None or s[0] == "u" or s[1] in fixed for s in terms):
-            out += abs(c + sum(ai * _value(s, q, u) for s, ai in zip(terms, a))) / max(np.abs(a).sum(), 1e-300)
+            out += abs(c + sum(ai * _value(s, q, u) for s, ai in zip(terms, a))) / max(np.abs(a).sum(), TINY)
     return out
 
 
