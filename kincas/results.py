@@ -102,25 +102,19 @@ class Pose(Result):
         return f"{self.status}{f' ({self.flag})' if self.flag else ''}; {len(self.values)} values"
 
     def to_pandas(self, length: str = "", angle: str = "rad"):
-        """A one-row DataFrame: the inputs as index, a column per value, `status`, `flag`.
+        """A one-row DataFrame, as `Sweep.to_pandas` gives for a sweep.
 
         Parameters
         ----------
-        length : str
-            The unit of lengths, recorded in `df.attrs["units"]` ("" : none).
-        angle : {"rad", "deg"}
-            Angles, angular rates and derivatives of angles in radians (as held) or degrees.
-
-        Returns
-        -------
-        pandas.DataFrame
+        length, angle : str
+            As for `Sweep.to_pandas`.
 
         Examples
         --------
         >>> Pose({"crank.angle": 0.0}, "ok", None, {"C.x": 1.5}, 0.0).to_pandas("mm").attrs["units"]["C.x"]
         'mm'
         """
-        from .frames import pose_to_pandas, in_angle
+        from .frames import in_angle, pose_to_pandas
         return in_angle(pose_to_pandas(self, length), angle)
 
     def to_xarray(self, length: str = "", angle: str = "rad"):
@@ -128,21 +122,15 @@ class Pose(Result):
 
         Parameters
         ----------
-        length : str
-            The unit of lengths, recorded in each variable's units ("" : none).
-        angle : {"rad", "deg"}
-            Angles, angular rates and derivatives of angles in radians (as held) or degrees.
-
-        Returns
-        -------
-        xarray.Dataset
+        length, angle : str
+            As for `Sweep.to_xarray`.
 
         Examples
         --------
         >>> float(Pose({"crank.angle": 0.0}, "ok", None, {"C.x": 1.5}, 0.0).to_xarray()["C.x"][0])
         1.5
         """
-        from .frames import pose_to_xarray, in_angle
+        from .frames import in_angle, pose_to_xarray
         return in_angle(pose_to_xarray(self, length), angle)
 
 
@@ -254,10 +242,7 @@ class Sweep(Result):
 
         Examples
         --------
-        >>> import numpy as np
-        >>> Sweep(inputs={"t": np.zeros(2)}, rates={}, accelerations={}, status=["ok", "no assembly"],
-        ...       flags=[None, None], values={"C.x": np.array([1.0, np.nan])}, q=np.zeros((2, 1)),
-        ...       residual=np.zeros(2), iterations=np.zeros(2, int), unknowns=["q"], size=1.0).summary()
+        >>> z = np.zeros(2); Sweep({"t": z}, {}, {}, ["ok", "no"], [None] * 2, {"C.x": z}, z, z, z, [], 1).summary()
         '2 poses, 1 solved, 1 not solved; inputs t; reported C.x'
         """
         return f"{self._counts()}; inputs {_names(self.inputs)}; reported {_names(self.values)}"
@@ -316,10 +301,6 @@ class Sweep(Result):
         angle : {"rad", "deg"}
             Angles, angular rates and derivatives of angles in radians (as held) or degrees.
 
-        Returns
-        -------
-        pandas.DataFrame
-
         Examples
         --------
         >>> import kincas
@@ -339,22 +320,15 @@ class Sweep(Result):
 
         Parameters
         ----------
-        length : str
-            The unit of lengths, recorded in the units ("" : none).
-        angle : {"rad", "deg"}
-            Angles, angular rates and derivatives of angles in radians (as held) or degrees.
-
-        Returns
-        -------
-        xarray.Dataset
+        length, angle : str
+            As for `to_pandas`.
 
         Examples
         --------
         >>> import kincas
         >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
         ...                      inputs=[kincas.Input.angle("crank")])
-        >>> sw = kincas.sweep(m, {"crank.angle": [0.0, 1.5707963267948966]}, report=["A.x", "A.y"])
-        >>> ds = sw.to_xarray("m")
+        >>> ds = kincas.sweep(m, {"crank.angle": [0.0, 1.5707963267948966]}, report=["A.x"]).to_xarray("m")
         >>> ds["A.x"].attrs["units"], ds.sizes["pose"]
         ('m', 2)
         """
