@@ -153,7 +153,7 @@ def tolerance_part(samples: int, one_worker_samples: int, lines: list[str]):
     m, inputs = sc.mechanism, sc.study.inputs
     n_pose = len(next(iter(inputs.values())))
     report = ["C.x", "C.y", "rocker.angle"]
-    analyse(m, inputs, STD, report, samples=200)  # compiled loop loaded
+    analyse(m, inputs, STD, report, draws=200)  # compiled loop loaded
     lines += ["\n## Tolerance Monte Carlo",
               f"`analyse` (the `kincas tolerance` path) of {SCENE.name}, std 0.05 mm on a2..a5, "
               f"report {report}, {n_pose} poses.\n",
@@ -162,7 +162,7 @@ def tolerance_part(samples: int, one_worker_samples: int, lines: list[str]):
     out = {}
     for n, w in ((samples, None), (one_worker_samples, 1)):
         before = load_avg().split()[-3]
-        wall, cpu, r = timed(lambda: analyse(m, inputs, STD, report, samples=n, workers=w))
+        wall, cpu, r = timed(lambda: analyse(m, inputs, STD, report, draws=n, workers=w))
         out[w] = wall
         if w == 1:
             out["cpu"] = cpu * samples / n  # scaled to `samples` when fewer were run
@@ -170,7 +170,7 @@ def tolerance_part(samples: int, one_worker_samples: int, lines: list[str]):
                      f"{int(r.failed.max())} | {before} |")
         print(f"tolerance: {n:,} samples x {n_pose} poses on {w or 'all'} workers: {wall:.2f} s "
               f"(CPU {cpu:.2f} s); {load_avg()}")
-    f = gil_free_share(lambda: analyse(m, inputs, STD, report, samples=20_000, workers=1))
+    f = gil_free_share(lambda: analyse(m, inputs, STD, report, draws=20_000, workers=1))
     cpu1 = out["cpu"]
     lines.append(f"\n{samples:,} samples x {n_pose} poses in **{out[None]:.2f} s** (target: under 10 s), "
                  f"{cpu1:.1f} s of CPU time on one worker. There {f:.0%} of the wall time is spent in "

@@ -110,7 +110,7 @@ def careful_for(model, p, L, m, U):
 
 
 def per_pose(name, m, report, closed, n, repeats, lines):
-    model, p, L = kincas.compile(m), np.array([v for _, v in m.parameters]), m.size()
+    model, p, L = kincas.model_of(m), np.array([v for _, v in m.parameters]), m.size()
     th = np.linspace(0, 2 * np.pi, n)
     U = th[:, None]
     fs = FastSweeper(model, report, compile=True)
@@ -162,7 +162,7 @@ import numpy as np, kincas
 from bench_sweep import FOURBAR, FOURBAR_REPORT
 from kincas.core.fast import FastSweeper
 t1 = time.perf_counter()
-fs = FastSweeper(kincas.compile(FOURBAR), FOURBAR_REPORT, compile=True)
+fs = FastSweeper(kincas.model_of(FOURBAR), FOURBAR_REPORT, compile=True)
 fs.backend.compiled(1)
 t2 = time.perf_counter()
 print(json.dumps({{"import": t1 - t0, "ready": t2 - t1, "cached": fs.backend.library.cached,
@@ -231,7 +231,7 @@ from kincas.core.fast import sweeper_for
 import kincas
 sc = load({scene!r})
 m, st = sc.mechanism, sc.study
-model = kincas.compile(m)
+model = kincas.model_of(m)
 p, L = np.array([v for _, v in m.parameters]), m.size()
 U = np.stack([st.inputs[i.key] for i in m.inputs], axis=1)
 g = {{k: (m.value(x), m.value(y)) for k, (x, y) in m.guess}}

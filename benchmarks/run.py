@@ -164,7 +164,7 @@ def study_growth(cfg, log) -> dict:
         case = cases.chain(n, cfg["chain_poses"])
         P, V = closed_form.solve_numpy(case)
         t0 = time.perf_counter()
-        kincas.compile(cases.to_kincas(case))  # a new structure: the symbolic model is built here
+        kincas.model_of(cases.to_kincas(case))  # a new structure: the symbolic model is built here
         res = out[n] = {"compile": time.perf_counter() - t0, "case": case}
         for lb, prep in tools:
             t = time_tool(lambda: prep(case), cfg["repeats"], budget=10.0)

@@ -17,7 +17,7 @@ from . import _aliases
 from .errors import KincasError, ModelError, SceneError
 from .model import Input, Link, Load, Mechanism, Param, Slide
 from .results import Pose, Sweep
-from .core.numeric import compile, model_of
+from .core.numeric import model_of
 from .analysis.sweeps import solve, sweep
 from . import views
 from .model import mechanism as _mechanism
@@ -34,11 +34,17 @@ Sweep._repr_html_ = views.sweep_html_display
 
 
 def __getattr__(name):
+    from .result_base import RENAMED, TYPES, result_type
+    if name in TYPES or name in RENAMED:  # kincas.Study, kincas.Range, ... (old names warned)
+        return result_type(name)
+    if name == "compile":  # 0.1's name of model_of: it compiles nothing, shadows the builtin
+        from ._deprecated import renamed  # and is not sweep(compile=...), which does compile
+        return renamed(globals(), {"compile": "model_of"}, "kincas")(name)
     return _aliases.attribute(name)
 
 
 __all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "sweep",
-           "sweep_designs", "study", "model_of", "compile",
+           "sweep_designs", "study", "model_of",
            "sensitivities", "analyse", "optimize", "find_modes", "input_range",
            "Pose", "Sweep", "KincasError", "ModelError", "SceneError"]
 __version__ = "0.1.0"

@@ -2,10 +2,12 @@
 
 Scripts written against the first README import `kincas.modes`, `kincas.plot`, ...; those
 modules now live in subpackages. A meta-path finder resolves the old names lazily, so
-`import kincas` stays cheap and `import kincas.modes` still works. The presentation modules
-that left `kincas/cli` for `kincas/views` (`kincas.cli.plot`, `kincas.cli.svg`,
-`kincas.notebook`, ...) still import under their old paths for one release, with a
-DeprecationWarning naming the new one.
+`import kincas` stays cheap and `import kincas.modes` still works, for one more release: it
+warns (DeprecationWarning) and names the new path. `kincas.optimize` (the function itself) and
+`kincas.scene`, `kincas.plot`, `kincas.outputs` (the README's entry points for scenes and
+drawings) stay quiet. The presentation modules that left `kincas/cli` for `kincas/views`
+(`kincas.cli.plot`, `kincas.cli.svg`, `kincas.notebook`, ...) still import under their old
+paths for one release, with a DeprecationWarning naming the new one.
 """
 from __future__ import annotations
 
@@ -25,6 +27,7 @@ OLD = {
     "checks": "synthesis.checks", "scene": "cli.scene", "outputs": "cli.outputs",
     "plot": "views.plot", "progress": "cli.progress",
 }
+QUIET = {"optimize", "scene", "plot", "outputs"}  # current entry points: no warning
 # paths of this release's predecessor: warned (DeprecationWarning), removed in the next release
 MOVED = {f"cli.{m}": f"views.{m}" for m in ("plot", "svg", "picture", "draw_joints",
                                            "draw_geometry", "dxf", "html", "mapplot", "numbers",
@@ -55,7 +58,8 @@ class _Finder(importlib.abc.MetaPathFinder):
             return None
         if tail in MOVED:
             return importlib.util.spec_from_loader(fullname, _Loader(f"kincas.{MOVED[tail]}", fullname))
-        return importlib.util.spec_from_loader(fullname, _Loader(f"kincas.{OLD[tail]}"))
+        old = None if tail in QUIET else fullname
+        return importlib.util.spec_from_loader(fullname, _Loader(f"kincas.{OLD[tail]}", old))
 
 
 def install() -> None:
@@ -75,6 +79,9 @@ def attribute(name: str):
     if name in FUNCTIONS:
         return getattr(importlib.import_module(f"kincas.{FUNCTIONS[name]}"), name)
     if name in OLD:
+        if name not in QUIET:
+            warnings.warn(f"kincas.{name} moved to kincas.{OLD[name]}; the old path goes in the "
+                          f"next release", DeprecationWarning, stacklevel=3)  # kincas.__getattr__'s caller
         return importlib.import_module(f"kincas.{OLD[name]}")
     if name in MOVED:
         return importlib.import_module(f"kincas.{name}")  # through the finder: warned

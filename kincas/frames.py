@@ -25,6 +25,8 @@ import importlib
 
 import numpy as np
 
+from .result_base import Result
+
 _ORDER = {"x": 0, "y": 0, "s": 0, "angle": 0, "vx": 1, "vy": 1, "v": 1, "omega": 1,
           "ax": 2, "ay": 2, "a": 2, "alpha": 2, "jx": 3, "jy": 3, "jerk": 3}
 
@@ -72,29 +74,48 @@ def _index(pd, inputs: dict, n: int):
 
 
 def sweep_to_pandas(sw, length: str = ""):
+    return _poses_frame(sw.inputs, sw.values, sw.status, sw.flags, length)
+
+
+def _poses_frame(inputs: dict, values: dict, status, flags, length: str):
     pd = require("pandas")
     # a reported quantity that is also an input (a driven link's angle) is the index, as the
     # input was given (unwrapped), not a second column of that name (as in to_xarray)
-    cols = {k: np.asarray(v, float) for k, v in sw.values.items() if k not in sw.inputs}
-    cols["status"] = sw.status.astype(str)
-    cols["flag"] = pd.array([f if f else None for f in sw.flags], dtype="object")
-    df = pd.DataFrame(cols, index=_index(pd, sw.inputs, len(sw)))
-    df.attrs["units"] = {k: unit_of(k, length) for k in [*sw.inputs, *sw.values]}
+    cols = {k: np.asarray(v, float) for k, v in values.items() if k not in inputs}
+    cols["status"] = np.asarray(status).astype(str)
+    cols["flag"] = pd.array([f if f else None for f in flags], dtype="object")
+    df = pd.DataFrame(cols, index=_index(pd, inputs, len(cols["status"])))
+    df.attrs["units"] = {k: unit_of(k, length) for k in [*inputs, *values]}
     return df
 
 
 def sweep_to_xarray(sw, length: str = ""):
+    return _poses_dataset(sw.inputs, sw.values, sw.status, sw.flags, sw.residual, length,
+                          {"size": float(sw.size)})
+
+
+def _poses_dataset(inputs: dict, values: dict, status, flags, residual, length: str, attrs=None):
     xr = require("xarray")
-    coords = {k: ("pose", np.asarray(v, float), {"units": unit_of(k, length)})
-              for k, v in sw.inputs.items()}
-    data = {k: ("pose", np.asarray(v, float), {"units": unit_of(k, length)})
-            for k, v in sw.values.items() if k not in sw.inputs}
-    data["status"] = ("pose", sw.status.astype(str))
-    data["flag"] = ("pose", np.array([f or "" for f in sw.flags], dtype=str))
-    data["ok"] = ("pose", sw.ok)
-    data["residual"] = ("pose", np.asarray(sw.residual, float),
+    coords = {k: ("pose", np.atleast_1d(np.asarray(v, float)), {"units": unit_of(k, length)})
+              for k, v in inputs.items()}
+    data = {k: ("pose", np.atleast_1d(np.asarray(v, float)), {"units": unit_of(k, length)})
+            for k, v in values.items() if k not in inputs}
+    status = np.asarray(status).astype(str)
+    data["status"] = ("pose", status)
+    data["flag"] = ("pose", np.array([f or "" for f in flags], dtype=str))
+    data["ok"] = ("pose", status == "ok")
+    data["residual"] = ("pose", np.atleast_1d(np.asarray(residual, float)),
                         {"description": "loop-closure residual relative to the size"})
-    return xr.Dataset(data, coords=coords, attrs={"size": float(sw.size)})
+    return xr.Dataset(data, coords=coords, attrs=attrs or {})
+
+
+def pose_to_pandas(pose, length: str = ""):
+    return _poses_frame({k: [v] for k, v in pose.inputs.items()},
+                        {k: [v] for k, v in pose.values.items()}, [pose.status], [pose.flag], length)
+
+
+def pose_to_xarray(pose, length: str = ""):
+    return _poses_dataset(pose.inputs, pose.values, [pose.status], [pose.flag], [pose.residual], length)
 
 
 # --- tolerance analyses ---
@@ -195,12 +216,165 @@ def optimize_to_xarray(r, length: str = ""):
 # --- a list of modes that converts like the other results ---
 
 
-class Modes(list):
-    """The assembly modes `find_modes` returns: a list of `Mode`, with `to_pandas()` (a row
-    per mode: points, angles, residual, orientation, from_guess) and `to_xarray()`."""
+class Modes(list, Result):
+    """The assembly modes `find_modes` returns: a list of `Mode` (indexed, iterated and
+    printed as a list), with `to_pandas()` (a row per mode: points, angles, residual,
+    orientation, from_guess), `to_xarray()`, `ok` (some mode was found) and `summary()`."""
 
-    def to_pandas(self, length: str = ""):
-        return modes_to_pandas(self, length)
+    @property
+    def ok(self) -> bool:
+        return len(self) > 0
 
-    def to_xarray(self, length: str = ""):
-        return modes_to_xarray(self, length)
+    def summary(self) -> str:
+        return f"{len(self)} assembly modes" + ("" if self else " (none found)")
+
+    def to_pandas(self, length: str = "", angle: str = "rad"):
+        return in_angle(modes_to_pandas(self, length), angle)
+
+    def to_xarray(self, length: str = "", angle: str = "rad"):
+        return in_angle(modes_to_xarray(self, length), angle)
+
+
+# --- designs' sweeps (design x pose) and studies (one row per design) ---
+
+
+def designs_to_pandas(r, length: str = ""):
+    pd = require("pandas")
+    nd, npose = r.code.shape
+    index = pd.MultiIndex.from_product([range(nd), range(npose)], names=["design", "pose"])
+    cols = {n: np.repeat(r.params[:, j], npose) for j, n in enumerate(r.names)}
+    cols.update({k: np.tile(np.asarray(v, float), nd) for k, v in r.inputs.items()})
+    cols.update({k: np.asarray(v, float).ravel() for k, v in r.values.items() if k not in r.inputs})
+    cols["status"] = r.status.astype(str).ravel()
+    df = pd.DataFrame(cols, index=index)
+    df.attrs["units"] = {k: unit_of(k, length) for k in [*r.names, *r.inputs, *r.values]}
+    return df
+
+
+def designs_to_xarray(r, length: str = ""):
+    xr = require("xarray")
+    data = {n: (("design", "pose"), v, {"units": unit_of(n, length)}) for n, v in r.values.items()}
+    data["status"] = (("design", "pose"), r.status.astype(str))
+    coords = {n: ("design", r.params[:, j], {"units": unit_of(n, length)}) for j, n in enumerate(r.names)}
+    coords.update({k: ("pose", v, {"units": unit_of(k, length)}) for k, v in r.inputs.items()})
+    return xr.Dataset(data, coords=coords)
+
+
+def study_to_pandas(r, length: str = ""):
+    pd = require("pandas")
+    df = pd.DataFrame(r.columns())
+    df.index.name = "design"
+    df.attrs["units"] = {n: unit_of(n, length) for n in r.names}  # the report's expressions: free
+    return df
+
+
+def study_to_xarray(r, length: str = ""):
+    xr = require("xarray")
+    data = {k: ("design", np.asarray(v, dtype=str if k == "status" else float),
+                {"units": unit_of(k, length)} if k in r.names else {})
+            for k, v in r.columns().items()}
+    return xr.Dataset(data, coords={"design": np.arange(len(r.status))})
+
+
+# --- a range of motion, sensitivities ---
+
+
+def range_to_pandas(r, length: str = ""):
+    pd = require("pandas")
+    df = pd.DataFrame({"kind": [k for k, _ in r.limits], "value": [float(v) for _, v in r.limits]},
+                      index=pd.RangeIndex(len(r.limits), name="limit"))
+    df.attrs.update(key=r.key, low=float(r.low), high=float(r.high), full_turn=bool(r.full_turn),
+                    start=float(r.start), units={r.key: unit_of(r.key, length)})
+    return df
+
+
+def range_to_xarray(r, length: str = ""):
+    xr = require("xarray")
+    data = {"kind": ("limit", np.array([k for k, _ in r.limits], dtype=str)),
+            "value": ("limit", np.array([v for _, v in r.limits], dtype=float),
+                      {"units": unit_of(r.key, length)})}
+    attrs = {"key": r.key, "low": float(r.low), "high": float(r.high),
+             "full_turn": int(r.full_turn), "start": float(r.start)}
+    return xr.Dataset(data, attrs=attrs)
+
+
+def sensitivities_to_pandas(s, length: str = ""):
+    sw = s.sweep
+    return _poses_frame(sw.inputs, {n: s[n] for n in s}, sw.status, sw.flags, length)
+
+
+def sensitivities_to_xarray(s, length: str = ""):
+    sw = s.sweep
+    return _poses_dataset(sw.inputs, {n: s[n] for n in s}, sw.status, sw.flags, sw.residual, length)
+
+
+def multistart_to_pandas(r, length: str = ""):
+    pd = require("pandas")
+    cols = {f"start {n}": np.asarray(r.starts)[:, j] for j, n in enumerate(r.names)}
+    cols["objective"] = [float(o.objective) for o in r.results]
+    cols["ok"] = [bool(o.ok) for o in r.results]
+    cols["status"] = [str(o.status) for o in r.results]
+    for n in r.names:
+        cols[n] = [float(o.varied.get(n, np.nan)) for o in r.results]
+    df = pd.DataFrame(cols, index=pd.RangeIndex(len(r.results), name="start"))
+    df.attrs["units"] = {n: unit_of(n, length) for n in r.names}
+    return df
+
+
+# --- angles in degrees on request (every result's `angle="deg"`) ---
+
+
+def _angle_factor(unit: str, angle: str) -> float:
+    """What turns a value of `unit` (as recorded, radians) into `angle`'s unit: 180/pi for a
+    unit whose numerator is radians (rad, rad/s, rad/mm), 1 otherwise."""
+    return 180.0 / np.pi if angle == "deg" and unit.split("/")[0] == "rad" else 1.0
+
+
+def _deg_unit(unit: str) -> str:
+    return "deg" + unit[3:] if unit.split("/")[0] == "rad" else unit
+
+
+def in_angle(table, angle: str = "rad"):
+    """`table` (a DataFrame or Dataset made above, in radians) with its angles, angular rates
+    and derivatives of angles in `angle` ("rad" : as it is, "deg" : degrees), units renamed.
+
+    >>> import pandas as pd
+    >>> df = pd.DataFrame({"L.angle": [np.pi]}); df.attrs["units"] = {"L.angle": "rad"}
+    >>> t = in_angle(df, "deg"); float(t["L.angle"][0]), t.attrs["units"]
+    (180.0, {'L.angle': 'deg'})
+    """
+    if angle not in ("rad", "deg"):
+        from .errors import ModelError
+        raise ModelError(f"angle: expected 'rad' or 'deg', got {angle!r}")
+    if angle == "rad":
+        return table
+    table = table.copy()
+    if hasattr(table, "data_vars"):  # an xarray Dataset: units on each variable and coordinate
+        for name in [*table.data_vars, *table.coords]:
+            unit = table[name].attrs.get("units", "")
+            k = _angle_factor(unit, angle)
+            if k != 1.0:
+                table[name] = table[name] * k
+                table[name].attrs["units"] = _deg_unit(unit)
+        if "units" in table.coords and "quantity" in table.dims:  # per quantity (tolerances)
+            k = np.array([_angle_factor(str(u), angle) for u in table["units"].values])
+            for name in table.data_vars:
+                if "quantity" in table[name].dims and table[name].dtype.kind == "f":
+                    table[name] = table[name] * table["units"].copy(data=k)
+            table = table.assign_coords(units=("quantity", [_deg_unit(str(u)) for u in table["units"].values]))
+        return table
+    units = dict(table.attrs.get("units", {}))  # a DataFrame: units by column (or index) name
+    for col in table.columns:
+        key = next((col[len(p):] for p in ("std ", "mc ") if str(col).startswith(p)), col)
+        k = _angle_factor(units.get(key, ""), angle)
+        if k != 1.0:
+            table[col] = table[col] * k
+    names = list(table.index.names)
+    if any(_angle_factor(units.get(n, ""), angle) != 1.0 for n in names if n):
+        levels = [table.index.get_level_values(i) * _angle_factor(units.get(n, ""), angle)
+                  for i, n in enumerate(names)]
+        import pandas as pd
+        table.index = (pd.MultiIndex.from_arrays(levels, names=names) if len(names) > 1
+                       else pd.Index(levels[0], name=names[0]))
+    table.attrs["units"] = {n: _deg_unit(u) for n, u in units.items()}
+    return table

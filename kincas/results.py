@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .result_base import Result
+
 
 def wrap_angle(a: np.ndarray) -> np.ndarray:
     """Wrap radians to (-pi, pi]."""
@@ -30,7 +32,7 @@ def wrap_angle(a: np.ndarray) -> np.ndarray:
 
 
 @dataclass(repr=False)
-class Pose:
+class Pose(Result):
     """One solved (or unsolved) pose: `pose["C.x"]` is a float (NaN when not solved).
 
     A pose is a container of names, as a `Sweep` is (inputs, then reported quantities).
@@ -89,9 +91,51 @@ class Pose:
         flag = f" ({self.flag})" if self.flag else ""
         return f"<Pose {at}: {self.status}{flag}; {len(self.values)} values>"
 
+    def summary(self) -> str:
+        """The status, and how many values (the `repr`'s body).
+
+        Examples
+        --------
+        >>> Pose({}, "no assembly", None, {"C.x": float("nan")}, float("inf")).summary()
+        'no assembly; 1 values'
+        """
+        return f"{self.status}{f' ({self.flag})' if self.flag else ''}; {len(self.values)} values"
+
+    def to_pandas(self, length: str = "", angle: str = "rad"):
+        """A one-row DataFrame, as `Sweep.to_pandas` gives for a sweep.
+
+        Parameters
+        ----------
+        length, angle : str
+            As for `Sweep.to_pandas`.
+
+        Examples
+        --------
+        >>> Pose({"crank.angle": 0.0}, "ok", None, {"C.x": 1.5}, 0.0).to_pandas("mm").attrs["units"]["C.x"]
+        'mm'
+        """
+        from .frames import in_angle, pose_to_pandas
+        return in_angle(pose_to_pandas(self, length), angle)
+
+    def to_xarray(self, length: str = "", angle: str = "rad"):
+        """A Dataset along `pose` (of length 1), as `Sweep.to_xarray` gives.
+
+        Parameters
+        ----------
+        length, angle : str
+            As for `Sweep.to_xarray`.
+
+        Examples
+        --------
+        >>> float(Pose({"crank.angle": 0.0}, "ok", None, {"C.x": 1.5}, 0.0).to_xarray()["C.x"][0])
+        1.5
+        """
+        from .frames import in_angle, pose_to_xarray
+        return in_angle(pose_to_xarray(self, length), angle)
+
 
 @dataclass(repr=False)
-class Sweep:
+class Sweep(Result):
     """Poses over a sweep of the inputs: `sweep["C.x"]` is an array with one entry per pose.
 
     A sweep is a container of names (the inputs', then the reported quantities'): `"C.x" in
@@ -189,10 +233,20 @@ class Sweep:
         return list(self)
 
     def __repr__(self) -> str:
-        return f"<Sweep: {self._counts()}; inputs {_names(self.inputs)}; reported {_names(self.values)}>"
+        return f"<Sweep: {self.summary()}>"
 
     def __str__(self) -> str:
         return "\n".join(self.summary_lines())
+
+    def summary(self) -> str:
+        """Poses solved and not, the inputs and the reported quantities (the `repr`'s body).
+
+        Examples
+        --------
+        >>> z = np.zeros(2); Sweep({"t": z}, {}, {}, ["ok", "no"], [None] * 2, {"C.x": z}, z, z, z, [], 1).summary()
+        '2 poses, 1 solved, 1 not solved; inputs t; reported C.x'
+        """
+        return f"{self._counts()}; inputs {_names(self.inputs)}; reported {_names(self.values)}"
 
     def _counts(self) -> str:
         n, good = len(self), int(self.ok.sum())
@@ -235,7 +289,7 @@ class Sweep:
         return out
 
     # --- in the data tools (extra kincas[data]) ---
-    def to_pandas(self, length: str = ""):
+    def to_pandas(self, length: str = "", angle: str = "rad"):
         """A DataFrame: one row per pose, the inputs as index, a column per quantity, then
         `status` and `flag`; units (radians, and `length` if named) in `df.attrs["units"]`.
         A reported quantity that is also an input (the driven link's angle) is the index, as
@@ -245,10 +299,8 @@ class Sweep:
         ----------
         length : str
             The unit of lengths, recorded in the units ("" : none).
-
-        Returns
-        -------
-        pandas.DataFrame
+        angle : {"rad", "deg"}
+            Angles, angular rates and derivatives of angles in radians (as held) or degrees.
 
         Examples
         --------
@@ -260,34 +312,29 @@ class Sweep:
         >>> list(df.columns), df.attrs["units"]["A.x"]
         (['A.x', 'A.y', 'status', 'flag'], 'm')
         """
-        from .frames import sweep_to_pandas
-        return sweep_to_pandas(self, length)
+        from .frames import sweep_to_pandas, in_angle
+        return in_angle(sweep_to_pandas(self, length), angle)
 
-    def to_xarray(self, length: str = ""):
+    def to_xarray(self, length: str = "", angle: str = "rad"):
         """A Dataset along the dimension `pose`: inputs as coordinates, each quantity a variable
         with `attrs["units"]`, and `status`, `flag`, `ok`, `residual`.
 
         Parameters
         ----------
-        length : str
-            The unit of lengths, recorded in the units ("" : none).
-
-        Returns
-        -------
-        xarray.Dataset
+        length, angle : str
+            As for `to_pandas`.
 
         Examples
         --------
         >>> import kincas
         >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
         ...                      inputs=[kincas.Input.angle("crank")])
-        >>> sw = kincas.sweep(m, {"crank.angle": [0.0, 1.5707963267948966]}, report=["A.x", "A.y"])
-        >>> ds = sw.to_xarray("m")
+        >>> ds = kincas.sweep(m, {"crank.angle": [0.0, 1.5707963267948966]}, report=["A.x"]).to_xarray("m")
         >>> ds["A.x"].attrs["units"], ds.sizes["pose"]
         ('m', 2)
         """
-        from .frames import sweep_to_xarray
-        return sweep_to_xarray(self, length)
+        from .frames import sweep_to_xarray, in_angle
+        return in_angle(sweep_to_xarray(self, length), angle)
 
     @property
     def ok(self) -> np.ndarray:

@@ -66,7 +66,7 @@ def test_the_usual_names_are_exported():
     for name in ("sensitivities", "analyse", "optimize", "find_modes", "input_range"):
         assert name in kincas.__all__
     import kincas.optimize as old_path  # the 0.1 module path still works, and stays callable
-    assert hasattr(old_path, "OptimizeResult") and callable(kincas.optimize)
+    assert hasattr(old_path, "Optimization") and callable(kincas.optimize)
     modes = kincas.find_modes(fourbar(), {"crank.angle": 0.5}, starts=32)
     assert len(modes) == 2  # a four-bar assembles two ways
 

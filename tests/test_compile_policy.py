@@ -54,7 +54,7 @@ def poses(monkeypatch):  # compile after 1,000 poses (20,000 by default): quick 
 
 def test_repeated_short_sweeps_compile_in_the_background(cache, poses):
     m, th = fourbar(3.5, "policy_b1"), np.linspace(0, 2 * np.pi, 360)
-    fast = sweeper_for(kincas.compile(m), REPORT, None)
+    fast = sweeper_for(kincas.model_of(m), REPORT, None)
     for _ in range(2):  # 720 poses so far: nothing compiled
         check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.5)
     assert fast.backend.lib is None and fast.backend._thread is None
@@ -69,7 +69,7 @@ def test_repeated_short_sweeps_compile_in_the_background(cache, poses):
 
 def test_sweeps_from_threads_while_the_kernel_compiles(cache, poses):
     m, th = fourbar(3.45, "policy_b2"), np.linspace(0, 2 * np.pi, 500)
-    fast = sweeper_for(kincas.compile(m), REPORT, None)
+    fast = sweeper_for(kincas.model_of(m), REPORT, None)
     kincas.sweep(m, {"crank.angle": th}, report=list(REPORT))
     errors = []
 
@@ -94,11 +94,11 @@ def test_compile_false_and_no_compile_never_compile(cache, monkeypatch, poses):
     m, th = fourbar(3.4, "policy_b3"), np.linspace(0, 1, 400)
     for _ in range(3):
         check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT), compile=False), th, 3.4)
-    assert sweeper_for(kincas.compile(m), REPORT, False).backend._thread is None
+    assert sweeper_for(kincas.model_of(m), REPORT, False).backend._thread is None
     monkeypatch.setenv("KINCAS_NO_COMPILE", "1")
     for _ in range(3):
         check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.4)
-    assert sweeper_for(kincas.compile(m), REPORT, None).backend._thread is None
+    assert sweeper_for(kincas.model_of(m), REPORT, None).backend._thread is None
     assert not list(cache.glob("*.so"))
 
 

@@ -35,7 +35,7 @@ def fourbar(a=1.0, b=3.5, c=3.0, d=4.0, s=1.0, guess=(3.6, 2.9)):
 
 def assert_residuals(sw, tol=1e-12):
     """Every solved pose really closes its loops (checked again, independently of the solver)."""
-    model = kincas.compile(MECH_OF[id(sw)]) if id(sw) in MECH_OF else None
+    model = kincas.model_of(MECH_OF[id(sw)]) if id(sw) in MECH_OF else None
     assert np.all(sw.residual[sw.ok] <= tol), sw.residual[sw.ok].max()
     if model is not None:
         m = MECH_OF[id(sw)]

@@ -65,7 +65,7 @@ def test_two_inputs_are_a_multiindex():
 
 def test_tolerance_to_pandas_and_xarray():
     r = kincas.analyse(fourbar(), {"crank.angle": np.linspace(0, 1, 4)}, std={"a": 0.01},
-                       report=["B.x"], samples=200, seed=1)
+                       report=["B.x"], draws=200, seed=1)
     df = r.to_pandas()
     assert len(df) == 4 and df.index.name == "crank.angle"
     # B.x = a cos t: first-order std = 0.01 |cos t|

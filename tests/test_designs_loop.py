@@ -115,8 +115,8 @@ def test_monte_carlo_chunks_on_two_threads_equal_one_thread_and_a_numpy_referenc
     m = fourbar()
     th = np.linspace(0, 2 * np.pi, 37)
     std = {"a2": 0.05, "a4": 0.05, "a5": 0.05}
-    one = analyse(m, {"crank.angle": th}, std, ["C.y", "rocker.angle"], samples=2100, seed=5, workers=1)
-    two = analyse(m, {"crank.angle": th}, std, ["C.y", "rocker.angle"], samples=2100, seed=5, workers=2)
+    one = analyse(m, {"crank.angle": th}, std, ["C.y", "rocker.angle"], draws=2100, seed=5, workers=1)
+    two = analyse(m, {"crank.angle": th}, std, ["C.y", "rocker.angle"], draws=2100, seed=5, workers=2)
     for q in ("C.y", "rocker.angle"):
         assert np.array_equal(one.monte_carlo[q], two.monte_carlo[q])
         assert np.array_equal(one.mean_shift[q], two.mean_shift[q])

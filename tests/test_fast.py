@@ -66,7 +66,7 @@ FOURBAR_REPORT = ["C.x", "C.y", "C.vx", "C.vy", "rocker.angle", "rocker.omega"]
 
 
 def first_pose(m, U):
-    model, p, L = kincas.compile(m), np.array([v for _, v in m.parameters]), m.size()
+    model, p, L = kincas.model_of(m), np.array([v for _, v in m.parameters]), m.size()
     g = {k: (m.value(x), m.value(y)) for k, (x, y) in m.guess}
     sol = model.newton(model.initial_q(U[0], p, g, L), U[0], p, L)
     assert sol.ok
@@ -81,7 +81,7 @@ def check_residuals(model, run, p, L, tol=1e-12):
 
 @pytest.fixture(scope="module")
 def fourbar_sweepers():
-    model = kincas.compile(fourbar())
+    model = kincas.model_of(fourbar())
     return {c: FastSweeper(model, FOURBAR_REPORT, compile=c) for c in (True, False)}
 
 
@@ -214,7 +214,7 @@ def test_quantity_evaluator_compiled_and_uncompiled_with_mask():
 def test_no_unknowns_every_pose_goes_to_the_careful_path():
     m = Mechanism(ground={"A": (0, 0)}, links=[Link.bar("crank", "A", "B", 2.0)],
                   inputs=[Input.angle("crank")])
-    model = kincas.compile(m)
+    model = kincas.model_of(m)
     th = np.linspace(0, 3, 7)
     calls = []
 
@@ -250,7 +250,7 @@ def test_progress_in_blocks_gives_the_same_poses(fourbar_sweepers, compiled, mon
 
 def test_disk_cache_is_hit_by_a_second_process(cache):
     m = fourbar(b=3.6)  # a structure of its own: same shape, other report
-    fs = FastSweeper(kincas.compile(m), ["C.y"], compile=True)
+    fs = FastSweeper(kincas.model_of(m), ["C.y"], compile=True)
     assert fs.backend.compiled(10) is not None
     lib = fs.backend.library
     assert lib.path.exists() and lib.path.parent == cache
@@ -259,7 +259,7 @@ import json, numpy as np, kincas, sys
 sys.path.insert(0, {os.path.dirname(__file__)!r})
 from test_fast import fourbar
 from kincas.core.fast import FastSweeper
-fs = FastSweeper(kincas.compile(fourbar(b=3.6)), ["C.y"], compile=True)
+fs = FastSweeper(kincas.model_of(fourbar(b=3.6)), ["C.y"], compile=True)
 ok = fs.backend.compiled(10) is not None
 print(json.dumps({{"cached": fs.backend.library.cached, "compile": fs.backend.library.times["compile"],
                    "path": str(fs.backend.library.path), "ok": ok}}))
@@ -278,14 +278,14 @@ def test_the_cache_keeps_the_most_recently_used_libraries(tmp_path, monkeypatch)
     for i, f in enumerate(old):
         f.write_bytes(b"")
         os.utime(f, (1000 + i, 1000 + i))
-    fs = FastSweeper(kincas.compile(fourbar(b=3.55)), ["C.x"], compile=True)
+    fs = FastSweeper(kincas.model_of(fourbar(b=3.55)), ["C.x"], compile=True)
     assert fs.backend.compiled(10) is not None
     assert sorted(f.name for f in tmp_path.glob("*.so")) == sorted([old[2].name, fs.backend.library.path.name])
 
 
 def test_auto_policy_does_not_compile_a_short_sweep_unless_cached(fourbar_sweepers, tmp_path, monkeypatch):
     monkeypatch.setenv("KINCAS_CACHE", str(tmp_path))
-    model = kincas.compile(fourbar())
+    model = kincas.model_of(fourbar())
     fs = FastSweeper(model, ["C.x"], compile=None)
     assert fs.backend.compiled(100) is None and not any(tmp_path.iterdir())
     assert fs.backend.compiled(10**6) is not None  # a long sweep is worth compiling

@@ -110,7 +110,7 @@ while not os.path.exists(go):  # start together
 m = kincas.Mechanism(ground={"A": (0, 0), "D": (4.25, 0)},
     links=[kincas.Link.bar("crank", "A", "B", 1.1), kincas.Link.bar("coupler", "B", "C", 3.45),
            kincas.Link.bar("rocker", "D", "C", 3.05)], inputs=[kincas.Input.angle("crank")])
-model, U = kincas.compile(m), np.linspace(0, 2 * np.pi, 721)[:, None]
+model, U = kincas.model_of(m), np.linspace(0, 2 * np.pi, 721)[:, None]
 q0 = model.newton(model.initial_q(U[0], [], {"C": (3.6, 2.9)}, 5), U[0], [], 5).q
 fs = FastSweeper(model, ["C.x", "C.y"], compile=True)
 run = fs.run(U, [], m.size(), q0, U[0], start=1)

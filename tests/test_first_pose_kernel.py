@@ -49,7 +49,7 @@ def test_kernel_first_pose_is_the_careful_pose_for_any_guess(th):
     accepted = rejected = 0
     for G in guesses(th):
         m = fourbar(G)
-        model = kincas.compile(m)
+        model = kincas.model_of(m)
         pm, u = prepared(model, m), np.array([th])
         want = first_pose(model, u, pm.p, pm.size, pm.guess)
         fast = sweeper_for(model, tuple(report), False)
@@ -80,7 +80,7 @@ def test_kernel_first_pose_is_the_careful_pose_for_any_guess(th):
 @pytest.mark.parametrize("th, G", [(2.0, (7.74610694, 0.31767392)), (1.0, (-4.01969978, 3.48102958))])
 def test_a_guess_where_plain_newton_leaves_the_careful_answer_goes_to_the_careful_path(th, G):
     m = fourbar(G)
-    model = kincas.compile(m)
+    model = kincas.model_of(m)
     pm, u = prepared(model, m), np.array([th])
     want = first_pose(model, u, pm.p, pm.size, pm.guess)
     fast = sweeper_for(model, ("C.x", "C.y"), False)
@@ -93,7 +93,7 @@ def test_a_guess_where_plain_newton_leaves_the_careful_answer_goes_to_the_carefu
 
 def test_placement_is_kept_per_mechanism_and_inputs():
     m = fourbar((3.6, 2.9))
-    model = kincas.compile(m)
+    model = kincas.model_of(m)
     pm = prepared(model, m)
     a = pm.placement(model, np.array([0.2]), pm.guess)
     assert pm.placement(model, np.array([0.2]), pm.guess) is a  # placed once

@@ -219,7 +219,7 @@ def test_assembly_near_a_solved_pose_keeps_its_turns():
     from kincas.core.assembly import assemble
     from conftest import EXAMPLES
     m = load(EXAMPLES / "rack_fourbar.toml").mechanism
-    model, p, L = kincas.compile(m), np.array([v for _, v in m.parameters]), m.size()
+    model, p, L = kincas.model_of(m), np.array([v for _, v in m.parameters]), m.size()
     sw = kincas.sweep(m, {"pinion.angle": [0.3]})
     near = sw.q[0].copy()
     j = sw.unknowns.index("coupler.angle")

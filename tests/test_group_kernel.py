@@ -30,11 +30,11 @@ def chain(n):
 
 
 def test_equal_groups_share_one_function():
-    model = kincas.compile(chain(12))
+    model = kincas.model_of(chain(12))
     kinds = GroupFunctions(model.sym, list(model.blocks))
     assert len(model.blocks) == 12 and len(kinds.newton_kinds) <= 3  # the first ones differ
-    small = FastSweeper(kincas.compile(chain(9)), ["T9.x"], compile=False)
-    large = FastSweeper(kincas.compile(chain(30)), ["T30.x"], compile=False)
+    small = FastSweeper(kincas.model_of(chain(9)), ["T9.x"], compile=False)
+    large = FastSweeper(kincas.model_of(chain(30)), ["T30.x"], compile=False)
     # the code grows with the glue between calls only; the work with every group
     assert large.work > 3 * small.work and large.size < 2 * small.size + 2000
 
@@ -50,7 +50,7 @@ def test_grouped_and_flat_kernels_agree(source):
     else:
         sc = scene.load(EXAMPLES[[p.stem for p in EXAMPLES].index(source)])
         m, report = sc.mechanism, sc.study.report
-    model = kincas.compile(m)
+    model = kincas.model_of(m)
     if not model.square or not model.nq:
         pytest.skip("no fast kernel (redundant joints, or nothing to solve)")
     sym, blocks = model.sym, list(model.blocks)
@@ -70,7 +70,7 @@ def test_grouped_and_flat_kernels_agree(source):
 def test_long_chain_sweeps_to_the_closed_form(compile):
     n, t = GROUPS_APART, np.radians(np.linspace(60, 120, 41))  # the kernel written group by group
     m, report = chain(n), [f"T{n}.x", f"T{n}.y", f"T{n}.vx", f"T{n}.vy"]
-    assert sweeper_for(kincas.compile(m), tuple(report), compile).functions[1].is_a("MXFunction")
+    assert sweeper_for(kincas.model_of(m), tuple(report), compile).functions[1].is_a("MXFunction")
     s = kincas.sweep(m, {"crank.angle": t}, rates={"crank.angle": 2.0}, report=report, compile=compile)
     assert all(st == "ok" for st in s.status)
     np.testing.assert_allclose(s[f"T{n}.x"], 4.0 * n + np.cos(t), rtol=0, atol=1e-13)

@@ -38,7 +38,7 @@ def one_step_residual(model, q0, u0, u1, p):
 def test_kernel_residual_is_relative_to_the_group(compile):
     m = fourbar((1e5, 0.0))
     assert m.size() > 1e4  # the drawing is long, the group is not
-    model = kincas.compile(m)
+    model = kincas.model_of(m)
     p = np.array([v for _, v in m.parameters], dtype=float)
     U = np.array([[0.3], [0.6]])  # a long step: one Newton step leaves a visible residual
     q0 = model.newton(model.initial_q(U[0], p, dict(m.guess), m.size()), U[0], p).q
@@ -52,7 +52,7 @@ def test_kernel_residual_is_relative_to_the_group(compile):
 def test_group_lengths_in_casadi_match_the_careful_path():
     """The kernel's lengths (casadi) and the careful path's (numpy) are the same numbers."""
     m = fourbar((1e5, 0.0))
-    model = kincas.compile(m)
+    model = kincas.model_of(m)
     p = np.array([v for _, v in m.parameters], dtype=float)
     u = np.array([0.3])
     local, ground = (a.ravel() for a in model._geometry(u, p))

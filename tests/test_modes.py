@@ -77,7 +77,7 @@ def test_floating_link_modes():
                   slides=[Slide("P", "ground", name="sx"),
                           Slide("Q", "ground", angle=math.pi / 2, name="sy")],
                   inputs=[Input.slide("sx")])
-    assert "bar.x" in kincas.compile(m).sym.unknowns[1]  # the bar floats: its origin is unknown
+    assert "bar.x" in kincas.model_of(m).sym.unknowns[1]  # the bar floats: its origin is unknown
     modes = find_modes(m, {"sx.s": 3.0}, starts=64)
     match(modes, [{"P": np.array([3.0, 0]), "Q": np.array([0, s * 4.0])} for s in (1, -1)],
           5.0, ["P", "Q"])

@@ -64,7 +64,7 @@ def full_turn():
 def test_counted_rigid_but_accepted_with_one_redundant_equation():
     m = triple()
     assert m.mobility == 0 and m.redundant == 1
-    assert kincas.compile(m).sym.g.numel() == kincas.compile(m).nq + 1  # a tall system
+    assert kincas.model_of(m).sym.g.numel() == kincas.model_of(m).nq + 1  # a tall system
 
 
 def test_full_turn_stays_a_parallelogram_through_both_change_points(full_turn):
@@ -122,7 +122,7 @@ def test_rates_match_central_differences_of_solved_positions():
 
 def test_gauss_newton_converges_from_a_disturbed_pose():
     m = triple()
-    model, p = kincas.compile(m), np.array([1.0, 4.0])
+    model, p = kincas.model_of(m), np.array([1.0, 4.0])
     t = 0.7
     order = [n for n, _ in model.sym.unknowns]
     q_true = np.array([{"coupler.angle": 0.0}.get(n, t) for n in order])

@@ -197,7 +197,7 @@ def test_the_size_checks_build_no_model(capsys, tmp_path, monkeypatch):
     from conftest import EXAMPLES
     for path in sorted(EXAMPLES.glob("*.toml")):  # the same count as the model's own
         m = loads(path.read_text(encoding="utf-8")).mechanism
-        assert solved_unknowns(m) == kincas.compile(m).nq, path.name
+        assert solved_unknowns(m) == kincas.model_of(m).nq, path.name
     built = []
     monkeypatch.setattr(numeric, "_CACHE", {})
     monkeypatch.setattr(numeric.Model, "__init__", lambda self, *a, **k: built.append(1) or 1 / 0)

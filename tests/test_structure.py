@@ -74,7 +74,7 @@ def unknown_links(model, cols) -> frozenset[str]:
 @pytest.mark.parametrize("path", SHIPPED, ids=lambda p: p.stem)
 def test_blocks_are_the_assur_groups(path):
     m = load(path).mechanism
-    model = kincas.compile(m)
+    model = kincas.model_of(m)
     # the count above knows pins, slides and absolute inputs only: with gears, racks, cams
     # or relative inputs, only the blocks' own properties below are checked
     if not (m.gears or m.racks or m.cams or any("/" in i.target for i in m.inputs)):
@@ -98,10 +98,10 @@ def test_blocks_are_the_assur_groups(path):
 
 
 def test_triad_and_class_four_group_are_one_block_each():
-    triad = kincas.compile(load(EXAMPLES / "assur_triad.toml").mechanism)
+    triad = kincas.model_of(load(EXAMPLES / "assur_triad.toml").mechanism)
     # legs 1-3 and the plate: four angles, two closures of two equations
     assert [(b.size, b.links) for b in triad.blocks] == [(4, ("leg1", "leg2", "leg3", "plate"))]
-    eight = kincas.compile(load(EXAMPLES / "eightbar.toml").mechanism)
+    eight = kincas.model_of(load(EXAMPLES / "eightbar.toml").mechanism)
     # the class-IV group (lever, PR, floater, QS) before the dyad that it drives (rod, rocker)
     assert [(b.size, b.links) for b in eight.blocks] == [
         (4, ("floater", "lever", "link1", "link2")), (2, ("rocker", "rod"))]
@@ -119,7 +119,7 @@ def _chain(n: int) -> kincas.Mechanism:
 
 def test_chained_fourbars_are_dyads_in_order():
     n = 6
-    model = kincas.compile(_chain(n))
+    model = kincas.model_of(_chain(n))
     assert [b.links for b in model.blocks] == [(f"coupler{k}", f"rocker{k}") for k in range(n)]
     assert [b.size for b in model.blocks] == [2] * n
 
@@ -141,7 +141,7 @@ def test_scales_come_from_the_group_not_the_drawing():
     near, far = _fourbar(), _fourbar((1e5, 0))
     assert far.size() > 1e4  # the whole drawing is huge ...
     for m in (near, far):
-        model = kincas.compile(m)
+        model = kincas.model_of(m)
         eq, qs = model.scales(np.array([0.3]), np.zeros(0))
         # ... but the dyad's loop A-B-C-D is measured by its own longest body, the coupler
         assert np.all(eq == 3.5) and eq.shape == (model.ng,)
@@ -157,7 +157,7 @@ def test_length_unknowns_scale_with_their_group():
         slides=[kincas.Slide("P", "ground"), kincas.Slide("Q", "ground"),
                 kincas.Slide("B", "yoke", angle=math.pi / 2, name="slot")],
         inputs=[kincas.Input.angle("crank")], guess={"P": (0.5, 0), "Q": (5.5, 0)})
-    model = kincas.compile(m)
+    model = kincas.model_of(m)
     # (its equations are triangular: P's height gives y, Q's the angle, the slot x)
     assert [b.links for b in model.blocks] == [("yoke",)] * 3
     eq, qs = model.scales(np.array([0.3]), np.zeros(0))

@@ -198,8 +198,8 @@ def test_threads_give_the_numbers_of_one_thread_compiled():
     m = fourbar()
     args = (m, {"a4": (84, 96), "a5": (62, 70)}, {"crank.angle": np.linspace(0, 2 * np.pi, 361)},
             ["max(C.y)", "mean(rocker.omega)"])
-    one = kincas.study(*args, samples=24, seed=2, workers=1, compile=True)
-    two = kincas.study(*args, samples=24, seed=2, workers=2, chunk=3, compile=True)
+    one = kincas.study(*args, designs=24, seed=2, workers=1, compile=True)
+    two = kincas.study(*args, designs=24, seed=2, workers=2, chunk=3, compile=True)
     assert one.status == two.status and one.ok.all()
     for t in args[3]:
         assert np.array_equal(one.values[t], two.values[t])

@@ -50,7 +50,7 @@ def test_a_worker_killed_mid_study_loses_nothing():
     m = fourbar()
     vary = {"a4": (84, 100), "a5": (60, 70)}
     inputs = {"crank.angle": np.linspace(0, 2 * np.pi, 721)}
-    local = kincas.study(m, vary, inputs, REPORT, samples=60, seed=4, workers=1)
+    local = kincas.study(m, vary, inputs, REPORT, designs=60, seed=4, workers=1)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   host="127.0.0.1", dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
@@ -62,7 +62,7 @@ def test_a_worker_killed_mid_study_loses_nothing():
             seen.append(done)
             if done == 2:  # two chunks back, the rest under way or queued: kill a worker
                 os.kill(victim, signal.SIGKILL)
-        remote = kincas.study(m, vary, inputs, REPORT, samples=60, seed=4, client=client,
+        remote = kincas.study(m, vary, inputs, REPORT, designs=60, seed=4, client=client,
                               chunk=2, progress=progress)
         assert victim not in client.run(os.getpid).values()  # it did die (and was replaced)
     assert seen[-1] == 30 and len(remote.status) == 60

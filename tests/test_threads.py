@@ -126,7 +126,7 @@ def test_modes_and_tolerance_from_threads():
 
     def tol(d):
         r = analyse(fourbar(*d), {"crank.angle": U[:7]}, std={"a": 0.01, "b": 0.01},
-                    report=["C.y"], samples=200, seed=3)
+                    report=["C.y"], draws=200, seed=3)
         return np.concatenate([r.monte_carlo["C.y"], r.first_order["C.y"]])
 
     for fn in (modes, tol):

@@ -53,7 +53,7 @@ def test_first_order_std_from_central_differences():
     th = np.radians([20.0, 100.0, 230.0])
     std = {"a": 0.01, "b": 0.03, "c": 0.02, "d": 0.05}
     r = analyse(m, {"crank.angle": th}, std, report=["C.x", "C.y", "rocker.angle", "rocker.omega"],
-                samples=50, seed=0, rates={"crank.angle": 3.0})
+                draws=50, seed=0, rates={"crank.angle": 3.0})
     var = {n: np.zeros(3) for n in r.names}
     for p, s in std.items():
         h = 1e-5
@@ -71,7 +71,7 @@ def test_monte_carlo_equals_the_closed_form_on_the_same_draws():
     std = {"a": 0.02, "b": 0.05, "c": 0.05, "d": 0.05}
     n = 3000
     r = analyse(m, {"crank.angle": th}, std, report=["C.x", "C.y", "rocker.angle"],
-                samples=n, seed=7)
+                draws=n, seed=7)
     assert r.status.tolist() == ["ok"] * len(th) and r.failed.tolist() == [0] * len(th)
     dp = draws(std, n, 7)
     a, b, c, d = (1.0 + dp[:, 0], 3.5 + dp[:, 1], 3.0 + dp[:, 2], 4.0 + dp[:, 3])
@@ -95,7 +95,7 @@ def test_linear_output_has_the_draws_own_spread():
                   inputs=[Input.angle("crank")], guess={"B": (220, 20)})
     std = {"r": 0.1, "l": 0.2, "e": 0.3}
     r = analyse(m, {"crank.angle": np.radians([0.0, 75.0, 160.0])}, std,
-                report=["B.y", "guide.s"], samples=500, seed=11)
+                report=["B.y", "guide.s"], draws=500, seed=11)
     e = draws(std, 500, 11)[:, 2]
     assert np.allclose(r.first_order["B.y"], 0.3, rtol=1e-12)
     assert np.allclose(r.monte_carlo["B.y"], e.std(ddof=1), rtol=1e-10)
@@ -111,7 +111,7 @@ def test_samples_that_cannot_assemble_are_counted_and_left_out():
     th = np.radians([120.0, 145.0, 150.5])  # the limit is at 151.2 deg
     std = {"a": 0.02, "b": 0.02, "c": 0.02, "d": 0.02}
     n = 1000
-    r = analyse(m, {"crank.angle": th}, std, report=["C.y"], samples=n, seed=3)
+    r = analyse(m, {"crank.angle": th}, std, report=["C.y"], draws=n, seed=3)
     assert r.status.tolist() == ["ok"] * 3
     dp = draws(std, n, 3)
     pars = (1.0 + dp[:, 0], 1.9 + dp[:, 1], 3.0 + dp[:, 2], 4.0 + dp[:, 3])
@@ -132,9 +132,9 @@ def test_samples_that_cannot_assemble_are_counted_and_left_out():
 def test_bad_arguments_name_the_field():
     m = fourbar()
     with pytest.raises(ModelError) as e:
-        analyse(m, {"crank.angle": [0.0]}, {"zz": 0.1, "a": -1.0}, samples=1)
+        analyse(m, {"crank.angle": [0.0]}, {"zz": 0.1, "a": -1.0}, draws=1)
     text = str(e.value)
-    assert "zz" in text and "a: expected a standard deviation" in text and "samples" in text
+    assert "zz" in text and "a: expected a standard deviation" in text and "draws" in text
 
 
 # --- the command line ---

@@ -4,7 +4,7 @@
   kincas accepts (`method`, `compile` or `jit`; an option its `sweep` does not have is
   reported as missing, not faked);
 - `solve per pose`: one `kincas.solve` call per pose, its guess the previous pose's points;
-- `newton per pose, tol T`: `kincas.compile(m).newton` from the previous pose's unknowns,
+- `newton per pose, tol T`: `kincas.model_of(m).newton` from the previous pose's unknowns,
   velocities for all poses in one `model.quantities` call at the end; the tolerance is
   kincas's module setting `kincas.core.numeric.TOL` (Newton's target residual), set for the run;
 - `IPOPT per pose`: `model.nearest_assembly` (IPOPT, then a Newton polish) targeting the
@@ -112,7 +112,7 @@ def prepare_method(case, label):
                     guess = {p: (pose[f"{p}.x"], pose[f"{p}.y"]) for p in m.moving_points}
             return _result(case, vals, ok)
         return run
-    model = kincas.compile(m)
+    model = kincas.model_of(m)
     p = np.array([v for _, v in m.parameters], dtype=float)
     L = m.size()
     U = theta.reshape(-1, 1)

@@ -198,7 +198,7 @@ def stability_tables(stab: dict) -> list[str]:
 def growth_table(growth: dict) -> list[str]:
     sizes = list(growth)
     tools = [lb for lb in growth[sizes[0]] if lb not in ("compile", "case")]
-    out = ["| four-bars N | unknowns | kincas.compile s | " + " | ".join(f"{lb} µs/pose (setup s)" for lb in tools) + " |",
+    out = ["| four-bars N | unknowns | kincas.model_of s | " + " | ".join(f"{lb} µs/pose (setup s)" for lb in tools) + " |",
            "|---|---|---|" + "---|" * len(tools)]
     for n in sizes:
         res = growth[n]
@@ -224,7 +224,7 @@ def plot_growth(growth: dict, path: Path) -> None:
         if lb.startswith("sweep"):
             a2.plot(sizes, [growth[n][lb]["t"].setup if _ok(growth[n][lb]) else np.nan for n in sizes],
                     "o-", label=f"{lb}: first call (setup)")
-    a2.plot(sizes, [growth[n]["compile"] for n in sizes], "ks--", label="kincas.compile (symbolic model)")
+    a2.plot(sizes, [growth[n]["compile"] for n in sizes], "ks--", label="kincas.model_of (symbolic model)")
     for ax, yl in ((a1, "time per pose (µs, median)"), (a2, "seconds")):
         ax.set_xscale("log")
         ax.set_yscale("log")

@@ -47,6 +47,7 @@ from ..errors import ModelError
 from ..core.numeric import compile as compile_model
 from ..model.names import default_report
 from ..model.mechanism import Mechanism, as_param
+from ..result_base import Result
 from .continuation import _first
 from .design_job import (BLOCK, BLOCK_POSES, BRANCH_LOST, CALL_SECONDS, FIRST_CALL, FULL_BLOCK,  # noqa: F401
                          NO_ASSEMBLY, NO_MESH, NOT_SOLVED, OK, STATUS, _Job)
@@ -58,8 +59,8 @@ from .sweeps import _input_table
 # --- the result ---
 
 
-@dataclass
-class DesignSweep:
+@dataclass(repr=False)
+class DesignSweep(Result):
     """Designs x poses. `values[Q]` (n_designs, n_poses) in radians for angles, NaN where a
     pose is not solved; `code` (n_designs, n_poses) indexes STATUS ("ok", "no assembly",
     "not solved", "branch lost"); `params` (n_designs, len(names)) the varied values;
@@ -90,16 +91,34 @@ class DesignSweep:
         bad = np.flatnonzero(self.code[d] != OK)
         return None if not len(bad) else (STATUS[self.code[d, bad[0]]], int(bad[0]))
 
-    def to_xarray(self):
+    def summary(self) -> str:
+        """Designs solved at every pose, poses, varied parameters, reported quantities."""
+        nd, npose = self.code.shape
+        return (f"{nd} designs x {npose} poses, {int(self.design_ok.sum())} solved at every pose; "
+                f"varied {', '.join(self.names) or 'none'}; reported {', '.join(self.values) or 'none'}")
+
+    def to_pandas(self, length: str = "", angle: str = "rad"):
+        """A DataFrame indexed by (design, pose): the varied parameters, the inputs, each
+        quantity and `status`; units in `df.attrs["units"]` (`length` names lengths').
+
+        Examples
+        --------
+        >>> import kincas
+        >>> m = kincas.Mechanism(parameters={"a": 2.0}, ground={"O": (0, 0)},
+        ...     links=[kincas.Link.bar("crank", "O", "A", "a")], inputs=[kincas.Input.angle("crank")])
+        >>> r = kincas.sweep_designs(m, {"a": [1.0, 3.0]}, {"crank.angle": [0.0, 0.5]}, report=["A.x"])
+        >>> df = r.to_pandas("mm")
+        >>> df.loc[(1, 0), "A.x"], df.attrs["units"]["a"]
+        (np.float64(3.0), 'mm')
+        """
+        from ..frames import designs_to_pandas, in_angle
+        return in_angle(designs_to_pandas(self, length), angle)
+
+    def to_xarray(self, length: str = "", angle: str = "rad"):
         """An xarray Dataset with dimensions (design, pose): the varied parameters along
         design, the inputs along pose, each quantity and `status` over both."""
-        import xarray as xr
-
-        data = {n: (("design", "pose"), v) for n, v in self.values.items()}
-        data["status"] = (("design", "pose"), self.status.astype(str))
-        coords = {n: ("design", self.params[:, j]) for j, n in enumerate(self.names)}
-        coords.update({k: ("pose", v) for k, v in self.inputs.items()})
-        return xr.Dataset(data, coords=coords)
+        from ..frames import designs_to_xarray, in_angle
+        return in_angle(designs_to_xarray(self, length), angle)
 
 
 # --- the designs' table ---

@@ -14,7 +14,7 @@ basin of attraction under a trust-region Newton is rarely small: with a few hund
 the six assemblies of the class-III triad are found from every seed in the tests.
 
 >>> import numpy as np, kincas
->>> from kincas.modes import find_modes
+>>> from kincas.analysis.modes import find_modes
 >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
 ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
 ...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
@@ -85,7 +85,7 @@ class Mode:
 
 
 def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
-               iterations: int = 60) -> list[Mode]:
+               iterations: int = 60) -> "Modes":
     """The distinct real assemblies of `m` at `inputs` (input key -> value; a plain number
     for a one-input mechanism; nothing for a structure without inputs).
 
@@ -105,7 +105,9 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
 
     Returns
     -------
-    list of Mode
+    Modes
+        A list of `Mode` (index it, iterate it as before) that is also a `kincas` result:
+        `ok`, `to_pandas()`, `to_xarray()`.
 
     Examples
     --------

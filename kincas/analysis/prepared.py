@@ -14,7 +14,7 @@ and is guarded by a lock: nothing here is global, and threads share only immutab
 ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
 ...            kincas.Link.bar("rocker", "D", "C", 3)],
 ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
->>> model = kincas.compile(m)
+>>> model = kincas.model_of(m)
 >>> pm = prepared(model, m)
 >>> pm is prepared(model, m), pm.size, pm.keys
 (True, 4.0, ('crank.angle',))

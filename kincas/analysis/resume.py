@@ -63,7 +63,7 @@ def larger_groups(model) -> list[int]:
     ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 1.9),
     ...            kincas.Link.bar("rocker", "D", "C", 3)],
     ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.2, 2.5)})
-    >>> larger_groups(kincas.compile(m))  # a four-bar's one group is a dyad
+    >>> larger_groups(kincas.model_of(m))  # a four-bar's one group is a dyad
     []
     """
     if not model.square:
@@ -114,7 +114,7 @@ def resume_label(model, U, p, L, j, qj, k, qk, carried=None) -> dict:
     >>> sw = kincas.sweep(m, {"crank.angle": U[:, 0]}, report=["C.y"])
     >>> sw.status.tolist()
     ['ok', 'no assembly', 'ok']
-    >>> resume_label(kincas.compile(m), U, np.zeros(0), m.size(), 0, sw.q[0], 2, sw.q[2])
+    >>> resume_label(kincas.model_of(m), U, np.zeros(0), m.size(), 0, sw.q[0], 2, sw.q[2])
     {'branch': 'same'}
     """
     before = modes(model, model.jac(qj, U[j], p), L)[0]
@@ -202,7 +202,7 @@ def carry_groups(model, U, p, L, j, qj, k, groups, memo=None) -> dict:
     ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.2, 2.5)})
     >>> U = np.radians([[140.0], [180.0], [220.0]])
     >>> q0 = kincas.sweep(m, {"crank.angle": U[:1, 0]}).q[0]
-    >>> carry_groups(kincas.compile(m), U, np.zeros(0), m.size(), 0, q0, 2, [0])
+    >>> carry_groups(kincas.model_of(m), U, np.zeros(0), m.size(), 0, q0, 2, [0])
     {0: None}
     """
     out = {}
@@ -333,9 +333,9 @@ def unlabelled_resumes(model, U, p, L, Q, ok, events) -> list[dict]:
     ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.2, 2.5)})
     >>> U = np.radians([[140.0], [180.0], [220.0]])
     >>> sw = kincas.sweep(m, {"crank.angle": U[:, 0]}, report=["C.y"])
-    >>> unlabelled_resumes(kincas.compile(m), U, np.zeros(0), m.size(), sw.q, sw.ok, sw.events)
+    >>> unlabelled_resumes(kincas.model_of(m), U, np.zeros(0), m.size(), sw.q, sw.ok, sw.events)
     []
-    >>> unlabelled_resumes(kincas.compile(m), U, np.zeros(0), m.size(), sw.q, sw.ok, [])
+    >>> unlabelled_resumes(kincas.model_of(m), U, np.zeros(0), m.size(), sw.q, sw.ok, [])
     [{'kind': 'resume', 'pose': 2, 'branch': 'same'}]
     """
     idx = np.flatnonzero(ok)

@@ -30,6 +30,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import Mechanism
+from ..result_base import Result
 from ..results import Sweep
 
 
@@ -42,8 +43,8 @@ def names(of: list[str], to: list[str]) -> list[str]:
     return [f"d({q})/d({p})" for q in of for p in to]
 
 
-@dataclass
-class Sensitivities:
+@dataclass(repr=False)
+class Sensitivities(Result):
     """d(Q)/d(p) at every pose: `matrix[i, j, k]` is d(of[j])/d(to[k]) at pose i (NaN where the
     pose was not solved); `s["C.x", "a"]` is one column over the poses; `sweep` holds the
     solved poses and the quantities `of` themselves."""
@@ -71,9 +72,21 @@ class Sensitivities:
         return key in names(self.of, self.to) or (isinstance(key, tuple) and len(key) == 2
                                                  and key[0] in self.of and key[1] in self.to)
 
-    def __repr__(self) -> str:
-        return (f"<Sensitivities: {len(self.of)} quantities x {len(self.to)} parameters over "
-                f"{self.matrix.shape[0]} poses: {', '.join(list(self)[:3])}{' ...' if len(list(self)) > 3 else ''}>")
+    def summary(self) -> str:
+        """How many quantities, parameters and poses; the first names (the `repr`'s body)."""
+        return (f"{len(self.of)} quantities x {len(self.to)} parameters over "
+                f"{self.matrix.shape[0]} poses: {', '.join(list(self)[:3])}{' ...' if len(list(self)) > 3 else ''}")
+
+    def to_pandas(self, length: str = "", angle: str = "rad"):
+        """A DataFrame per pose (inputs as index) with a column `d(Q)/d(p)` per pair, then
+        `status` and `flag`; units in `df.attrs["units"]` (`length` names lengths')."""
+        from ..frames import sensitivities_to_pandas, in_angle
+        return in_angle(sensitivities_to_pandas(self, length), angle)
+
+    def to_xarray(self, length: str = "", angle: str = "rad"):
+        """A Dataset along `pose`, a variable `d(Q)/d(p)` per pair, as `Sweep.to_xarray`."""
+        from ..frames import sensitivities_to_xarray, in_angle
+        return in_angle(sensitivities_to_xarray(self, length), angle)
 
     @property
     def ok(self) -> np.ndarray:

@@ -35,6 +35,7 @@ from ..core.limits import _scales, locate_singular, scaled_jacobians  # noqa: F4
 from ..core.newton import newton
 from ..core.tolerances import FLAG_SIGMA, MIN_ARC_STEP, ROUNDING_REL
 from ..model.mechanism import Mechanism
+from ..result_base import Result
 
 
 # --- scaled Jacobians and classification ---
@@ -57,9 +58,11 @@ def classify(J: np.ndarray, Gu: np.ndarray, tol: float = FLAG_SIGMA) -> str | No
 # --- range of motion by pseudo-arclength continuation ---
 
 
-@dataclass
-class Range:
-    """The interval an input can sweep on the starting pose's branch."""
+@dataclass(repr=False)
+class Range(Result):
+    """The interval an input can sweep on the starting pose's branch: `low` to `high`, or
+    a full turn; `limits` the (kind, input value) of each limit met; `ok` whether the
+    interval was found (finite ends)."""
 
     key: str
     low: float
@@ -67,6 +70,27 @@ class Range:
     full_turn: bool
     limits: list[tuple[str, float]] = field(default_factory=list)  # (kind, input value)
     start: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        """Whether the range was found: a full turn, or both ends finite."""
+        return bool(self.full_turn or (np.isfinite(self.low) and np.isfinite(self.high)))
+
+    def summary(self) -> str:
+        """The input, its interval and the limits met (the `repr`'s body)."""
+        span = "full turn" if self.full_turn else f"{self.low:.6g} to {self.high:.6g}"
+        return f"{self.key} {span}; {len(self.limits)} limits met"
+
+    def to_pandas(self, length: str = "", angle: str = "rad"):
+        """A DataFrame of the limits met (kind, input value); key, low, high, full_turn and
+        start in `df.attrs`."""
+        from ..frames import range_to_pandas, in_angle
+        return in_angle(range_to_pandas(self, length), angle)
+
+    def to_xarray(self, length: str = "", angle: str = "rad"):
+        """A Dataset along `limit` (kind, value); key, low, high, full_turn, start as attributes."""
+        from ..frames import range_to_xarray, in_angle
+        return in_angle(range_to_xarray(self, length), angle)
 
 
 def input_range(m: Mechanism, inputs: dict, key: str | None = None, *, max_steps: int = 20000) -> Range:

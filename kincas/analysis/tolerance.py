@@ -25,7 +25,7 @@ reported beside the Monte-Carlo sampling error, 1 / sqrt(2 (N - 1)) relative.
 ...            kincas.Link.bar("rocker", "D", "C", 3)],
 ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
 >>> r = analyse(m, {"crank.angle": np.array([0.5, 1.0])}, std={"a": 0.01, "b": 0.01},
-...             report=["C.y"], samples=400, seed=1)
+...             report=["C.y"], draws=400, seed=1)
 >>> r.failed.tolist(), bool(np.all(np.abs(r.agreement["C.y"] - 1) < 0.2))
 ([0, 0], True)
 """
@@ -39,14 +39,16 @@ import numpy as np
 from ..errors import ModelError
 from ..core.tolerances import ROUNDING_REL, TINY
 from ..model.mechanism import Mechanism
+from .._deprecated import keyword, renamed
+from ..result_base import Result
 
 FEW_POSES = 16  # up to this many poses, each is solved from the nominal's (not swept to)
 CHUNK = 2048  # samples per task of the executor
 
 
 
-@dataclass
-class ToleranceResult:
+@dataclass(repr=False)
+class ToleranceAnalysis(Result):
     """First-order and Monte-Carlo standard deviations of each output at each pose.
 
     `first_order[Q]`, `monte_carlo[Q]`, `nominal[Q]`, `mean_shift[Q]` (Monte-Carlo mean minus
@@ -68,6 +70,16 @@ class ToleranceResult:
     info: dict = field(default_factory=dict)
 
     @property
+    def ok(self) -> np.ndarray:
+        """Boolean mask of the poses whose nominal design was solved."""
+        return np.array([s == "ok" for s in self.status], dtype=bool)
+
+    def summary(self) -> str:
+        """Poses, Monte-Carlo samples, parameters and outputs (the `repr`'s body)."""
+        return (f"{len(self.status)} poses, {int(self.ok.sum())} solved; {self.samples} samples; "
+                f"std of {', '.join(self.std)}; outputs {', '.join(self.names)}")
+
+    @property
     def agreement(self) -> dict[str, np.ndarray]:
         """Monte-Carlo std over first-order std (1 where both are zero)."""
         out = {}
@@ -84,15 +96,15 @@ class ToleranceResult:
         """Relative sampling error of a Monte-Carlo standard deviation, 1 / sqrt(2 (n - 1))."""
         return 1.0 / math.sqrt(2.0 * max(self.samples - 1, 1))
 
-    def to_pandas(self, length: str = ""):
+    def to_pandas(self, length: str = "", angle: str = "rad"):
         """A DataFrame per pose: each output's nominal value, `std Q` and `mc Q`, status, failed."""
-        from ..frames import tolerance_to_pandas
-        return tolerance_to_pandas(self, length)
+        from ..frames import tolerance_to_pandas, in_angle
+        return in_angle(tolerance_to_pandas(self, length), angle)
 
-    def to_xarray(self, length: str = ""):
+    def to_xarray(self, length: str = "", angle: str = "rad"):
         """A Dataset (pose x quantity): nominal, first_order, monte_carlo; status, failed."""
-        from ..frames import tolerance_to_xarray
-        return tolerance_to_xarray(self, length)
+        from ..frames import tolerance_to_xarray, in_angle
+        return in_angle(tolerance_to_xarray(self, length), angle)
 
     def agrees(self, k: float = 4.0) -> bool:
         """Whether, at every solved pose, |Monte Carlo - first order| is within k sampling
@@ -112,8 +124,8 @@ class ToleranceResult:
 
 
 def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | None = None, *,
-            samples: int = 2000, seed: int | None = 0, rates=None, accelerations=None,
-            progress=None, workers: int | None = None) -> ToleranceResult:
+            draws: int = 2000, seed: int | None = 0, rates=None, accelerations=None,
+            progress=None, workers: int | None = None, samples: int | None = None) -> ToleranceAnalysis:
     """Spread of the `report` quantities over `inputs` from independent normal parameter
     errors with standard deviations `std` (parameter name -> sigma, in its own unit). The
     samples run in chunks on `workers` threads (default: every core); the numbers do not
@@ -128,18 +140,21 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
         Parameter name -> standard deviation.
     report : list of str, optional
         Quantity names (default: points and link angles).
-    samples : int
-        Monte-Carlo designs.
+    draws : int
+        Monte-Carlo draws: manufactured designs, each with random parameter errors.
     seed : int, optional
     rates, accelerations : dict, optional
         As for `kincas.sweep`.
     progress : callable, optional
     workers : int, optional
-        Threads for the samples (default: every core).
+        Threads for the draws (default: every core).
+    samples : int, optional
+        Deprecated name of `draws` (kincas 0.1; a DeprecationWarning). A scene's
+        `[tolerance] samples` is unchanged.
 
     Returns
     -------
-    ToleranceResult
+    ToleranceAnalysis
 
     Examples
     --------
@@ -151,7 +166,7 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
     ...     links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", 3.5),
     ...            kincas.Link.bar("rocker", "D", "C", 3)],
     ...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
-    >>> t = analyse(m, {"crank.angle": [0.0]}, {"a": 0.001}, ["C.x"], samples=400)
+    >>> t = analyse(m, {"crank.angle": [0.0]}, {"a": 0.001}, ["C.x"], draws=400)
     >>> round(float(t.first_order["C.x"][0]), 12), round((1 / 2 + 3.25 / 18) * 0.001, 12)
     (0.000680555556, 0.000680555556)
     >>> bool(abs(t.monte_carlo["C.x"][0] / t.first_order["C.x"][0] - 1) < 0.15)  # 400 samples
@@ -160,12 +175,13 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
     from .sensitivity import sensitivities
     from ..model.names import default_report, parse_quantity
 
+    draws = keyword("analyse", "samples", "draws", samples, draws, 2000)
     report = list(default_report(m) if report is None else report)
     problems = check_std(m, std, "std")
     problems += [f"report: {n!r}: a sensitivity has no spread to analyse" for n in report
                  if parse_quantity(n)[0] == "sens"]
-    if not isinstance(samples, int) or isinstance(samples, bool) or samples < 2:
-        problems.append(f"samples: expected a whole number >= 2, got {samples!r}")
+    if not isinstance(draws, int) or isinstance(draws, bool) or draws < 2:
+        problems.append(f"draws: expected a whole number >= 2, got {draws!r}")
     if problems:
         raise ModelError(problems)
     to = list(std)
@@ -175,11 +191,11 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
     sw = sens.sweep
     fo = np.sqrt(np.einsum("ijk,k->ij", sens.matrix ** 2, sig ** 2))  # poses x outputs
     rng = np.random.default_rng(seed)
-    dp = rng.standard_normal((samples, len(to))) * sig  # one row per manufactured mechanism
+    dp = rng.standard_normal((draws, len(to))) * sig  # one row per manufactured mechanism
     mc, shift, failed, retried = _monte_carlo(m, sw, report, to, dp, workers)
     nominal = {n: sw[n] for n in report}
-    return ToleranceResult(
-        names=report, std={p: float(std[p]) for p in to}, samples=samples, seed=seed,
+    return ToleranceAnalysis(
+        names=report, std={p: float(std[p]) for p in to}, samples=draws, seed=seed,
         inputs=sw.inputs, status=sw.status, nominal=nominal,
         first_order={n: fo[:, j] for j, n in enumerate(report)},
         monte_carlo={n: mc[:, j] for j, n in enumerate(report)},
@@ -317,3 +333,7 @@ class _Samples:
             d[bad] = 0.0
             s2[:, i] = np.einsum("ij,ij->j", d, d)
         return c[:, None], mu, s2, restarts
+
+
+# the name of 0.1 (results are named by what they hold, as Sweep and Pose are)
+__getattr__ = renamed(globals(), {'ToleranceResult': 'ToleranceAnalysis'}, 'kincas.analysis.tolerance')

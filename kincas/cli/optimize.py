@@ -9,7 +9,7 @@ import sys
 import numpy as np
 
 from ..model.names import is_angular
-from ..synthesis.optimize import OptimizeResult
+from ..synthesis.optimize import Optimization
 from .common import _list, _param_unit, _unit
 from .scene import load
 from .scene_optimize import run_scene
@@ -39,7 +39,7 @@ def cli_run(args) -> int:
     return 0 if r.ok else 3
 
 
-def report(sc, r: OptimizeResult) -> dict:
+def report(sc, r: Optimization) -> dict:
     """The result as the JSON object of `kincas optimize --json`, in the scene's units."""
     deg = sc.study.deg
     user = lambda n, v: np.degrees(v) if deg and is_angular(n, sc.mechanism) else np.asarray(v, float)
@@ -110,7 +110,7 @@ def _at_bound(v: float, lo: float, hi: float) -> str | None:
     return "lower" if abs(v - lo) <= tol else "upper" if abs(v - hi) <= tol else None
 
 
-def _print(sc, r: OptimizeResult, doc: dict):
+def _print(sc, r: Optimization, doc: dict):
     print(f"{sc.study.title or 'kincas'}: optimisation by IPOPT ({r.status}, "
           f"{r.iterations} iterations)")
     print(r.message)

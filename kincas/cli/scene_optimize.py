@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from ..errors import ModelError
-from ..synthesis.optimize import OptimizeResult, optimize
+from ..synthesis.optimize import Optimization, optimize
 
 
 FIELDS = {"vary", "minimize", "constraints", "data", "samples", "check_path", "max_iter", "curve"}
@@ -116,7 +116,7 @@ def _read_curve(sc, c, problems):
         return None
 
 
-def run_scene(sc) -> OptimizeResult:
+def run_scene(sc) -> Optimization:
     """Optimise as the scene's [optimize] section says (SceneError for a bad section)."""
     from ..errors import ModelError, SceneError
 

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError, OutputError, SceneError
-from ..synthesis.study import FIELDS, StudyResult, parse_report, study
+from ..synthesis.study import FIELDS, Study, parse_report, study
 
 FORMATS = (".nc", ".csv", ".parquet")
 
@@ -131,7 +131,7 @@ def cli_run(args) -> int:
     sc.refuse_jerks(kw["report"], "[study] report")
     try:
         r = study(sc.mechanism, kw["vary"], st.inputs, kw["report"], grid=kw["grid"],
-                  samples=kw["samples"], seed=kw["seed"], rates=st.rates,
+                  designs=kw["samples"], seed=kw["seed"], rates=st.rates,
                   accelerations=st.accelerations, degrees=st.deg, client=client,
                   workers=args.workers, progress=progress_for(args), backend=args.backend)
     finally:
@@ -177,7 +177,7 @@ def _client(address):
         raise OutputError(f"--scheduler: cannot connect to {address!r}: {e}") from None
 
 
-def _summary(title, r: StudyResult, out, plot=None):
+def _summary(title, r: Study, out, plot=None):
     ok = int(r.ok.sum())
     print(f"{title or 'kincas'}: study of {len(r.status)} designs over {', '.join(r.names)}: "
           f"{ok} solved at every pose, {len(r.status) - ok} not")
@@ -209,7 +209,7 @@ def _has(mod) -> bool:
     return importlib.util.find_spec(mod) is not None
 
 
-def write(r: StudyResult, path) -> None:
+def write(r: Study, path) -> None:
     """Write the study's rows to .nc, .csv or .parquet (chosen by the suffix)."""
     from ..views.atomic import replacing
     path = Path(path)
@@ -230,7 +230,7 @@ def write(r: StudyResult, path) -> None:
         raise OutputError(f"--out: cannot write {str(path)!r}: {e.strerror or e}") from None
 
 
-def _write_csv(r: StudyResult, path):
+def _write_csv(r: Study, path):
     cols = r.columns()
     with open(path, "w", newline="", encoding="utf-8") as f:
         w = csv.writer(f)
@@ -240,7 +240,7 @@ def _write_csv(r: StudyResult, path):
                         for k, c in cols.items()])
 
 
-def _write_parquet(r: StudyResult, path):
+def _write_parquet(r: Study, path):
     cols = r.columns()
     cols["status"] = [str(s) for s in cols["status"]]
     if _has("pyarrow"):

@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 
-from ..analysis.tolerance import ToleranceResult, analyse, check_std
+from ..analysis.tolerance import ToleranceAnalysis, analyse, check_std
 from ..core.numeric import model_of
 from ..errors import SceneError
 from ..model.names import is_angular, parse_quantity
@@ -36,6 +36,7 @@ def cli_run(args) -> int:
         raise SceneError(f"--samples: expected a whole number >= 2, got {kw['samples']}")
     st = sc.study
     sc.refuse_jerks(sc.quantities, "[tolerance]")
+    kw["draws"] = kw.pop("samples")  # the scene's `[tolerance] samples`: analyse's draws
     r = analyse(sc.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
                 progress=progress_for(args), **kw)
     user = lambda n, v: np.degrees(v) if is_angular(n, sc.mechanism) and st.deg else np.asarray(v, float)
@@ -60,7 +61,7 @@ def cli_run(args) -> int:
     return 3 if unsolved else 0
 
 
-def _print(sc, r: ToleranceResult, inputs, fo, mc, unit):
+def _print(sc, r: ToleranceAnalysis, inputs, fo, mc, unit):
     stds = ", ".join(f"{p} {s:g}" for p, s in r.std.items())
     print(f"{sc.study.title or 'kincas'}: tolerance analysis, {r.samples} samples (seed {r.seed})")
     print(f"standard deviations: {stds}")

@@ -25,7 +25,7 @@ is 2 x 2); the equations of block i involve only the unknowns of blocks 0..i. So
 >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
 ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
 ...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
->>> model = kincas.compile(m)
+>>> model = kincas.model_of(m)
 >>> sol = assemble(model, np.array([0.0]), np.zeros(0), m.size())
 >>> sol.ok, modes(model, sol.J, m.size())[0].tolist()  # no guess needed: the default mode
 (True, [1])
@@ -84,7 +84,7 @@ def modes(model, J, L) -> tuple[np.ndarray, np.ndarray]:
     >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
     ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 4),
     ...            kincas.Link.bar("rocker", "D", "C", 1)], inputs=[kincas.Input.angle("crank")])
-    >>> model = kincas.compile(m)
+    >>> model = kincas.model_of(m)
     >>> q = np.array([np.pi / 2, 0.0])  # a parallelogram at 90 deg (rocker, coupler angles)
     >>> mode, cond = modes(model, model.jac(q, np.array([np.pi / 2]), np.zeros(0)), 4.0)
     >>> mode.tolist(), bool(cond[0] > 0.1)
@@ -304,7 +304,7 @@ def assemble(model, u, p, L, want=None, near=None, starts: int = 8) -> Solution 
     >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
     ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 1.9),
     ...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
-    >>> model = kincas.compile(m)  # a triple rocker: no assembly at 180 deg
+    >>> model = kincas.model_of(m)  # a triple rocker: no assembly at 180 deg
     >>> assemble(model, np.array([np.pi]), np.zeros(0), m.size()) is None
     True
     """

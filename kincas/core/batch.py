@@ -1,6 +1,6 @@
 """Many designs of one structure at once: batched evaluation and one compiled call per block.
 
-A *design* is one set of parameter values for a compiled model (`kincas.compile(m)`: the
+A *design* is one set of parameter values for a compiled model (`kincas.model_of(m)`: the
 structure is built once, the parameters stay numeric inputs). `BatchEvaluator` gives g, g_q,
 g_u, g_p and the reported quantities at many (q, u, p) columns in one mapped CasADi call
 each, for damped-free Newton steps on all of them with numpy's batched linear algebra (no
@@ -11,7 +11,7 @@ in kincas/core/designs_kernel.py.
 >>> m = kincas.Mechanism(parameters={"a": 1.0}, ground={"A": (0, 0), "D": (4, 0)},
 ...     links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", 3.5),
 ...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
->>> ev = BatchEvaluator(kincas.compile(m))
+>>> ev = BatchEvaluator(kincas.model_of(m))
 >>> g, J, Ju, Jp = ev.derivatives(np.zeros((2, 2)), np.zeros((2, 1)), np.array([[1.0], [2.0]]))
 >>> g.shape, J.shape, Jp[:, :, 0].round(6).tolist()
 ((2, 2), (2, 2, 2), [[1.0, 0.0], [1.0, 0.0]])

@@ -393,7 +393,7 @@ class QuantityEvaluator:
     >>> import numpy as np, kincas
     >>> m = kincas.Mechanism(ground={"A": (0, 0)}, links=[kincas.Link.bar("crank", "A", "B", 2)],
     ...     inputs=[kincas.Input.angle("crank")])
-    >>> ev = QuantityEvaluator(kincas.compile(m), ["B.y", "B.vx"], compile=False)
+    >>> ev = QuantityEvaluator(kincas.model_of(m), ["B.y", "B.vx"], compile=False)
     >>> ev.evaluate(np.zeros((2, 0)), np.array([[0.0], [np.pi / 2]]), [], Ud=[3.0]).round(12)
     array([[ 0.,  2.],
            [-0., -6.]])

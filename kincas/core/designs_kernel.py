@@ -31,7 +31,7 @@ sweeps designs from first poses solved elsewhere (states given).
 >>> m = kincas.Mechanism(parameters={"a": 1.0}, ground={"A": (0, 0), "D": (4, 0)},
 ...     links=[kincas.Link.bar("crank", "A", "B", "a"), kincas.Link.bar("coupler", "B", "C", 3.5),
 ...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
->>> loop = designs_loop_for(kincas.compile(m), ("C.y",), compile=False)
+>>> loop = designs_loop_for(kincas.model_of(m), ("C.y",), compile=False)
 >>> loop.lib(10) is None, loop.sweeper.nq
 (True, 2)
 """

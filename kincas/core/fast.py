@@ -28,7 +28,7 @@ arithmetic runs in casadi's virtual machine, `mapaccum` over chunks of CHUNK pos
 >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
 ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
 ...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
->>> model, U = kincas.compile(m), np.linspace(0, 2 * np.pi, 721)[:, None]
+>>> model, U = kincas.model_of(m), np.linspace(0, 2 * np.pi, 721)[:, None]
 >>> q0 = model.newton(model.initial_q(U[0], [], {"C": (3.6, 2.9)}, 5), U[0], [], 5).q
 >>> run = FastSweeper(model, compile=False).run(U, [], 5.0, q0, U[0], start=1)
 >>> run.first_bad, bool(run.residual[1:].max() < 1e-13)
@@ -168,7 +168,7 @@ class FastRun:
 
 
 class FastSweeper:
-    """Whole sweeps of one compiled model (`kincas.compile(m)`), any parameter values.
+    """Whole sweeps of one compiled model (`kincas.model_of(m)`), any parameter values.
 
     `report` lists the quantities computed with each pose (only what they need is built).
     `run(U, p, L, q_start, u_start)` solves U[start:] from a solved pose; `sweep(U, p, L,

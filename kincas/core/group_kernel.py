@@ -24,7 +24,7 @@ are their own function (flat: a point far down a chain needs the whole chain's v
 ...               kincas.Link.bar(f"rk{k}", f"G{k}", f"T{k}", 1)]
 >>> m = kincas.Mechanism(ground={"O": (0, 0), **{f"G{k}": (4 * k, 0) for k in range(1, 6)}},
 ...     links=links, inputs=[kincas.Input.angle("crank")])
->>> model = kincas.compile(m)
+>>> model = kincas.model_of(m)
 >>> kinds = GroupFunctions(model.sym, list(model.blocks))
 >>> len(model.blocks), len(kinds.newton_kinds)  # the first four-bars differ from the rest
 (5, 3)

@@ -28,7 +28,7 @@ coupler points).
 ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("rod", "B", "C", 1.78)],
 ...     slides=[kincas.Slide("C", "ground", through=(0, 0.45), name="guide")],
 ...     inputs=[kincas.Input.slide("guide")])
->>> model, u, p = kincas.compile(m), np.array([0.662]), np.zeros(0)
+>>> model, u, p = kincas.model_of(m), np.array([0.662]), np.zeros(0)
 >>> B = (np.cos(-2.24) + 1e-3, np.sin(-2.24) + 1e-3)  # one of two assemblies: crank at -2.241
 >>> round(float(model.newton(model.initial_q(u, p, {"B": B}, 2.78), u, p).q[0]), 3)  # rod at 0
 -2.848

@@ -1,6 +1,6 @@
 """Numeric evaluation of a mechanism's symbolic model: residuals, Newton, placement, IPOPT.
 
-`model_of(m)` (also `kincas.compile`, its first name) gives the `Model` of m's structure, built once and cached (parameter values are
+`model_of(m)` (`kincas.model_of`; 0.1 called it `kincas.compile`, now deprecated) gives the `Model` of m's structure, built once and cached (parameter values are
 numeric inputs, so changing them does not rebuild it). Every CasADi call on a hot path goes
 through zero-copy numpy buffers (one set per thread). Newton solves the Assur groups of the
 structure one after another (kincas/core/structure.py), each until its next step is below
@@ -214,8 +214,38 @@ class Model:
         far point elsewhere loosens nobody's tolerance. With redundant joints g_q is tall:
         the step is Gauss-Newton's, the least-squares solution of g_q dq = -g, which
         converges quadratically on a consistent system where g_q has full column rank.
-        `L` is not used (tolerances were once relative to the whole mechanism's size).
         The residual reported is the largest over all equations, each relative to its group.
+
+        Parameters
+        ----------
+        q : array
+            The starting unknowns.
+        u, p : array
+            The inputs' and the parameters' values.
+        L : float, optional
+            Ignored, whatever it is: None or any size gives the same answer, because each
+            group's residual is measured against that group's own length (`scales(u, p)`),
+            so no overall size is needed. It is kept so that calls written for kincas 0.1,
+            `newton(q, u, p, L)`, still work; new code leaves it out (tolerances were once
+            relative to the whole mechanism's size).
+        max_iter : int
+            Newton iterations per group at most.
+
+        Returns
+        -------
+        Solution
+            `q`, the relative residual, iterations, `ok`, and the Jacobian at `q`.
+
+        Examples
+        --------
+        >>> import numpy as np, kincas
+        >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
+        ...                      inputs=[kincas.Input.angle("crank")])
+        >>> model, u, p = kincas.model_of(m), np.array([0.5]), np.zeros(0)
+        >>> q0 = model.initial_q(u, p, {}, 2.0)
+        >>> a, b = model.newton(q0, u, p), model.newton(q0, u, p, 1e6)  # L changes nothing
+        >>> a.ok, bool(np.array_equal(a.q, b.q)), a.residual == b.residual
+        (True, True, True)
         """
         q = np.array(q, dtype=float)
         eq, qs = self.scales(u, p)

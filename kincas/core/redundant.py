@@ -4,7 +4,7 @@ Counting (Gruebler: unknowns minus equations) assumes every equation independent
 parallelogram four-bar with a third parallel link has 3 unknown angles and 4 closure
 equations, a count of 0, yet it moves with 1 degree of freedom: at every assembly one
 closure equation is implied by the others. Where the count gives fewer freedoms than inputs,
-`decide(m)` runs the test below once per mechanism, at its first solve (`kincas.compile`)
+`decide(m)` runs the test below once per mechanism, at its first solve (`kincas.model_of`)
 or when `Mechanism.redundant` is read; declaring a mechanism runs no numerics, and ordinary
 mechanisms never pay for it.
 

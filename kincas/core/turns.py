@@ -21,7 +21,7 @@ inputs (an input angle enters as given) and from the guessed positions (a rack's
 >>> m = kincas.Mechanism(ground={"A": (0, 0), "B": (45, 0)},
 ...     links=[kincas.Link.bar("g1", "A", "P", 30), kincas.Link.bar("g2", "B", "Q", 15)],
 ...     gears=[Gear(("g1", "g2"), (30, 15))], inputs=[kincas.Input.angle("g1")])
->>> model = kincas.compile(m)
+>>> model = kincas.model_of(m)
 >>> q = turns(model, np.array([0.5]), np.array([20.0]), np.zeros(0))  # g2 = -2 g1 = -40 rad
 >>> bool(abs(q[0] + 40) <= np.pi), bool(np.isclose(np.sin(q[0]), np.sin(0.5)))
 (True, True)

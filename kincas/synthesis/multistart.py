@@ -1,6 +1,6 @@
 """Multistart synthesis: the same optimisation from many starting designs, best optima kept.
 
-IPOPT finds a local optimum near its start. `multistart(m, samples, vary, ...)` draws
+IPOPT finds a local optimum near its start. `multistart(m, inputs, vary, ...)` draws
 `starts` starting designs in the bounds of `vary` (a Latin hypercube: one start in each of
 `starts` strata of every range, from `seed`), runs `kincas.optimize` from each (every answer
 checked as a single run checks it: assembly at every sample on the start's branch, the path
@@ -25,16 +25,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import ModelError
 from ..model.mechanism import Mechanism
+from .._deprecated import keyword, renamed
+from ..result_base import Result
 from .study import latin_hypercube
 
 SAME = 1e-4  # optima closer than this fraction of every range are one optimum
 
 
-@dataclass
-class MultistartResult:
+@dataclass(repr=False)
+class Multistart(Result):
     """`optima`: distinct optima that passed every check, best (lowest objective) first;
-    `results`: every start's `OptimizeResult`, in the starts' order; `starts`: the starting
+    `results`: every start's `Optimization`, in the starts' order; `starts`: the starting
     values (n_starts, len(vary))."""
 
     optima: list
@@ -50,6 +53,26 @@ class MultistartResult:
     @property
     def runs(self) -> int:
         return len(self.results)
+
+    @property
+    def ok(self) -> bool:
+        """Whether some start gave a trustworthy optimum."""
+        return bool(self.optima)
+
+    def summary(self) -> str:
+        """Starts, distinct optima, the best objective (the `repr`'s body)."""
+        best = f"; best objective {self.best.objective:.6g}" if self.best is not None else ""
+        return f"{self.runs} starts, {len(self.optima)} distinct optima{best}"
+
+    def to_pandas(self, length: str = "", angle: str = "rad"):
+        """A DataFrame, one row per start: its starting values, `objective`, `ok`, `status`
+        and the varied parameters it reached (`length`: the unit of lengths, in the units)."""
+        from ..frames import multistart_to_pandas, in_angle
+        return in_angle(multistart_to_pandas(self, length), angle)
+
+    def to_xarray(self, length: str = "", angle: str = "rad"):
+        """A Dataset along `start`, the columns of `to_pandas`."""
+        return self.to_pandas(length, angle).to_xarray()
 
 
 @dataclass
@@ -71,13 +94,17 @@ class _Start:
             return start, e
 
 
-def multistart(m: Mechanism, samples, vary: dict, minimize: str | None = None, constraints=(),
-               *, starts: int = 8, seed=0, keep: int = 3, same: float = SAME, client=None,
-               workers: int | None = 1, progress=None, **kw) -> MultistartResult:
+def multistart(m: Mechanism, inputs=None, vary: dict | None = None, minimize: str | None = None,
+               constraints=(), *, starts: int = 8, seed=0, keep: int = 3, same: float = SAME,
+               client=None, workers: int | None = 1, progress=None, samples=None,
+               **kw) -> Multistart:
     """Optimise from `starts` designs drawn in the bounds (see the module's text); `kw` are
     `kincas.optimize`'s keywords. `workers` defaults to 1: IPOPT's linear solver is not
     re-entrant, so one process runs one optimisation at a time (a Dask cluster's worker
-    processes run theirs side by side)."""
+    processes run theirs side by side). `samples` is the deprecated name of `inputs`."""
+    samples = keyword("multistart", "samples", "inputs", samples, inputs)
+    if samples is None or vary is None:
+        raise ModelError([f"{k}: missing" for k, v in (("inputs", samples), ("vary", vary)) if v is None])
     names = list(vary)
     ranges = [tuple(float(v) for v in vary[k]) for k in names]
     X = latin_hypercube(ranges, int(starts), seed)
@@ -99,4 +126,8 @@ def multistart(m: Mechanism, samples, vary: dict, minimize: str | None = None, c
         if all(np.any(np.abs(x - np.array([o.varied[k] for k in names])) > same * width)
                for o in optima):
             optima.append(r)
-    return MultistartResult(optima=optima[:keep], results=results, starts=X, names=names)
+    return Multistart(optima=optima[:keep], results=results, starts=X, names=names)
+
+
+# the name of 0.1 (results are named by what they hold, as Sweep and Pose are)
+__getattr__ = renamed(globals(), {'MultistartResult': 'Multistart'}, 'kincas.synthesis.multistart')

@@ -40,6 +40,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.mechanism import Mechanism
+from .._deprecated import keyword, renamed
+from ..result_base import Result
 from ..errors import ModelError
 from ..results import Sweep
 from .curve import Curve, constrain as curve_constrain, distances as curve_distances
@@ -49,7 +51,7 @@ from .simultaneous import Problem
 
 MAX_ROUNDS = 3  # IPOPT runs when extremes moved away from where they were tracked
 
-__all__ = ["optimize", "Curve", "Constraint", "OptimizeResult", "cli_arguments", "cli_run"]
+__all__ = ["optimize", "Curve", "Constraint", "Optimization", "cli_arguments", "cli_run"]
 
 
 @dataclass
@@ -61,8 +63,8 @@ class Constraint:
     max: float | None = None
 
 
-@dataclass
-class OptimizeResult:
+@dataclass(repr=False)
+class Optimization:
     """What the optimiser found, and whether it may be trusted (`ok`).
 
     `converged`: IPOPT reported success; `ok`: that, and the optimised design passed every
@@ -90,16 +92,25 @@ class OptimizeResult:
     sweep: Sweep | None = None
     info: dict = field(default_factory=dict)
 
-    def to_pandas(self, length: str = ""):
+    def __repr__(self) -> str:
+        return f"<Optimization: {self.summary()}>"
+
+    def summary(self) -> str:
+        """Trusted or not, the status, the objective and the varied parameters."""
+        varied = ", ".join(f"{k}={v:.6g}" for k, v in self.varied.items())
+        return (f"{'ok' if self.ok else 'not ok'} ({self.status}); objective {self.objective:.6g}"
+                f" after {self.iterations} iterations; {varied}")
+
+    def to_pandas(self, length: str = "", angle: str = "rad"):
         """A DataFrame per sample (inputs as index, the expressions' quantities as columns),
         the parameters, objective and status in `df.attrs`."""
-        from ..frames import optimize_to_pandas
-        return optimize_to_pandas(self, length)
+        from ..frames import optimize_to_pandas, in_angle
+        return in_angle(optimize_to_pandas(self, length), angle)
 
-    def to_xarray(self, length: str = ""):
+    def to_xarray(self, length: str = "", angle: str = "rad"):
         """A Dataset along `sample`; parameters, objective and status as attributes."""
-        from ..frames import optimize_to_xarray
-        return optimize_to_xarray(self, length)
+        from ..frames import optimize_to_xarray, in_angle
+        return in_angle(optimize_to_xarray(self, length), angle)
 
     # --- scipy.optimize.OptimizeResult's familiar names ---
     @property
@@ -123,6 +134,11 @@ class OptimizeResult:
         return int(self.iterations)
 
 
+# `ok` is a field here (scipy's OptimizeResult has `success`), which the dataclass would take
+# for a default if it inherited Result's abstract property: a registered Result instead
+Result.register(Optimization)
+
+
 def _as_constraint(c, i) -> Constraint:
     if isinstance(c, Constraint):
         return c
@@ -137,14 +153,15 @@ def _as_constraint(c, i) -> Constraint:
 
 
 
-def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, constraints=(), *, data=None,
-             rates=None, accelerations=None, deg: bool = False, check_path: bool = True,
-             max_iter: int = 1000, tol: float = 1e-12) -> OptimizeResult:
+def optimize(m: Mechanism, inputs=None, vary: dict | None = None, minimize: str | None = None,
+             constraints=(), *, data=None, rates=None, accelerations=None, deg: bool = False,
+             check_path: bool = True, max_iter: int = 1000, tol: float = 1e-12,
+             samples=None) -> Optimization:
     """Vary the parameters `vary` (name -> (low, high)) to minimise `minimize` subject to
     `constraints` (Constraint, dict {expr, min, max} or tuple (expr, min, max)), with the
-    mechanism posed at the `samples` inputs (key -> array, as for `kincas.sweep`).
+    mechanism posed at the `inputs` (key -> array, as for `kincas.sweep`): the samples.
 
-    `samples` may instead be a `Curve` (see `kincas.curve`): targets for a point without
+    `inputs` may instead be a `Curve` (see `kincas.curve`): targets for a point without
     prescribed inputs. Then the input at each target is a variable too (`samples` of the
     result gives the fitted ones), the objective is the sum of squared distances from the
     point to the targets, plus `minimize` if given, and `data` has one value per target.
@@ -157,7 +174,7 @@ def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, con
     ----------
     m : Mechanism
         The initial design; its guess picks the assembly branch kept at every sample.
-    samples : dict or Curve
+    inputs : dict or Curve
         Input key -> values of the samples; or target points (`kincas.curve.Curve`).
     vary : dict
         Parameter name -> (low, high).
@@ -175,10 +192,12 @@ def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, con
         Sweep the optimised design through the samples to check its branch.
     max_iter, tol : int, float
         IPOPT's iterations and tolerance.
+    samples : dict or Curve, optional
+        Deprecated keyword name of `inputs` (kincas 0.1; a DeprecationWarning).
 
     Returns
     -------
-    OptimizeResult
+    Optimization
         `ok` only if IPOPT converged and every check passed; otherwise `problems` says why.
 
     Examples
@@ -195,6 +214,10 @@ def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, con
     >>> r.ok, round(r.parameters["c"], 9), round(float(np.hypot(np.sqrt(10) - 4, 2.5)), 9)
     (True, 2.636622597, 2.636622597)
     """
+    samples = keyword("optimize", "samples", "inputs", samples, inputs)
+    problems = [f"{k}: missing" for k, v in (("inputs", samples), ("vary", vary)) if v is None]
+    if problems:
+        raise ModelError(problems)
     first = _once(m, samples, vary, minimize, constraints, data, rates, accelerations, deg,
                   check_path, max_iter, tol)
     r, rounds = first, 1
@@ -213,7 +236,7 @@ def optimize(m: Mechanism, samples, vary: dict, minimize: str | None = None, con
 
 
 def _once(m, samples, vary, minimize, constraints, data, rates, accelerations, deg, check_path,
-          max_iter, tol) -> OptimizeResult:
+          max_iter, tol) -> Optimization:
     from ..core.numeric import compile
     from ..analysis.sweeps import sweep
 
@@ -242,7 +265,7 @@ def _once(m, samples, vary, minimize, constraints, data, rates, accelerations, d
     if curve is not None:
         f = f + curve_objective(prob, curve)
     rows = [(c, prob.evaluate(e, c.expr)) for c, e in cons]
-    r = OptimizeResult(**prob.solve(f, rows, check_path, max_iter, tol))
+    r = Optimization(**prob.solve(f, rows, check_path, max_iter, tol))
     if curve is not None:
         r.info["curve"] = {"point": curve.point, "targets": curve.targets,
                            "distances": curve_distances(r.sweep, curve, prob.at)}
@@ -257,8 +280,12 @@ class _CallableModule(types.ModuleType):
     `kincas.optimize.optimize`) and the function: calling the module calls `optimize`, so
     importing the module path never hides the function."""
 
-    def __call__(self, *args, **kwargs) -> OptimizeResult:
+    def __call__(self, *args, **kwargs) -> Optimization:
         return optimize(*args, **kwargs)
 
 
 sys.modules[__name__].__class__ = _CallableModule
+
+
+# the name of 0.1 (results are named by what they hold, as Sweep and Pose are)
+__getattr__ = renamed(globals(), {'OptimizeResult': 'Optimization'}, 'kincas.synthesis.optimize')

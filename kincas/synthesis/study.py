@@ -1,8 +1,8 @@
 """Design studies: many designs of one mechanism, one row of results per design.
 
 `study(m, vary, inputs, report)` makes designs from ranges of some parameters (`grid`: a full
-grid; `samples`: a Latin hypercube, one sample in each of `samples` equal strata of every
-range, with a seed), sweeps each over the inputs on the branch of m's guess
+grid; `designs`: a Latin hypercube, one design in each of `designs` equal strata of every
+range, with a seed; the scene's `[study] samples`), sweeps each over the inputs on the branch of m's guess
 (`kincas.sweep_designs`), and evaluates the `report` expressions over each design's sweep.
 The expressions are those of `[optimize]` (kincas.synthesis.expressions), evaluated on the
 swept poses: `max(E)` and `min(E)` are the extremes over the poses of the sweep, `sum` and
@@ -34,6 +34,8 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import Mechanism
+from .._deprecated import keyword, renamed
+from ..result_base import Result
 from .expressions import AGGREGATE, CONST, SAMPLE, TOTAL, parse, quantity_name
 
 FIELDS = {"vary", "grid", "samples", "seed", "report"}
@@ -163,8 +165,8 @@ def parse_report(m: Mechanism, report, where: str = "report") -> list:
 # --- the study ---
 
 
-@dataclass
-class StudyResult:
+@dataclass(repr=False)
+class Study(Result):
     """One row per design: `params` (n_designs, len(names)) the varied values, `status`
     ("ok", or why the design failed), `values[text]` one number per design per report
     expression (NaN where the design failed)."""
@@ -186,20 +188,22 @@ class StudyResult:
         cols.update(self.values)
         return cols
 
-    def to_xarray(self):
-        """An xarray Dataset along the dimension `design`."""
-        import xarray as xr
+    def summary(self) -> str:
+        """Designs solved, varied parameters, report expressions (the `repr`'s body)."""
+        return (f"{len(self.status)} designs, {int(self.ok.sum())} ok; varied "
+                f"{', '.join(self.names) or 'none'}; report {', '.join(self.report) or 'none'}")
 
-        cols = self.columns()
-        data = {k: ("design", np.asarray(v, dtype=str if k == "status" else float))
-                for k, v in cols.items()}
-        return xr.Dataset(data, coords={"design": np.arange(len(self.status))})
+    def to_xarray(self, length: str = "", angle: str = "rad"):
+        """An xarray Dataset along the dimension `design` (`length`: the unit of lengths,
+        recorded in the varied parameters' units)."""
+        from ..frames import study_to_xarray, in_angle
+        return in_angle(study_to_xarray(self, length), angle)
 
-    def to_pandas(self):
-        """A pandas DataFrame, one row per design."""
-        import pandas as pd
-
-        return pd.DataFrame(self.columns())
+    def to_pandas(self, length: str = "", angle: str = "rad"):
+        """A pandas DataFrame, one row per design; the varied parameters' units in
+        `df.attrs["units"]` (`length` names the unit of lengths)."""
+        from ..frames import study_to_pandas, in_angle
+        return in_angle(study_to_pandas(self, length), angle)
 
 
 @dataclass
@@ -243,10 +247,10 @@ class _Chunk:
         return idx, code, pose, vals
 
 
-def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, seed=0,
+def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, designs=None, seed=0,
           rates=None, accelerations=None, degrees: bool = False, client=None,
           workers: int | None = None, chunk: int | None = None, compile: bool | None = None,
-          progress=None, backend: str = "casadi") -> StudyResult:
+          progress=None, backend: str = "casadi", samples=None) -> Study:
     """Sweep many designs of `m` and evaluate `report` over each (see the module's text).
 
     Parameters
@@ -260,7 +264,9 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, 
     report : list of str
         Expressions in the `[optimize]` language, each one number per design.
     grid : sequence of int, optional
-        Values per parameter of a full grid; or `samples` (with `seed`) for a Latin hypercube.
+        Values per parameter of a full grid; or:
+    designs : int, optional
+        How many designs, drawn as a Latin hypercube (with `seed`).
     degrees : bool
         Quantities, trigonometric functions and input values in the messages in degrees.
     client : dask.distributed.Client, optional
@@ -271,10 +277,13 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, 
         to 4096 designs a chunk).
     backend : {"casadi", "jax"}
         The designs' fast pass, as for `kincas.sweep_designs`.
+    samples : int, optional
+        Deprecated name of `designs` (kincas 0.1; a DeprecationWarning). A scene's
+        `[study] samples` is unchanged.
 
     Returns
     -------
-    StudyResult
+    Study
 
     Examples
     --------
@@ -299,12 +308,13 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, 
 
     names = list(vary)
     ranges = [tuple(float(x) for x in vary[k]) for k in names]
-    if (grid is None) == (samples is None):
-        raise ModelError("give either grid (values per parameter) or samples (Latin hypercube)")
+    designs = keyword("study", "samples", "designs", samples, designs)
+    if (grid is None) == (designs is None):
+        raise ModelError("give either grid (values per parameter) or designs (a count, for a Latin hypercube)")
     if grid is not None:
         X = grid_designs(ranges, list(grid))
     else:
-        X = latin_hypercube(ranges, int(samples), seed)
+        X = latin_hypercube(ranges, int(designs), seed)
     design_table(m, X, names)  # names checked
     parse_report(m, report)
     U = _input_table(m, inputs, "inputs", None)
@@ -335,9 +345,13 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, samples=None, 
             continue
         at = ", ".join(f"{key} = {_user(U[k, j], key, degrees):.6g}" for j, key in enumerate(keys))
         status.append(f"{STATUS[c]} at {at}" if at else STATUS[c])
-    return StudyResult(names=names, params=X, status=status, report=list(report),
+    return Study(names=names, params=X, status=status, report=list(report),
                        values={t: vals[:, j] for j, t in enumerate(report)})
 
 
 def _user(v, key, degrees):
     return math.degrees(v) if degrees and key.endswith(".angle") else float(v)
+
+
+# the name of 0.1 (results are named by what they hold, as Sweep and Pose are)
+__getattr__ = renamed(globals(), {'StudyResult': 'Study'}, 'kincas.synthesis.study')

@@ -25,7 +25,7 @@ def check_plot(path, vary) -> None:
 
 
 def plot_map(r, path, title: str = "") -> None:
-    """Draw the map of the `StudyResult` r into the file `path`."""
+    """Draw the map of the `Study` r into the file `path`."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
