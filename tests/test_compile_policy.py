@@ -100,3 +100,32 @@ def test_compile_false_and_no_compile_never_compile(cache, monkeypatch, poses):
         check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.4)
     assert sweeper_for(kincas.compile(m), REPORT, None).backend._thread is None
     assert not list(cache.glob("*.so"))
+
+
+# --- one rule: a library built or found is used from then on (issue [15]) ---
+
+
+@pytest.mark.parametrize("first", [None, False])
+def test_a_library_built_by_compile_true_serves_the_default_sweeps_after_it(cache, first):
+    # before: the default sweeps' sweeper, made before the library existed, kept running
+    # the virtual machine after compile=True had built and loaded it in the same process
+    m, th = fourbar(3.4, f"policy_rule_{first}"), np.linspace(0, 2 * np.pi, 360)
+    sw = kincas.sweep(m, {"crank.angle": th}, report=list(REPORT), compile=first)
+    check(sw, th, 3.4)
+    assert sw.info["fast pass"] == "virtual machine"  # a short sweep compiles nothing
+    sw = kincas.sweep(m, {"crank.angle": th}, report=list(REPORT), compile=True)
+    check(sw, th, 3.4)
+    assert sw.info["fast pass"] == "compiled"
+    for _ in range(2):
+        sw = kincas.sweep(m, {"crank.angle": th}, report=list(REPORT))
+        check(sw, th, 3.4)
+        assert sw.info["fast pass"] == "compiled"
+    sw = kincas.sweep(m, {"crank.angle": th}, report=list(REPORT), compile=False)  # still obeyed
+    check(sw, th, 3.4)
+    assert sw.info["fast pass"] == "virtual machine"
+
+
+def test_the_sweepers_of_one_kernel_share_its_functions(cache):
+    model = kincas.compile(fourbar(3.3, "policy_rule_share"))
+    a, b = sweeper_for(model, REPORT, None), sweeper_for(model, REPORT, True)
+    assert a is not b and a.functions is b.functions  # one code generation, one library

@@ -178,7 +178,7 @@ def _nothing_met(ok, signs, sigma) -> bool:
     """Whether the sweep met no singular position and no gap: every pose solved, every
     group well conditioned at every pose (none near NEAR or FLAG_SIGMA) and in one mode
     throughout. The usual sweep: then none of the searches below has anything to look at."""
-    if not ok.all() or not (sigma > max(NEAR, 1e3 * FLAG_SIGMA)).all():
+    if not ok.all() or not sigma.min(initial=np.inf) > max(NEAR, 1e3 * FLAG_SIGMA):  # (NaN: not)
         return False
     signs = np.asarray(signs)
     return bool((signs == signs[:1]).all())

@@ -30,6 +30,7 @@ from collections import OrderedDict
 import numpy as np
 
 from ..core.assembly import Placement, ambiguous, assemble
+from ..core.fast import sweeper_for
 from ..core.guessed import guessed_start
 from ..model.mechanism import Mechanism
 
@@ -56,6 +57,23 @@ class Prepared:
         self.plain = not (m.gears or m.racks)
         self._places: OrderedDict = OrderedDict()
         self._lock = threading.Lock()
+        self._sweepers: dict = {}  # (report, compile) -> FastSweeper
+        self._names: set = set()  # reports whose names were checked
+
+    def sweeper(self, model, report: tuple, compile):
+        """The model's `FastSweeper` for `report` and `compile` (`sweeper_for`), found here
+        without the model's lock once looked up (unknown names raise ModelError, every time)."""
+        fast = self._sweepers.get((report, compile))
+        if fast is None:
+            fast = self._sweepers[(report, compile)] = sweeper_for(model, report, compile)
+        return fast
+
+    def check_report(self, model, report: tuple) -> None:
+        """ModelError for a quantity name the model does not know (`Model.quantity_function`),
+        each list of names looked up once."""
+        if report not in self._names:
+            model.quantity_function(report)
+            self._names.add(report)
 
     def placement(self, model, u: np.ndarray, guess: dict):
         """A `Placement` (q0, qs): the first pose's unknowns placed at inputs u from `guess`
@@ -64,7 +82,8 @@ class Prepared:
         assembly found group by group). Computed once per inputs and guess."""
         if not self.plain or model.nq == 0:
             return None
-        key = (np.asarray(u, float).tobytes(), tuple(sorted(guess.items())))
+        key = (np.asarray(u, float).tobytes(),
+               None if guess is self.guess else tuple(sorted(guess.items())))  # (the usual case)
         with self._lock:
             if key in self._places:
                 self._places.move_to_end(key)
@@ -113,3 +132,27 @@ class _Recent:
 def prepared(model, m: Mechanism) -> Prepared:
     """The `Prepared` data of mechanism m, whose structure's model is `model`."""
     return model.memo("sweep.prepared", _Recent).get(m)
+
+
+# --- the mechanisms last swept, by identity: their model and prepared data in one look-up ---
+
+_SEEN: dict = {}  # id(m) -> (m, model, Prepared); each entry keeps its m, so its id is its own
+_SEEN_LOCK = threading.Lock()
+
+
+def model_and_prepared(m: Mechanism, model_of):
+    """(model_of(m), prepared(model, m)) for mechanism m, found by identity when m was swept
+    lately: a sweep of a mechanism already swept neither hashes its structure again (the
+    structure key is every link and joint) nor repeats the deferred mobility check, which
+    `model_of` runs (a mechanism is immutable: what was decided for it stays decided; a
+    mechanism refused raises every time, since nothing is kept for it)."""
+    hit = _SEEN.get(id(m))  # (a dict read is atomic: no lock)
+    if hit is not None and hit[0] is m:
+        return hit[1], hit[2]
+    model = model_of(m)
+    pm = prepared(model, m)
+    with _SEEN_LOCK:
+        _SEEN[id(m)] = (m, model, pm)
+        while len(_SEEN) > RECENT:
+            del _SEEN[next(iter(_SEEN))]
+    return model, pm

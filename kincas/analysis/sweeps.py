@@ -16,11 +16,11 @@ one before along the exact tangent dq/du = -g_q^-1 g_u, so the branch is kept.
 """
 from __future__ import annotations
 
+import math
 
 import numpy as np
 
 from ..errors import ModelError
-from ..core.fast import sweeper_for
 from ..model.mechanism import Mechanism
 from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
@@ -29,11 +29,11 @@ from ..model.names import default_report
 from .choice import choose_assembly
 from .continuation import careful_pose
 from .resume import unlabelled_resumes
-from .events import null_derivatives
+from .events import null_derivatives, sweep_events
 from ..core.joints import check_first_pose
 from .inputs import derivative_table, input_table as _input_table
 from ..model.mechanism import check_guess
-from .prepared import prepared
+from .prepared import model_and_prepared
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
 
@@ -62,6 +62,11 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     mechanism, a short sweep); True compiles it
     (unless the kernel is too large for the compiler to be worth waiting for), False runs it
     in CasADi's virtual machine.
+
+    One rule decides whether the fast pass runs compiled: unless `compile` is False, a compiled
+    library of its kernel is used as soon as it exists (in the cache, or loaded by this
+    process, whichever option built it); `Sweep.info["fast pass"]` says which ran: "compiled",
+    "virtual machine", or None where every pose was solved on the careful path.
 
     Each solved pose gets a flag where it sits at or next to a singular position ("limit",
     "change point", "singular"); `Sweep.events` lists those positions with their input values
@@ -105,14 +110,15 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     >>> sw.ok.all(), round(float(sw["C.x"][0]), 12), round(float(sw["C.x"][180]), 12)
     (np.True_, 3.041666666667, 1.825)
     """
-    model = _model_of(m)
+    # the model and the parameter values, size, guess, input keys: once per mechanism
+    model, pm = model_and_prepared(m, _model_of)
     report = report_names(m, report)
-    model.quantity_function(tuple(report))  # unknown names fail here, before any solving
-    pm = prepared(model, m)  # parameter values, size, guess, input keys: once per mechanism
+    names = tuple(report)
+    pm.check_report(model, names)  # unknown names fail here, before any solving
     U = _input_table(m, inputs, "inputs", None, pm.keys)
     n = U.shape[0]
-    Ud = derivative_table(m, rates, "rates", 1.0, n, pm.keys)
-    Udd = derivative_table(m, accelerations, "accelerations", 0.0, n, pm.keys)
+    Ud = _per_pose(m, rates, "rates", 1.0, n, pm.keys)
+    Udd = _per_pose(m, accelerations, "accelerations", 0.0, n, pm.keys)
     Uddd = None if jerks is None else derivative_table(m, jerks, "jerks", 0.0, n, pm.keys)
     p, L = pm.p, pm.size
     g = pm.guess if not guess else {**pm.guess, **{k: (m.value(x), m.value(y)) for k, (x, y) in check_guess(m, guess)}}
@@ -129,7 +135,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     # The fast pass (compiled, checked pose by pose) solves what it can; every pose it does
     # not accept goes to the careful path above, and the fast pass restarts after it.
     # (a tall system, with redundant joints, has no compiled pass: its g_q is not square)
-    fast = sweeper_for(model, tuple(report), compile) if method == "fast" and model.square else None
+    fast = pm.sweeper(model, names, compile) if method == "fast" and model.square else None
     if fast is not None and (compile is False or fast.worth_it(n)):
         run = fast.sweep(U, p, L, careful, Ud=Ud, Udd=Udd, progress=progress, first=first)
     elif method in ("fast", "careful"):  # "fast" for a kernel too large to pay for itself
@@ -137,15 +143,17 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     else:
         raise ModelError(f"method: {method!r} is neither \"fast\" nor \"careful\"")
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
-    if ok.any():  # gear centre distances at the first solved pose
+    every = bool(ok.all())
+    if m.gears and ok.any():  # gear centre distances at the first solved pose
         check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
-    if ok.all():
+    if every:
         status = np.empty(n, dtype=object)  # (np.full of an object is ten times slower)
         status.fill("ok")
     else:
-        status = ["ok" if s else NO_ASSEMBLY for s in ok]
+        status = np.array(["ok" if s else NO_ASSEMBLY for s in ok], dtype=object)
     flags = [None] * n
-    events += unlabelled_resumes(model, U, p, L, Q, ok, events)  # after gaps the fast pass crossed
+    if not every:  # after gaps the fast pass crossed (none where every pose is solved)
+        events += unlabelled_resumes(model, U, p, L, Q, ok, events)
     found, at = _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma,
                                  getattr(run, "crossed", ()))
     events += found
@@ -156,25 +164,42 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
             got = model.third_derivatives([report[i] for i in third], Q[ok], U[ok], p, Ud[ok], Udd[ok], Uddd[ok])
             values = np.array(values, dtype=float)
             values[np.ix_(third, np.flatnonzero(ok))] = got
-    null_derivatives(model, report, values, Q, U, p, at)  # no wrong number at a singular pose
+    if at.any():  # no wrong number at a singular pose
+        null_derivatives(model, report, values, Q, U, p, at)
     keys = pm.keys
     events.sort(key=lambda e: e["pose"])
     for e in events:
         e.setdefault("inputs", {kk: float(U[e["pose"], j]) for j, kk in enumerate(keys)})
     out = Sweep(inputs={k: U[:, j].copy() for j, k in enumerate(keys)},
-                 rates={k: Ud[:, j].copy() for j, k in enumerate(keys)},
-                 accelerations={k: Udd[:, j].copy() for j, k in enumerate(keys)},
-                 status=status, flags=flags,
-                 values={nm: values[i] for i, nm in enumerate(report)},
-                 q=Q, residual=res, iterations=its,
-                 unknowns=model.unknown_names, size=L, events=events)
-    if g:
+                rates={k: Ud[:, j] for j, k in enumerate(keys)},  # (tables of this call's own)
+                accelerations={k: Udd[:, j] for j, k in enumerate(keys)},
+                status=status, flags=flags,
+                values={nm: values[i] for i, nm in enumerate(report)},
+                q=Q, residual=res, iterations=its,
+                unknowns=model.unknown_names, size=L, events=events,
+                info={"fast pass": getattr(run, "backend", None)})
+    if g or every:
         return out  # the guess picks the assembly, whatever poses its branch loses
     # no guess: where the default assembly loses poses, one of the first pose's others that
     # runs them all (kincas/analysis/choice.py), said in an "assembly" event
     rerun = lambda guess: sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
                                 guess=guess, progress=progress, method=method, compile=compile, jerks=jerks)
     return choose_assembly(model, m, U, p, L, out, rerun) or out
+
+
+def _per_pose(m, values, what: str, default: float, n: int, keys) -> np.ndarray:
+    """The (n, nu) table of the inputs' rates or accelerations (`derivative_table`), a new array
+    (`np.broadcast_to` costs more than filling a few thousand numbers, and a short sweep
+    pays every microsecond): the usual cases, none given or one number for the one input,
+    without building a table first."""
+    if values is None:
+        return np.full((n, len(keys)), default)
+    if len(keys) == 1 and type(values) is dict and len(values) == 1:
+        v = values.get(keys[0])
+        if type(v) is float and math.isfinite(v) or type(v) is int:
+            return np.full((n, 1), float(v))
+    return np.array(derivative_table(m, values, what, default, n, keys), dtype=float)  # (a copy:
+    # the user's array stays theirs)
 
 
 class _CarefulRun:
@@ -312,5 +337,4 @@ def _singular_events(model: Model, m: Mechanism, U, Q, ok, p, L, flags, signs, s
     of a group's scaled block, so only the few poses where it is small, and the ends of a
     change of a group's sign, get exact per-group measures.
     """
-    from .events import sweep_events
     return sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed)

@@ -254,9 +254,11 @@ class Backend:
     """Chooses between a compiled `Library` and casadi's virtual machine.
 
     compile=True: compile when first needed; False (or $KINCAS_NO_COMPILE): never; None:
-    compile when the library is already cached or a call has COMPILE_MIN_POSES poses or
-    more, or in the background once `start()` is called (repeated use: the caller decides),
-    the virtual machine serving meanwhile. `make_library()` builds the `Library` (code
+    compile when a call has COMPILE_MIN_POSES poses or more, or in the background once
+    `start()` is called (repeated use: the caller decides), the virtual machine serving
+    meanwhile. Whatever the policy but False, a library that is already built is used: found
+    in the cache when first asked for, or loaded since by this process (another `Backend`
+    of the same code, such as a sweep with compile=True after default ones). `make_library()` builds the `Library` (code
     generation only) when first asked.
 
     >>> Backend(False, None, "nothing").compiled(10**6) is None
@@ -315,7 +317,10 @@ class Backend:
             try:  # a failed build must never fail a user's solve
                 if self.library is None:
                     self.library = self.make_library()
-                if self.compile or self.library.cached or n >= COMPILE_MIN_POSES:
+                # one rule: a library this process has loaded (whoever built it: a sweep
+                # with compile=True, a background compile) or that was in the cache is used
+                if (self.compile or self.library.cached or n >= COMPILE_MIN_POSES
+                        or str(self.library.path) in _LIBS):
                     self.lib = self.library.load()
             except Exception as e:
                 self._failed(e)
@@ -326,8 +331,9 @@ class Backend:
 
 
 def ptr(a: np.ndarray, offset: int = 0) -> int:
-    """The address of a float64 array's element `offset` (C order)."""
-    return a.ctypes.data + 8 * offset
+    """The address of a float64 array's element `offset` (C order). (From the array
+    interface: `a.ctypes.data` builds a ctypes object per call, about twice the time.)"""
+    return a.__array_interface__["data"][0] + 8 * offset
 
 
 def table(a, width: int) -> np.ndarray:

@@ -74,6 +74,7 @@ VM_FLAT = 64
 BACKGROUND_POSES = 20_000
 INFO = ("residual", "step", "jac_change", "correction", "steps")
 BLOCK = 65536  # poses per call when a progress callback wants news
+_HEAD = np.array([np.nan, RESIDUAL, STEP, JAC_CHANGE, CORRECTION, NEAR])  # L, then thresholds
 _I, _V = ctypes.c_longlong, ctypes.c_void_p
 # kincas_sweep's C signature (SWEEP_C): every library that links the loop declares it so
 SWEEP_SIG = [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V, _V]
@@ -109,18 +110,20 @@ class FastRun:
         no, nm = len(sweeper.report), len(sweeper.blocks) + 1
         o = self._off = list(accumulate([0, 6, sweeper.state_size, n * nq, 5 * n, no * n, nm * n]))
         block = self._block = np.empty(o[-1])
-        block[:6] = float(L), RESIDUAL, STEP, JAC_CHANGE, CORRECTION, NEAR
+        block[:6] = _HEAD  # the thresholds, then L in its place
+        block[0] = L
         self.L, self.thr, self._state = block[0:1], block[1:6], block[o[1]:o[2]]
         self.Q, self.info = block[o[2]:o[3]].reshape(n, nq), block[o[3]:o[4]].reshape(5, n)
         self.values, self.measures = block[o[4]:o[5]].reshape(no, n), block[o[5]:o[6]].reshape(nm, n)
         self.accepted, self.solved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
-        self.first_bad, self._s, self._addr = 0, None, None
+        self.first_bad, self._s, self._addr, self.recorded = 0, None, None, 0
+        self.backend = None  # "compiled" or "virtual machine": what `advance` ran last
 
     residual = property(lambda self: self.info[0], doc="max |g| / L at each pose (L: each group's)")
     step = property(lambda self: self.info[1], doc="the last Newton step (negligible, applied)")
     jac_change = property(lambda self: self.info[2], doc="max per group of sum |D^-1 (A_prev^-1 A - I) D|")
     correction = property(lambda self: self.info[3], doc="max per group of ||D^-1 (q - q_pred)||_1")
-    iterations = property(lambda self: np.where(np.isnan(self.info[4]), 0.0, self.info[4]).astype(int),
+    iterations = property(lambda self: np.fmax(self.info[4], 0.0).astype(int),  # fmax: NaN -> 0
                           doc="Newton steps taken at each pose (0 where none was attempted)")
     signs = property(lambda self: self.measures[:-1].T, doc="(N, groups) signs of det per group")
     sigma = property(lambda self: self.measures[-1], doc="smallest relative singular value bound")
@@ -137,6 +140,7 @@ class FastRun:
             self._s = sw.state(q_last, u_last, self.p, out=self._state)
         s = self._s  # the C loop leaves the last accepted pose's state in it
         lib = sw.backend.compiled(self.n)
+        self.backend = "virtual machine" if lib is None else "compiled"
         if lib is not None:
             if self._addr is None:  # addresses of the run's block and of its inputs
                 self._addr = (ptr(self._block), ptr(self.U), ptr(self.p), ptr(self.Ud[0]), ptr(self.Udd[0]))
@@ -156,6 +160,7 @@ class FastRun:
 
     def record(self, k: int, sol) -> None:
         """Store a carefully solved pose (an object with q, residual, iterations, ok, J)."""
+        self.recorded += 1
         self.solved[k] = bool(sol.ok)
         self.Q[k], self.values[:, k] = (sol.q if sol.ok else np.nan), np.nan  # values: see sweep
         self.measures[:, k] = self.sweeper.measures(sol, self.U[k], self.p, self.L[0]) if sol.ok else np.nan
@@ -179,6 +184,10 @@ class FastSweeper:
         self.nq, self.nu, self.max_evals = model.sym.nq, model.sym.nu, int(max_evals)
         model.quantity_function(self.report)  # names checked here
         self.blocks = _model_blocks(model)
+        self._group_of = np.full(self.nq, len(self.blocks), dtype=np.intp)  # each unknown's group
+        for i, b in enumerate(self.blocks):
+            self._group_of[np.asarray(b.cols, dtype=np.intp)] = i
+        self._one_group = len(self.blocks) == 1 and not self._group_of.any()
         self.nj = diagonal_size(self.blocks)  # g_q's diagonal blocks, all the state keeps of it
         self.state_size = self.nq + self.nj + 2 * (self.nq * self.nu + self.nu)
         self._functions, self._size, self._poses = None, None, 0  # _poses: swept so far
@@ -211,12 +220,13 @@ class FastSweeper:
 
     @property
     def functions(self) -> list[ca.Function]:
-        """kP, kN, kF (kincas/core/kernel.py), built when first needed."""
+        """kP, kN, kF, kL (kincas/core/kernel.py), built when first needed, once per model
+        and report: the sweepers of one kernel with different `compile` settings share them,
+        so they generate the same C code (the same library)."""
         if self._functions is None:
-            with self._lock:
-                if self._functions is None:
-                    self._functions = kernel_functions(self.sym, self.blocks, self.report,
-                                                       self.model.structure)
+            self._functions = self.model.memo(
+                ("kernel", self.report),
+                lambda: kernel_functions(self.sym, self.blocks, self.report, self.model.structure))
         return self._functions
 
     def _library(self) -> Library:
@@ -319,8 +329,8 @@ class FastSweeper:
             else:
                 last, k, going = (k if sol.ok else last), k + 1, False
             tick(k - 1, k)
-        slow = np.flatnonzero(r.solved & ~r.accepted)
-        if self.report and slow.size:
+        slow = np.flatnonzero(r.solved & ~r.accepted) if r.recorded and self.report else ()
+        if len(slow):
             ev = evaluator_for(self.model, self.report)
             r.values[:, slow] = ev.evaluate(r.Q[slow], r.U[slow], r.p, _take(r.Ud, slow), _take(r.Udd, slow))
         if progress is not None:
@@ -346,16 +356,21 @@ class FastSweeper:
         if placed.kernel is None:  # the state at q0 and its groups' signs, once per placement
             s = self.state(q0, r.U[k], r.p)
             s.flags.writeable = False
-            placed.kernel = s, _diagonal_signs(s[self.nq:self.nq + self.nj], self.blocks)
-        s, before = placed.kernel
+            before = _diagonal_signs(s[self.nq:self.nq + self.nj], self.blocks)
+            placed.kernel = s, before.tolist(), bool((before != 0).all()), 1.0 / qs
+        s, before, regular, inv_qs = placed.kernel
+        if not regular:  # a group singular at q0: its mode is not the guess's to choose
+            r._s = None
+            return k
         r._state[:] = s
         r._s = r._state
         bad = r.advance(k, None, None, stop)
-        if bad > k:
-            after = r.measures[:len(self.blocks), k]
-            dq = np.abs(r.Q[k] - q0) / qs
-            moved = [float(dq[b.cols].sum()) for b in self.blocks]
-            if (before != 0).all() and (before == after).all() and max(moved, default=0.0) <= CORRECTION:
+        if bad > k and r.measures[:len(self.blocks), k].tolist() == before:
+            # each group's sum of |q - q0| / qs over its own unknowns
+            dq = np.abs(r.Q[k] - q0) * inv_qs
+            moved = (float(dq.sum()) if self._one_group else
+                     np.bincount(self._group_of, dq, len(self.blocks) + 1)[:-1].max(initial=0.0))
+            if moved <= CORRECTION:
                 return bad
         r._s = None  # nothing of this attempt is kept: the careful path starts afresh
         r.Q[k:bad + 1] = r.values[:, k:bad + 1] = r.measures[:, k:bad + 1] = np.nan

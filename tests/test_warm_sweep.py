@@ -1,0 +1,101 @@
+"""Repeated sweeps of one mechanism take the short road (issue [15], speed where users call
+it): a mechanism found by identity, its report checked once, rates written out per pose
+without broadcasting, no copy of what is the sweep's own already. What the short road must
+keep, checked here against the circle-intersection closed form of the four-bar and its
+derivative by central differences:
+
+- a Sweep's inputs and rates are its own (the user's arrays changed afterwards change nothing);
+- rates given as an int, a float, one per pose, or not at all, give the right velocities;
+- another mechanism (other parameter values, or an equal one built anew) is not mistaken for
+  one swept before; a name the model does not know fails on every call, not the first only;
+- a NaN or infinite input is refused; huge finite inputs are not.
+"""
+import numpy as np
+import pytest
+
+import closed_forms
+import kincas
+from kincas import Input, Link, Mechanism
+from kincas.errors import ModelError
+
+
+def fourbar(b=3.5):
+    return Mechanism(parameters={"b": b}, ground={"A": (0, 0), "D": (4, 0)},
+                     links=[Link.bar("crank", "A", "B", 1.0), Link.bar("coupler", "B", "C", "b"),
+                            Link.bar("rocker", "D", "C", 3.0)],
+                     inputs=[Input.angle("crank")], guess={"C": (3.6, 2.9)})
+
+
+def closed_C(th, b):
+    """C (2, n): the circles (B, b) and (D, 3) intersected on the upper side."""
+    return closed_forms.fourbar((0, 0), (4, 0), 1.0, b, 3.0, th, +1)[1].T
+
+
+def closed_V(th, b, w):
+    """dC/dt = w dC/dtheta, dC/dtheta by central differences of the closed form."""
+    e = 1e-6
+    return w * (closed_C(th + e, b) - closed_C(th - e, b)) / (2 * e)
+
+
+REPORT = ["C.x", "C.y", "C.vx", "C.vy"]
+
+
+def check(sw, th, b, w):
+    assert sw.ok.all()
+    C, V = closed_C(th, b), closed_V(th, b, w)
+    assert np.abs(np.array([sw["C.x"], sw["C.y"]]) - C).max() < 1e-12
+    assert np.abs(np.array([sw["C.vx"], sw["C.vy"]]) - V).max() < 1e-7 * max(1.0, np.abs(w).max())
+
+
+@pytest.mark.parametrize("rates, w", [(None, 1.0), (2, 2.0), (-0.5, -0.5), ("per pose", None)])
+def test_rates_in_every_form_give_the_closed_form_velocities(rates, w):
+    m, th = fourbar(), np.linspace(0, 2 * np.pi, 90)
+    if rates == "per pose":
+        w = 1.0 + np.sin(th)
+        rates = {"crank.angle": w}
+    elif rates is not None:
+        rates = {"crank.angle": rates}
+    for _ in range(2):  # the first sweep of the mechanism, then the short road
+        sw = kincas.sweep(m, {"crank.angle": th}, rates=rates, report=REPORT)
+        check(sw, th, 3.5, w)
+        assert np.array_equal(sw.rates["crank.angle"], np.broadcast_to(w, th.shape))
+
+
+def test_a_sweeps_inputs_and_rates_are_its_own():
+    m, th = fourbar(), np.linspace(0, 2 * np.pi, 60)
+    w = np.full(60, 3.0)
+    sw = kincas.sweep(m, {"crank.angle": th}, rates={"crank.angle": w}, report=REPORT)
+    th_copy = th.copy()
+    th += 1.0
+    w[:] = -7.0
+    assert np.array_equal(sw.inputs["crank.angle"], th_copy) and (sw.rates["crank.angle"] == 3.0).all()
+    check(sw, th_copy, 3.5, 3.0)
+
+
+def test_other_mechanisms_are_not_taken_for_one_swept_before():
+    th = np.linspace(0.2, 2.0, 40)
+    m = fourbar(3.5)
+    for mech, b in ((m, 3.5), (m.with_parameters(b=3.6), 3.6), (fourbar(3.5), 3.5), (m, 3.5),
+                    (fourbar(3.45), 3.45)):
+        check(kincas.sweep(mech, {"crank.angle": th}, report=REPORT), th, b, 1.0)
+
+
+def test_an_unknown_name_fails_on_every_call():
+    m, th = fourbar(), np.linspace(0, 1, 5)
+    kincas.sweep(m, {"crank.angle": th}, report=REPORT)
+    for _ in range(2):
+        with pytest.raises(ModelError, match="nowhere"):
+            kincas.sweep(m, {"crank.angle": th}, report=["nowhere.x"])
+
+
+def test_inputs_checked_finite_whatever_their_size():
+    m = fourbar()
+    with pytest.raises(ModelError, match="finite"):
+        kincas.sweep(m, {"crank.angle": np.array([0.0, np.nan, 1.0])}, report=["C.x"])
+    with pytest.raises(ModelError, match="finite"):
+        kincas.sweep(m, {"crank.angle": np.array([0.0, np.inf])}, report=["C.x"])
+    th = np.array([1e200, -1e200])
+    sw = kincas.sweep(m, {"crank.angle": th}, report=["C.x", "C.y"])
+    C = closed_C(th, 3.5)  # the crank at angle 1e200 rad is somewhere on its circle
+    solved = sw.ok
+    assert np.abs(np.array([sw["C.x"], sw["C.y"]])[:, solved] - C[:, solved]).max(initial=0) < 1e-9
