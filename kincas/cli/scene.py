@@ -33,9 +33,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import KincasError, SceneError
-from ..model.mechanism import GROUND, Input, Link, Mechanism, Param, Slide
-from ..model.names import parse_quantity, plain_quantity
+from ..model.mechanism import GROUND, Link, Mechanism, Param, Slide
 from ..results import Sweep
+from .scene_study import StudyReader
 
 LARGEST = 1e100  # beyond it, squared lengths overflow double precision
 SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
@@ -172,7 +172,7 @@ def loads(text: str) -> Scene:
 # --- reading, with every problem gathered ---
 
 
-class _Reader:
+class _Reader(StudyReader):
     def __init__(self, doc: dict):
         self.doc, self.problems = doc, []
         units = doc.get("units", {})
@@ -352,112 +352,3 @@ class _Reader:
         angle = self.num(f"{where}: line.angle", line.get("angle", 0.0), angle=True)
         return Slide(point=str(t.get("point", "")), along=str(t.get("along", "")),
                      through=through, angle=angle, name=str(t.get("name", "")))
-
-    def inputs(self):
-        inputs, values, rates, accs, steps, written = [], {}, {}, {}, set(), {}
-        for i, t in enumerate(self.array("inputs")):
-            where = f"[[inputs]] {i + 1}"
-            self.fields(where, t, {"angle", "parameter", "slide", "value", "sweep", "rate",
-                                   "acceleration", "jerk"})
-            kinds = [k for k in ("angle", "parameter", "slide") if k in t]
-            if len(kinds) != 1:
-                self.err(f"{where}: give exactly one of angle, parameter or slide")
-                continue
-            kind = kinds[0]
-            if not isinstance(t[kind], str):
-                self.err(f"{where}: {kind}: expected a name")
-                continue
-            inp = Input(kind, t[kind])
-            where = f"[[inputs]] {inp.key}"
-            ang = kind == "angle"
-            if ("value" in t) == ("sweep" in t):
-                self.err(f"{where}: give either `value` or `sweep`")
-                continue
-            k = np.pi / 180 if ang and self.deg else 1.0
-            if "value" in t:
-                vals = np.array([self.value(f"{where}: value", t["value"])])
-            else:
-                sw = t["sweep"]
-                if not isinstance(sw, dict) or not {"from", "to", "steps"} <= set(sw):
-                    self.err(f"{where}: sweep: expected {{ from = a, to = b, steps = n }}")
-                    continue
-                self.fields(f"{where}: sweep", sw, {"from", "to", "steps"})
-                n = sw["steps"]
-                if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-                    self.err(f"{where}: sweep.steps: expected a whole number >= 1, got {n!r}")
-                    continue
-                if not self.affordable(f"{where}: sweep.steps", n):
-                    continue
-                a = self.value(f"{where}: sweep.from", sw["from"])
-                b = self.value(f"{where}: sweep.to", sw["to"])
-                vals = np.linspace(a, b, n)
-                steps.add(n)
-            inputs.append(inp)
-            written[inp.key] = vals
-            values[inp.key] = vals * k
-            rates[inp.key] = self.value(f"{where}: rate", t.get("rate", 1.0), ang)
-            accs[inp.key] = self.value(f"{where}: acceleration", t.get("acceleration", 0.0), ang)
-            self.jerks[inp.key] = self.value(f"{where}: jerk", t.get("jerk", 0.0), ang)
-        if len(steps) > 1:
-            self.err(f"[[inputs]] sweep.steps: inputs that sweep advance together, but their "
-                     f"steps differ ({sorted(steps)})")
-        return inputs, values, rates, accs, written
-
-    def affordable(self, where: str, steps: int) -> bool:
-        """Whether a sweep of `steps` poses fits in memory (refused up front, before any array
-        is made). The unknowns are counted from the file: at most a point's two coordinates
-        per link point, one per slide."""
-        from . import bounds
-        links = self.doc.get("links", {})
-        nq = sum(len(t.get("points", ())) for t in links.values() if isinstance(t, dict)) \
-            if isinstance(links, dict) else 4
-        nq += len(self.doc.get("slides", [])) if isinstance(self.doc.get("slides"), list) else 0
-        out = self.doc.get("output", {})
-        report = out.get("report") if isinstance(out, dict) else None
-        nrep = len(report) if isinstance(report, list) else 2 * nq
-        try:
-            bounds.check(where, steps, bounds.per_pose(nq, nrep))
-        except ValueError as e:
-            self.err(str(e))
-            return False
-        return True
-
-    def output(self):
-        out = self.table("output")
-        self.fields("[output]", out, {"report", "sensitivity"})
-        report = out.get("report")
-        if report is not None and (not isinstance(report, list)
-                                   or not all(isinstance(r, str) for r in report)):
-            self.err("[output] report: expected a list of quantity names")
-            report = []
-        sens = []
-        if "sensitivity" in out:
-            s = out["sensitivity"]
-            of, to = (s.get("of"), s.get("to")) if isinstance(s, dict) else (None, None)
-            if not (isinstance(of, list) and isinstance(to, list)):
-                self.err("[output] sensitivity: expected { of = [\"Q\", ...], to = [\"p\", ...] }")
-            else:
-                self.fields("[output] sensitivity", s, {"of", "to"})
-                sens = [f"d({q})/d({p})" for q in of for p in to]
-        return report, sens
-
-    def check_quantities(self, m: Mechanism, report: list[str], sens: list[str]):
-        """Point, link and slide quantities are checked from the declarations; only a scene
-        that names other quantities (efforts, reactions, curvature, ...) builds the model
-        to check them, so reading an ordinary scene runs no CasADi."""
-        if all(plain_quantity(m, n) for n in [*report, *sens]):
-            return
-        from ..core.numeric import model_of
-        sym = model_of(m, check=False)
-        bad = sym.check_names(report)
-        # each `of` name and each `to` name once, under the field they were written in
-        of = list(dict.fromkeys(parse_quantity(n)[1] for n in sens))
-        bad += sym.check_names(of, "[output] sensitivity: of")
-        driven = {i.target for i in m.inputs if i.kind == "parameter"}
-        for p in dict.fromkeys(parse_quantity(n)[2] for n in sens):
-            if p not in m.param_values:
-                bad.append(f"[output] sensitivity: to: unknown parameter {p!r}")
-            elif p in driven:
-                bad.append(f"[output] sensitivity: to: {p!r} is driven by an input (use its rate instead)")
-        if bad:
-            raise SceneError(bad)
