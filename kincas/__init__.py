@@ -19,6 +19,7 @@ from .model import Input, Link, Load, Mechanism, Param, Slide
 from .results import Pose, Sweep
 from .core.numeric import model_of
 from .analysis.sweeps import solve, sweep
+from .analysis.methods import Careful, Fast, SweepMethod
 from . import views
 from .model import mechanism as _mechanism
 from .core.numeric import redundant_equations as _redundant_equations
@@ -44,6 +45,7 @@ def __getattr__(name):
 
 
 __all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "sweep",
+           "SweepMethod", "Fast", "Careful",
            "sweep_designs", "study", "model_of",
            "sensitivities", "analyse", "optimize", "find_modes", "input_range",
            "Pose", "Sweep", "KincasError", "ModelError", "SceneError"]

@@ -34,6 +34,7 @@ from ..core.joints import check_first_pose
 from .inputs import derivative_table, input_table as _input_table
 from ..model.mechanism import check_guess
 from .prepared import model_and_prepared
+from .methods import SweepMethod, method_of
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
 
@@ -44,7 +45,7 @@ NO_ASSEMBLY = "no assembly"
 
 
 def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,
-          guess=None, progress=None, method: str = "fast", compile: bool | None = None,
+          guess=None, progress=None, method: str | SweepMethod = "fast", compile: bool | None = None,
           jerks=None) -> Sweep:
     """Solve the mechanism at every pose of `inputs` (input key -> array), keeping the branch.
 
@@ -53,15 +54,16 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     they need is computed. `guess` overrides the mechanism's guessed points. `progress`, if
     given, is called as progress(done, total) while solving.
 
-    `method="fast"` (the default) runs a compiled pass over the poses and re-solves on the
-    careful path (continuation with step cutting) every pose that it does not accept;
-    `method="careful"` uses the careful path for every pose. `compile`: None compiles the
-    fast pass to C when a compiled library is cached or the sweep is long, compiles it in a
-    background thread once a structure's sweeps add up to 20,000 poses (the virtual machine
-    serving until it is loaded), and leaves out the fast pass where it would not pay (a large
-    mechanism, a short sweep); True compiles it
-    (unless the kernel is too large for the compiler to be worth waiting for), False runs it
-    in CasADi's virtual machine.
+    `method` is how the poses are solved (kincas/analysis/methods.py): `kincas.Fast(compile)`
+    (the default) runs a compiled pass over the poses and re-solves on the careful path
+    (continuation with step cutting) every pose that it does not accept; `kincas.Careful()`
+    uses the careful path for every pose; a subclass of `kincas.SweepMethod` is called as
+    they are. The strings "fast" (with `compile`) and "careful" mean the same two. `compile`:
+    None compiles the fast pass to C when a compiled library is cached or the sweep is long,
+    compiles it in a background thread once a structure's sweeps add up to 20,000 poses (the
+    virtual machine serving until it is loaded), and leaves out the fast pass where it would
+    not pay (a large mechanism, a short sweep); True compiles it (unless the kernel is too
+    large for the compiler to be worth waiting for), False runs it in CasADi's virtual machine.
 
     One rule decides whether the fast pass runs compiled: unless `compile` is False, a compiled
     library of its kernel is used as soon as it exists (in the cache, or loaded by this
@@ -88,8 +90,11 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         Point -> (x, y), overriding the mechanism's guess.
     progress : callable, optional
         progress(done, total).
-    method : {"fast", "careful"}
+    method : SweepMethod or {"fast", "careful"}
+        kincas.Fast(compile=None) by default; "fast" is kincas.Fast(compile), "careful"
+        kincas.Careful().
     compile : bool, optional
+        With the string "fast" only (a method object carries its own).
 
     Returns
     -------
@@ -110,6 +115,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     >>> sw.ok.all(), round(float(sw["C.x"][0]), 12), round(float(sw["C.x"][180]), 12)
     (np.True_, 3.041666666667, 1.825)
     """
+    solver = method_of(method, compile)  # a wrong `method` fails before any work
     # the model and the parameter values, size, guess, input keys: once per mechanism
     model, pm = model_and_prepared(m, _model_of)
     report = report_names(m, report)
@@ -135,13 +141,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     # The fast pass (compiled, checked pose by pose) solves what it can; every pose it does
     # not accept goes to the careful path above, and the fast pass restarts after it.
     # (a tall system, with redundant joints, has no compiled pass: its g_q is not square)
-    fast = pm.sweeper(model, names, compile) if method == "fast" and model.square else None
-    if fast is not None and (compile is False or fast.worth_it(n)):
-        run = fast.sweep(U, p, L, careful, Ud=Ud, Udd=Udd, progress=progress, first=first)
-    elif method in ("fast", "careful"):  # "fast" for a kernel too large to pay for itself
-        run = _careful_only(model, report, U, Ud, Udd, p, L, careful, progress)
-    else:
-        raise ModelError(f"method: {method!r} is neither \"fast\" nor \"careful\"")
+    # Which pass solves which pose is the method's choice (kincas/analysis/methods.py).
+    run = solver.sweep(SweepProblem(model, pm, names, report, U, Ud, Udd, p, L, careful, first, progress))
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
     every = bool(ok.all())
     if m.gears and ok.any():  # gear centre distances at the first solved pose
@@ -200,6 +201,34 @@ def _per_pose(m, values, what: str, default: float, n: int, keys) -> np.ndarray:
             return np.full((n, 1), float(v))
     return np.array(derivative_table(m, values, what, default, n, keys), dtype=float)  # (a copy:
     # the user's array stays theirs)
+
+
+class SweepProblem:
+    """A sweep prepared for its method (kincas/analysis/methods.py): `n` poses, the `report`
+    names, and the two passes a method composes."""
+
+    __slots__ = ("model", "pm", "names", "report", "U", "Ud", "Udd", "p", "L", "careful",
+                 "first", "progress", "n")
+
+    def __init__(self, model, pm, names, report, U, Ud, Udd, p, L, careful, first, progress):
+        self.model, self.pm, self.names, self.report, self.U, self.Ud, self.Udd = model, pm, names, report, U, Ud, Udd
+        self.p, self.L, self.careful, self.first, self.progress = p, L, careful, first, progress
+        self.n = U.shape[0]
+
+    def fast_pass(self, compile=None):
+        """The compiled pass (every pose it does not accept on the careful path), or None
+        where there is none worth running: a tall system (redundant joints: g_q not square),
+        a kernel too large to pay for itself on this sweep (unless compile is False)."""
+        fast = self.pm.sweeper(self.model, self.names, compile) if self.model.square else None
+        if fast is None or not (compile is False or fast.worth_it(self.n)):
+            return None
+        return fast.sweep(self.U, self.p, self.L, self.careful, Ud=self.Ud, Udd=self.Udd,
+                          progress=self.progress, first=self.first)
+
+    def careful_pass(self):
+        """Every pose on the careful path (continuation with step cutting)."""
+        return _careful_only(self.model, self.report, self.U, self.Ud, self.Udd, self.p, self.L,
+                             self.careful, self.progress)
 
 
 class _CarefulRun:
