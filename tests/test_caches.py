@@ -76,25 +76,30 @@ def test_the_scan_finds_writes(tmp_path):
     assert writes(f) == [(1, "memo"), (2, "_CACHE"), (3, "_DECIDED"), (5, "_memo"), (7, "_LOCKS"), (10, "memo")]
 
 
+def at_once(n, ask):
+    """ask() from n threads released together; their answers."""
+    start, got = threading.Barrier(n), []
+
+    def run():
+        start.wait()
+        got.append(ask())
+    threads = [threading.Thread(target=run) for _ in range(n)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    return got
+
+
 def test_many_threads_one_build():
     """16 threads ask at once for a key whose build is slow: it runs once, all get its value."""
-    memo, calls, start = Memo(), [], threading.Barrier(16)
+    memo, calls = Memo(), []
 
     def build():
         calls.append(1)
         time.sleep(0.05)
         return object()
-
-    got = []
-
-    def ask():
-        start.wait()
-        got.append(memo.get_or_build("k", build))
-    threads = [threading.Thread(target=ask) for _ in range(16)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
+    got = at_once(16, lambda: memo.get_or_build("k", build))
     assert len(calls) == 1 and len(got) == 16 and all(g is got[0] for g in got)
     assert memo._gates == {}  # nothing left behind once built
 
@@ -164,16 +169,8 @@ def test_model_of_builds_once_from_many_threads(monkeypatch):
         built.append(1)
         init(self, *a, **k)
     monkeypatch.setattr(numeric.Model, "__init__", spy)
-    m, start, got = fourbar(3.25), threading.Barrier(8), []
-
-    def ask():
-        start.wait()
-        got.append(numeric.model_of(m))
-    threads = [threading.Thread(target=ask) for _ in range(8)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
+    m = fourbar(3.25)
+    got = at_once(8, lambda: numeric.model_of(m))
     assert len(built) == 1 and len(got) == 8 and all(g is got[0] for g in got)
 
 
