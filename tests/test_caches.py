@@ -22,7 +22,7 @@ PKG = ROOT / "kincas"
 # each cache, by its name in the source, and the one module that may write into it
 OWNERS = {"_CACHE": "kincas/core/numeric.py", "_DECIDED": "kincas/core/redundant.py",
           "_LIBS": "kincas/core/compiled.py", "_LOCKS": "kincas/core/batch.py",
-          "_memo": "kincas/core/numeric.py", "memo": None}  # Model.memo: a method, never written
+          "_SEEN": "kincas/analysis/prepared.py", "_memo": "kincas/core/numeric.py", "memo": None}  # Model.memo: a method, never written
 WRITERS = {"setdefault", "pop", "popitem", "update", "clear", "get_or_build", "__setitem__"}
 
 
@@ -63,7 +63,8 @@ def test_every_module_cache_is_a_memo():
     import kincas.core.batch as batch
     import kincas.core.compiled as compiled
     import kincas.core.redundant as redundant
-    for module, name in [(numeric, "_CACHE"), (redundant, "_DECIDED"), (compiled, "_LIBS"), (batch, "_LOCKS")]:
+    import kincas.analysis.prepared as prepared
+    for module, name in [(prepared, "_SEEN"), (numeric, "_CACHE"), (redundant, "_DECIDED"), (compiled, "_LIBS"), (batch, "_LOCKS")]:
         assert isinstance(getattr(module, name), Memo), name
 
 
