@@ -191,8 +191,7 @@ class Sweep(Result):
 
     def __post_init__(self):
         # object dtype: a longer status assigned later is kept whole, not truncated
-        st = self.status
-        if not (isinstance(st, np.ndarray) and st.dtype == object):  # (kept as it is if it is one)
+        if not (isinstance(st := self.status, np.ndarray) and st.dtype == object):  # (kept if it is one)
             self.status = st.astype(object) if isinstance(st, np.ndarray) else np.array(list(st), dtype=object)
         for k in list(self.values):
             if k.endswith((".angle", ".phi")) and not k.startswith("d("):  # cam.phi too

@@ -21,7 +21,7 @@ from kincas.core.caches import Memo
 PKG = ROOT / "kincas"
 # each cache, by its name in the source, and the one module that may write into it
 OWNERS = {"_CACHE": "kincas/core/numeric.py", "_DECIDED": "kincas/core/redundant.py",
-          "_LIBS": "kincas/core/compiled.py", "_LOCKS": "kincas/core/batch.py",
+          "_LIBS": "kincas/core/c_library.py", "_LOCKS": "kincas/core/batch.py",
           "_SEEN": "kincas/analysis/prepared.py", "_memo": "kincas/core/numeric.py", "memo": None}  # Model.memo: a method, never written
 WRITERS = {"setdefault", "pop", "popitem", "update", "clear", "get_or_build", "__setitem__"}
 
@@ -61,10 +61,10 @@ def test_only_the_owner_writes_each_cache():
 def test_every_module_cache_is_a_memo():
     """The owners keep their caches as Memos (one interface), not as dicts of their own."""
     import kincas.core.batch as batch
-    import kincas.core.compiled as compiled
+    import kincas.core.c_library as c_library
     import kincas.core.redundant as redundant
     import kincas.analysis.prepared as prepared
-    for module, name in [(prepared, "_SEEN"), (numeric, "_CACHE"), (redundant, "_DECIDED"), (compiled, "_LIBS"), (batch, "_LOCKS")]:
+    for module, name in [(prepared, "_SEEN"), (numeric, "_CACHE"), (redundant, "_DECIDED"), (c_library, "_LIBS"), (batch, "_LOCKS")]:
         assert isinstance(getattr(module, name), Memo), name
 
 

@@ -126,6 +126,6 @@ def test_a_library_built_by_compile_true_serves_the_default_sweeps_after_it(cach
 
 
 def test_the_sweepers_of_one_kernel_share_its_functions(cache):
-    model = kincas.compile(fourbar(3.3, "policy_rule_share"))
+    model = kincas.model_of(fourbar(3.3, "policy_rule_share"))
     a, b = sweeper_for(model, REPORT, None), sweeper_for(model, REPORT, True)
     assert a is not b and a.functions is b.functions  # one code generation, one library

@@ -126,7 +126,7 @@ def test_compiled_and_uncompiled_give_the_same_poses(fourbar_sweepers):
 def test_both_virtual_machine_forms_follow_the_compiled_loop(fourbar_sweepers, monkeypatch, skip, n):
     """The flat SX pose in 64- or 256-pose chunks (a small kernel) and the switched pose in
     chunks sized to what is left (a large one, forced here) stop where the C loop stops."""
-    monkeypatch.setattr("kincas.core.fast.VM_SKIP", -1 if skip else 10**9)
+    monkeypatch.setattr("kincas.core.fast_vm.VM_SKIP", -1 if skip else 10**9)
     th = np.linspace(0.3, 0.3 + 2 * np.pi, n)
     U = th[:, None]
     model, p, L, q0 = first_pose(fourbar(), U)
@@ -271,9 +271,9 @@ print(json.dumps({{"cached": fs.backend.library.cached, "compile": fs.backend.li
 
 
 def test_the_cache_keeps_the_most_recently_used_libraries(tmp_path, monkeypatch):
-    import kincas.core.compiled
+    import kincas.core.c_library
     monkeypatch.setenv("KINCAS_CACHE", str(tmp_path))
-    monkeypatch.setattr(kincas.core.compiled, "MAX_CACHED", 2)
+    monkeypatch.setattr(kincas.core.c_library, "MAX_CACHED", 2)
     old = [tmp_path / f"kincas_sweep-old{i}.so" for i in range(3)]
     for i, f in enumerate(old):
         f.write_bytes(b"")

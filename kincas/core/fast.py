@@ -38,16 +38,17 @@ from __future__ import annotations
 
 import ctypes
 import threading
-from itertools import accumulate
 
 import casadi as ca
 import numpy as np
 
 from .blocks import diagonal_size, numeric_signs
-from .compiled import CHUNK, Backend, Library, QuantityEvaluator, ptr, rows, table
+from .compiled import CHUNK, Backend, Library, QuantityEvaluator  # noqa: F401 (CHUNK: its old home)
+from .fast_run import INFO, FastRun, _rows, _take  # noqa: F401 (INFO, _rows: their old home)
+from .fast_vm import VM_CHUNKS, VM_FLAT, VM_SKIP, VirtualMachineSweep, _Buffered  # noqa: F401
 from .group_kernel import kernel_sizes
-from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, NEAR, RESIDUAL, STEP, SWEEP_C,
-                     kernel_functions, state_function, vm_step)
+from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, NEAR, RESIDUAL, STEP, SWEEP_C,  # noqa: F401
+                     kernel_functions, state_function)
 
 # Kernel size, in casadi instructions, beyond which compiling costs more than it saves: gcc
 # -O3 took 1.7 s at 11k instructions, 13 s at 39k and 200 s (3.5 GB) at 150k.
@@ -57,24 +58,13 @@ COMPILE_MAX = 40_000
 # virtual machine took 0.3 ms a pose against 26 ms on the careful path: only a far larger
 # kernel could lose (and it is never compiled either).
 VM_MAX = 200_000
-VM_CHUNKS = (1, 8, 32, 128, CHUNK)  # poses per call of the virtual machine's sweep
-# Above VM_SKIP instructions a kernel pass (40 chained four-bars: 10,500), the virtual machine
-# skips the Newton steps after convergence and sizes its chunks to the poses left: a padded
-# or wasted pose costs more than the switches' calls and the build of a chunk function per
-# size (which grows with the size: 12 ms for 256 poses of a four-bar). Below (a four-bar:
-# 240), one flat SX pose, and chunks of VM_FLAT poses, the last one padded: CHUNK for a
-# stretch of at least 4 * CHUNK poses (fewer calls); a short sweep builds only 64 (3 ms).
-VM_SKIP = 2_000
-VM_FLAT = 64
 # With compile=None, a sweeper compiles its kernel in the background once its sweeps add up
 # to this many poses (one long sweep, or ~56 of 360 poses): the virtual machine costs ~1-3 us
 # a pose more than the compiled loop, compiling a small kernel ~1 s of a background thread.
 # Repeated use pays for it; a one-off short sweep (`kincas solve`) compiles nothing, and a
 # test suite sweeping hundreds of structures a few times each does not compile them all.
 BACKGROUND_POSES = 20_000
-INFO = ("residual", "step", "jac_change", "correction", "steps")
 BLOCK = 65536  # poses per call when a progress callback wants news
-_HEAD = np.array([np.nan, RESIDUAL, STEP, JAC_CHANGE, CORRECTION, NEAR])  # L, then thresholds
 _I, _V = ctypes.c_longlong, ctypes.c_void_p
 # kincas_sweep's C signature (SWEEP_C): every library that links the loop declares it so
 SWEEP_SIG = [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V, _V]
@@ -83,91 +73,7 @@ SWEEP_SIG = [_I, _V, _V, _V, _V, _I, _V, _V, _V, _I, _V, _I, _V, _I, _V, _V]
 # --- the sweep driver ---
 
 
-class FastRun:
-    """The arrays of one sweep, bound once; `advance` solves a stretch of it per call.
-
-    `Q` (N, nq): the unknowns, NaN where not solved; `values` (len(report), N): the reported
-    quantities; `info` (5, N): per pose attempted, the measures named in INFO; `measures`
-    (groups + 1, N): per pose, the sign of det of each Assur group's block of g_q, then the
-    smallest lower bound of a group's smallest singular value (relative, columns scaled,
-    kincas/core/blocks.py); `accepted`: the poses the fast pass accepted; `solved`: by either
-    path (`FastSweeper.sweep` fills it); `first_bad`: where the last `advance` stopped. The
-    arrays are not initialised (filling 100,000 rows with NaN costs more than solving them):
-    rows that no `advance` or `record` reached are NaN only after `run` or `sweep` returns.
-    Everything the kernel writes belongs to this run: runs in several threads share nothing.
-    """
-
-    def __init__(self, sweeper: "FastSweeper", U, p, L, Ud=None, Udd=None):
-        self.sweeper, nq, nu = sweeper, sweeper.nq, sweeper.nu
-        self.U = np.ascontiguousarray(table(U, nu))
-        self.n = n = self.U.shape[0]
-        self.Ud = _rows(np.ones(nu) if Ud is None else Ud, n, nu)
-        self.Udd = _rows(np.zeros(nu) if Udd is None else Udd, n, nu)
-        self.p = np.ascontiguousarray(np.asarray(p, dtype=float).ravel())
-        # everything the kernel reads or writes of this run, inputs aside, in one block of
-        # memory: L and the thresholds, the state, Q, info, values, measures (its address
-        # is taken once, not per array and per call)
-        no, nm = len(sweeper.report), len(sweeper.blocks) + 1
-        o = self._off = list(accumulate([0, 6, sweeper.state_size, n * nq, 5 * n, no * n, nm * n]))
-        block = self._block = np.empty(o[-1])
-        block[:6] = _HEAD  # the thresholds, then L in its place
-        block[0] = L
-        self.L, self.thr, self._state = block[0:1], block[1:6], block[o[1]:o[2]]
-        self.Q, self.info = block[o[2]:o[3]].reshape(n, nq), block[o[3]:o[4]].reshape(5, n)
-        self.values, self.measures = block[o[4]:o[5]].reshape(no, n), block[o[5]:o[6]].reshape(nm, n)
-        self.accepted, self.solved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
-        self.first_bad, self._s, self._addr, self.recorded = 0, None, None, 0
-        self.backend = None  # "compiled" or "virtual machine": what `advance` ran last
-
-    residual = property(lambda self: self.info[0], doc="max |g| / L at each pose (L: each group's)")
-    step = property(lambda self: self.info[1], doc="the last Newton step (negligible, applied)")
-    jac_change = property(lambda self: self.info[2], doc="max per group of sum |D^-1 (A_prev^-1 A - I) D|")
-    correction = property(lambda self: self.info[3], doc="max per group of ||D^-1 (q - q_pred)||_1")
-    iterations = property(lambda self: np.fmax(self.info[4], 0.0).astype(int),  # fmax: NaN -> 0
-                          doc="Newton steps taken at each pose (0 where none was attempted)")
-    signs = property(lambda self: self.measures[:-1].T, doc="(N, groups) signs of det per group")
-    sigma = property(lambda self: self.measures[-1], doc="smallest relative singular value bound")
-
-    def advance(self, start: int, q_last, u_last, stop: int | None = None) -> int:
-        """Solve poses start, start + 1, ... (before `stop`, default N) from the solved pose
-        (q_last, u_last) until one is rejected, and return its index (`stop` if none was).
-        The poses before it are accepted; the rejected pose keeps its `info` (why) and NaN in
-        `Q` and `values`. q_last None: go on from where the last call stopped, unrejected."""
-        sw, stop = self.sweeper, self.n if stop is None else min(stop, self.n)
-        if start >= stop or not (sw.nq and sw.nu):  # nothing to predict: all careful
-            return min(start, stop)
-        if q_last is not None or self._s is None:
-            self._s = sw.state(q_last, u_last, self.p, out=self._state)
-        s = self._s  # the C loop leaves the last accepted pose's state in it
-        lib = sw.backend.compiled(self.n)
-        self.backend = "virtual machine" if lib is None else "compiled"
-        if lib is not None:
-            if self._addr is None:  # addresses of the run's block and of its inputs
-                self._addr = (ptr(self._block), ptr(self.U), ptr(self.p), ptr(self.Ud[0]), ptr(self.Udd[0]))
-            a, aU, ap, aUd, aUdd = self._addr
-            o, sud, sudd, nq = self._off, self.Ud[1], self.Udd[1], sw.nq
-            k = start + lib.kincas_sweep(
-                stop - start, aU + 8 * start * sw.nu, ap, a, a + 8, sw.max_evals, a + 8 * o[1],
-                a + 8 * (o[2] + start * nq), a + 8 * (o[3] + start), self.n, aUd + 8 * start * sud, sud,
-                aUdd + 8 * start * sudd, sudd, a + 8 * (o[4] + start), a + 8 * (o[5] + start))
-        else:
-            k = sw._vm_advance(self, start, stop, s)
-        self.accepted[start:k] = self.solved[start:k] = True
-        if k < stop:
-            self.Q[k] = self.values[:, k] = self.measures[:, k] = np.nan
-        self.first_bad = k
-        return k
-
-    def record(self, k: int, sol) -> None:
-        """Store a carefully solved pose (an object with q, residual, iterations, ok, J)."""
-        self.recorded += 1
-        self.solved[k] = bool(sol.ok)
-        self.Q[k], self.values[:, k] = (sol.q if sol.ok else np.nan), np.nan  # values: see sweep
-        self.measures[:, k] = self.sweeper.measures(sol, self.U[k], self.p, self.L[0]) if sol.ok else np.nan
-        self.info[:, k] = [sol.residual, np.nan, np.nan, np.nan, sol.iterations]
-
-
-class FastSweeper:
+class FastSweeper(VirtualMachineSweep):
     """Whole sweeps of one compiled model (`kincas.model_of(m)`), any parameter values.
 
     `report` lists the quantities computed with each pose (only what they need is built).
@@ -388,92 +294,6 @@ class FastSweeper:
         r.solved[k] = True
         return False
 
-    # --- the virtual machine: the same arithmetic, mapaccum over chunks of VM_CHUNKS poses ---
-    def _vm_function(self, size: int) -> ca.Function:
-        with self._lock:
-            if getattr(self, "_vmF", None) is None:
-                self._vmF = {}
-            if size not in self._vmF:
-                nu = self.nu
-                kS = getattr(self, "_kS", None) or vm_step(*self.functions, self.nq, nu, self.max_evals,
-                                                           skip=self.work > VM_SKIP)
-                self._kS = kS
-                acc = kS.mapaccum("acc", size, [0, 1, 2, 3, 4, 5], [0, 1, 2, 3, 4, 5], {})
-                x = [ca.MX.sym(f"x{i}", *kS.size_in(i)) for i in range(6)]
-                U, Ud, Udd = (ca.MX.sym(c, nu, size) for c in ("U", "Ud", "Udd"))
-                p, L, t = ca.MX.sym("p", kS.size1_in(7)), ca.MX.sym("L"), ca.MX.sym("t", 5)
-                Lb = self.functions[3](U[:, 0], p)  # the groups' lengths, as the C loop takes them
-                rep = lambda a: ca.repmat(a, 1, size)
-                self._vmF[size] = ca.Function("chunk", [*x, U, p, L, t, Ud, Udd],
-                                              acc(*x, U, rep(p), rep(L), rep(t), Ud, Udd, rep(Lb)))
-            return self._vmF[size]
-
-    def _vm_buffers(self, size: int):
-        """This thread's buffers bound to the chunk function of `size` poses (built on first use)."""
-        vms = getattr(self._local, "vm", None)
-        if vms is None:
-            vms = self._local.vm = {}
-        if size not in vms:
-            nq, nu, no, nm = self.nq, self.nu, len(self.report), len(self.blocks) + 1
-            F = self._vm_function(size)
-            buf, call = F.buffer()
-            scratch = [np.zeros((size, m)) for m in (nq, self.nj, nq * nu, nu, nq * nu, nu, 6, no, nm,
-                                                     nu, nu, nu)]
-            for i, a in enumerate(scratch[:9]):
-                buf.set_res(i, memoryview(a))
-            vms[size] = (F, buf, call, scratch)  # buf holds raw pointers: keep it
-        return vms[size]
-
-    def _vm_advance(self, r: FastRun, start: int, stop: int, s: np.ndarray) -> int:
-        nq, nu = self.nq, self.nu
-        parts = np.split(s.copy(), np.cumsum([nq, self.nj, nq * nu, nu, nq * nu]))
-        k, sized = start, self.work > VM_SKIP
-        flat = CHUNK if stop - start >= 4 * CHUNK else VM_FLAT
-        while k < stop:  # a large kernel: the smallest chunk that holds what is left (padded
-            # poses cost too), and a short one first: the first pose of a stretch is the
-            # likeliest to be rejected, and the chunk's later poses are computed all the same
-            left = stop - k if k > start else min(stop - k, VM_CHUNKS[1])
-            size = (next((c for c in VM_CHUNKS if c >= left), VM_CHUNKS[-1]) if sized
-                    else flat)
-            _, buf, call, (Qc, Jc, Tc, Uo, T1c, U1c, Ic, Yc, Mc, Uc, Udc, Uddc) = self._vm_buffers(size)
-            m = min(size, stop - k)
-            for c, (a, st) in ((Uc, (r.U, 1)), (Udc, r.Ud), (Uddc, r.Udd)):
-                c[:m], c[m:] = (a[k:k + m] if st else a), (a[k + m - 1] if st else a)  # pad
-            for i, a in enumerate([*parts, Uc, r.p, r.L, r.thr, Udc, Uddc]):
-                buf.set_arg(i, memoryview(a))
-            call()
-            ok = (Ic[:m, 5] > 0) & np.all(Ic[:m, 2:4] <= r.thr[2:4], axis=1)
-            j = m if ok.all() else int(np.argmin(ok))
-            e = min(j + 1, m)
-            r.Q[k:k + e], r.info[:, k:k + e], r.values[:, k:k + e] = Qc[:e], Ic[:e, :5].T, Yc[:e].T
-            r.measures[:, k:k + e] = Mc[:e].T
-            if j < m:
-                return k + j
-            parts = [a[m - 1].copy() for a in (Qc, Jc, Tc, Uo, T1c, U1c)]
-            k += m
-        s[:] = np.concatenate(parts)  # where the compiled loop leaves it too
-        return stop
-
-
-class _Buffered:
-    """A casadi Function evaluated straight between numpy arrays (about 1 us a call instead
-    of 10-20 through DM). Its buffer holds raw pointers: one per thread, never shared."""
-
-    def __init__(self, f: ca.Function):
-        self.buf, self.call = f.buffer()
-        self.n_in = f.n_in()
-
-    def __call__(self, *arrays):
-        keep = [np.ascontiguousarray(a, dtype=float) for a in arrays]
-        for i, a in enumerate(keep[:self.n_in]):
-            self.buf.set_arg(i, memoryview(a))
-        for i, a in enumerate(keep[self.n_in:]):
-            self.buf.set_res(i, memoryview(a))
-        self.call()
-        for a, b in zip(keep[self.n_in:], arrays[self.n_in:]):
-            if a is not b:
-                b[...] = a
-
 
 def _diagonal_signs(d: np.ndarray, blocks) -> np.ndarray:
     """The signs of the determinants of g_q's diagonal blocks, given as the state keeps them
@@ -487,24 +307,6 @@ def _diagonal_signs(d: np.ndarray, blocks) -> np.ndarray:
         out[i] = np.sign(det)
     return out
 
-
-def _rows(a, n: int, width: int) -> tuple[np.ndarray, int]:
-    """`rows` (kincas/core/compiled.py) with its usual cases first: a C-contiguous (n, width)
-    table as it is, one row (or a table broadcast from one) as that row with stride 0."""
-    a = np.asarray(a, dtype=float)
-    if a.ndim == 2 and a.shape == (n, width) and width:
-        if a.strides[0] == 0:
-            return np.ascontiguousarray(a[0]), 0
-        if a.flags.c_contiguous:
-            return a, width
-    if a.size == width and width:
-        return np.ascontiguousarray(a.reshape(width)), 0
-    return rows(a, n, width)
-
-
-def _take(table, idx):
-    a, stride = table
-    return a if stride == 0 else a[idx]
 
 
 def _model_blocks(model):

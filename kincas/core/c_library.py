@@ -1,0 +1,243 @@
+"""Compiled libraries built and cached on disk: casadi functions code-generated with a C loop.
+
+`Library` code-generates casadi functions together with a hand-written C driver that calls
+them, pairs each angle's sine and cosine into one call (`pair_sincos`), compiles the whole
+with the C compiler ($CC, else gcc or cc) and keeps the result in the cache directory
+(`cache_dir`) under a hash of its source, the compiler, its flags and casadi's version: a
+second process, or a second run, loads it without compiling. The cache keeps the MAX_CACHED
+most recently used libraries. When to compile is `kincas.core.compiled.Backend`'s choice.
+
+>>> pair_sincos("  a1=sin(a0);").strip()
+'a1=sin(a0);'
+"""
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+from .caches import Memo
+from .cancel import WAIT, checkpoint
+
+import casadi as ca
+
+MAX_CACHED = 200  # libraries kept in the cache directory; the least recently used go first
+# -Bsymbolic: each library's own symbols bind inside it; -fno-semantic-interposition lets the
+# compiler inline the casadi functions into the C loop (about 15 % of a sweep's time); errno is
+# never read. Without fast-math: IEEE arithmetic, NaN tests intact. _PLAIN: a second try.
+_FLAGS = ["-O3", "-fno-semantic-interposition", "-fno-math-errno", "-shared", "-fPIC", "-Wl,-Bsymbolic"]
+_PLAIN = ["-O2", "-shared", "-fPIC"]
+# loaded libraries by path (the path holds the hash); threads of this process load (and
+# compile) one at a time
+_LIBS = Memo("compiled libraries", gate=threading.RLock())
+
+try:
+    import fcntl
+except ImportError:  # not on POSIX: compiles may race, but os.replace keeps each load whole
+    fcntl = None
+
+
+# --- building and caching ---
+
+
+def cache_dir() -> Path:
+    """Where compiled libraries are kept: $KINCAS_CACHE, else $XDG_CACHE_HOME/kincas, else
+    ~/.cache/kincas.
+
+    >>> cache_dir().name == "kincas" or "KINCAS_CACHE" in os.environ
+    True
+    """
+    if os.environ.get("KINCAS_CACHE"):
+        return Path(os.environ["KINCAS_CACHE"])
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "kincas"
+
+
+def compiling_disabled() -> bool:
+    """$KINCAS_NO_COMPILE set (to anything but 0): always use the virtual machine."""
+    return os.environ.get("KINCAS_NO_COMPILE", "") not in ("", "0")
+
+
+class Library:
+    """Casadi functions code-generated with a C driver, compiled once, cached on disk.
+
+    `defines` become C macros ahead of the driver (SZ_ARG, SZ_RES, SZ_IW, SZ_W, the largest
+    work sizes of the functions, are added); `signatures` gives the ctypes argument types of
+    the driver's entry points (each returns an int). `cached` says whether it was found
+    built; `times` the seconds spent generating, compiling and loading. `load()` raises on
+    any failure.
+    """
+
+    def __init__(self, tag: str, functions: list[ca.Function], driver: str, defines: dict,
+                 signatures: dict[str, list]):
+        t0 = time.perf_counter()
+        cg = ca.CodeGenerator(f"{tag}.c", {"with_header": False})
+        for f in functions:
+            cg.add(f)
+        work = {"SZ_ARG": [f.sz_arg() for f in functions], "SZ_RES": [f.sz_res() for f in functions],
+                "SZ_IW": [f.sz_iw() for f in functions], "SZ_W": [f.sz_w() for f in functions]}
+        defines = {**{k: max([1, *v]) for k, v in work.items()}, **defines}
+        self.source = (_PRELUDE + pair_sincos(cg.dump())
+                       + "".join(f"#define {k} {v}\n" for k, v in defines.items()) + driver)
+        self.cc = os.environ.get("CC") or shutil.which("gcc") or shutil.which("cc")
+        key = hashlib.sha256("\n".join([self.source, str(self.cc), *_FLAGS, ca.__version__]).encode())
+        self.path = cache_dir() / f"{tag}-{key.hexdigest()[:24]}.so"
+        self.cached = str(self.path) in _LIBS or self.path.exists()
+        self.signatures = signatures
+        self.times = {"generate": time.perf_counter() - t0, "compile": 0.0, "load": 0.0}
+
+    def load(self) -> ctypes.CDLL:
+        """The loaded library, compiled first if it is not in the cache.
+
+        Safe from several threads and processes at once: threads of a process take a lock,
+        processes an exclusive `flock` on a lock file beside the library, and whoever gets it
+        second finds the library built. A library is written under a temporary name and
+        renamed into place, so nobody ever loads a half-written one."""
+        return _LIBS.get_or_build(str(self.path), self._build)  # waiting, Ctrl-C is heard
+
+    def _build(self) -> ctypes.CDLL:
+        if not self.path.exists():
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            with _file_lock(self.path.with_suffix(".lock")):
+                if not self.path.exists():  # another process may have built it meanwhile
+                    self._compile()
+                    _prune(self.path.parent)
+        else:
+            os.utime(self.path)  # recently used: pruned last
+        t0 = time.perf_counter()
+        lib = ctypes.CDLL(str(self.path))
+        for name, args in self.signatures.items():
+            getattr(lib, name).argtypes, getattr(lib, name).restype = args, ctypes.c_int
+        self.times["load"] = time.perf_counter() - t0
+        return lib
+
+    def _compile(self):
+        if self.cc is None:
+            raise RuntimeError("no C compiler found (set CC)")
+        t0 = time.perf_counter()
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(dir=self.path.parent) as tmp:
+            src, out = Path(tmp) / "k.c", Path(tmp) / "k.so"
+            src.write_text(self.source)
+            for flags in (_FLAGS, _PLAIN):  # a compiler that lacks a flag still gets a try
+                code, err = _run([self.cc, *flags, str(src), "-o", str(out), "-lm"], timeout=600)
+                if code == 0:
+                    break
+            if code != 0:
+                raise RuntimeError(f"{self.cc} failed: {err.strip()[-400:]}")
+            os.replace(out, self.path)  # atomic: other processes see all of it or nothing
+        self.times["compile"] = time.perf_counter() - t0
+
+
+def _run(cmd, timeout: float) -> tuple[int, str]:
+    """(exit status, standard error) of `cmd`; killed on Ctrl-C, even from a worker thread
+    (kincas/core/cancel.py: a compile can take seconds, the exit must not wait for it)."""
+    group = os.name == "posix"  # the compiler's own children (cc1, as) go with it
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=group)
+    end = time.monotonic() + timeout
+    try:
+        while True:
+            try:
+                _, err = proc.communicate(timeout=WAIT)
+                return proc.returncode, err
+            except subprocess.TimeoutExpired:
+                checkpoint()
+                if time.monotonic() > end:
+                    raise
+    except BaseException:
+        try:
+            os.killpg(proc.pid, 9) if group else proc.kill()
+        except OSError:
+            pass
+        proc.communicate()
+        raise
+
+
+class _file_lock:
+    """An exclusive lock on a file, held between processes (a no-op without fcntl)."""
+
+    def __init__(self, path: Path):
+        self.path = path
+
+    def __enter__(self):
+        self.fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            while fcntl is not None:  # another process compiles: wait, hearing Ctrl-C
+                try:
+                    fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                    break
+                except BlockingIOError:
+                    checkpoint()
+                    time.sleep(WAIT / 2)
+        except BaseException:
+            os.close(self.fd)
+            raise
+        return self
+
+    def __exit__(self, *exc):
+        if fcntl is not None:
+            fcntl.flock(self.fd, fcntl.LOCK_UN)
+        os.close(self.fd)
+
+
+# --- sine and cosine of an angle in one call ---
+
+_PRELUDE = """#define _GNU_SOURCE
+#include <math.h>
+#ifdef __GLIBC__
+#define kincas_sincos(x, s, c) sincos(x, s, c)
+#else
+#define kincas_sincos(x, s, c) (*(s) = sin(x), *(c) = cos(x))
+#endif
+"""
+_TRIG = re.compile(r"^(\s*)(a\w+)=(sin|cos)\((a\w+)\);$")
+
+
+def pair_sincos(source: str) -> str:
+    r"""Casadi's generated `x=sin(a); ... y=cos(a);` as one sincos call (glibc's, which gives
+    the same values): each angle's sine and cosine cost one call. Most of a sweep's time is
+    this trigonometry, and once the casadi functions are inlined into the C loop the
+    compiler stops pairing them itself. A pair is joined only within one block and while
+    `a` is not reassigned between; anything else is left as it is.
+
+    >>> print(pair_sincos("  a1=sin(a0);\n  a2=(a1*a0);\n  a3=cos(a0);"))
+      casadi_real kt0; kincas_sincos(a0, &a1, &kt0);
+      a2=(a1*a0);
+      a3=kt0;
+    """
+    lines, n = source.split("\n"), 0
+    for i, line in enumerate(lines):
+        m = _TRIG.match(line)
+        if not m or m[2] == m[4]:  # x=sin(x): the angle is overwritten here
+            continue
+        indent, target, f, a = m.groups()
+        for j in range(i + 1, len(lines)):
+            mj = _TRIG.match(lines[j])
+            if mj and mj[4] == a and mj[3] != f:
+                s, c = (target, f"kt{n}") if f == "sin" else (f"kt{n}", target)
+                lines[i] = f"{indent}casadi_real kt{n}; kincas_sincos({a}, &{s}, &{c});"
+                lines[j] = f"{mj[1]}{mj[2]}=kt{n};"
+                n += 1
+                break
+            if "{" in lines[j] or "}" in lines[j] or re.match(rf"^\s*{a}=", lines[j]):
+                break
+    return "\n".join(lines)
+
+
+def _prune(folder: Path) -> None:
+    """Remove the least recently used libraries beyond MAX_CACHED (a loaded one may go: its
+    file stays open until the process ends)."""
+    try:
+        libs = sorted(folder.glob("kincas_*.so"), key=lambda f: f.stat().st_mtime)
+        for f in libs[:max(0, len(libs) - MAX_CACHED)]:
+            f.unlink(missing_ok=True)
+            f.with_suffix(".lock").unlink(missing_ok=True)
+    except OSError:  # another process pruned first: nothing lost
+        pass

@@ -1,0 +1,129 @@
+"""The arrays of one fast sweep and the call that solves a stretch of it (`FastRun`).
+
+A `FastRun` binds, once per sweep, one block of memory holding everything the kernel reads or
+writes for it (L and the acceptance thresholds, the state of the last solved pose, the
+unknowns, the measures of INFO, the reported quantities and the singular measures), and
+`advance` hands its addresses to the compiled C loop, else to the virtual machine of its
+`FastSweeper` (kincas/core/fast.py, which decides what to do with a rejected pose). `_rows`
+and `_take` read rates and accelerations given as a table or as one row for every pose.
+
+>>> _rows([1.0, 2.0], 5, 2)[1], _rows(np.zeros((5, 2)), 5, 2)[1]
+(0, 2)
+"""
+from __future__ import annotations
+
+from itertools import accumulate
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .compiled import ptr, rows, table
+from .kernel import CORRECTION, JAC_CHANGE, NEAR, RESIDUAL, STEP
+
+if TYPE_CHECKING:
+    from .fast import FastSweeper
+
+INFO = ("residual", "step", "jac_change", "correction", "steps")
+_HEAD = np.array([np.nan, RESIDUAL, STEP, JAC_CHANGE, CORRECTION, NEAR])  # L, then thresholds
+
+
+class FastRun:
+    """The arrays of one sweep, bound once; `advance` solves a stretch of it per call.
+
+    `Q` (N, nq): the unknowns, NaN where not solved; `values` (len(report), N): the reported
+    quantities; `info` (5, N): per pose attempted, the measures named in INFO; `measures`
+    (groups + 1, N): per pose, the sign of det of each Assur group's block of g_q, then the
+    smallest lower bound of a group's smallest singular value (relative, columns scaled,
+    kincas/core/blocks.py); `accepted`: the poses the fast pass accepted; `solved`: by either
+    path (`FastSweeper.sweep` fills it); `first_bad`: where the last `advance` stopped. The
+    arrays are not initialised (filling 100,000 rows with NaN costs more than solving them):
+    rows that no `advance` or `record` reached are NaN only after `run` or `sweep` returns.
+    Everything the kernel writes belongs to this run: runs in several threads share nothing.
+    """
+
+    def __init__(self, sweeper: "FastSweeper", U, p, L, Ud=None, Udd=None):
+        self.sweeper, nq, nu = sweeper, sweeper.nq, sweeper.nu
+        self.U = np.ascontiguousarray(table(U, nu))
+        self.n = n = self.U.shape[0]
+        self.Ud = _rows(np.ones(nu) if Ud is None else Ud, n, nu)
+        self.Udd = _rows(np.zeros(nu) if Udd is None else Udd, n, nu)
+        self.p = np.ascontiguousarray(np.asarray(p, dtype=float).ravel())
+        # everything the kernel reads or writes of this run, inputs aside, in one block of
+        # memory: L and the thresholds, the state, Q, info, values, measures (its address
+        # is taken once, not per array and per call)
+        no, nm = len(sweeper.report), len(sweeper.blocks) + 1
+        o = self._off = list(accumulate([0, 6, sweeper.state_size, n * nq, 5 * n, no * n, nm * n]))
+        block = self._block = np.empty(o[-1])
+        block[:6] = _HEAD  # the thresholds, then L in its place
+        block[0] = L
+        self.L, self.thr, self._state = block[0:1], block[1:6], block[o[1]:o[2]]
+        self.Q, self.info = block[o[2]:o[3]].reshape(n, nq), block[o[3]:o[4]].reshape(5, n)
+        self.values, self.measures = block[o[4]:o[5]].reshape(no, n), block[o[5]:o[6]].reshape(nm, n)
+        self.accepted, self.solved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+        self.first_bad, self._s, self._addr, self.recorded = 0, None, None, 0
+        self.backend = None  # "compiled" or "virtual machine": what `advance` ran last
+
+    residual = property(lambda self: self.info[0], doc="max |g| / L at each pose (L: each group's)")
+    step = property(lambda self: self.info[1], doc="the last Newton step (negligible, applied)")
+    jac_change = property(lambda self: self.info[2], doc="max per group of sum |D^-1 (A_prev^-1 A - I) D|")
+    correction = property(lambda self: self.info[3], doc="max per group of ||D^-1 (q - q_pred)||_1")
+    iterations = property(lambda self: np.fmax(self.info[4], 0.0).astype(int),  # fmax: NaN -> 0
+                          doc="Newton steps taken at each pose (0 where none was attempted)")
+    signs = property(lambda self: self.measures[:-1].T, doc="(N, groups) signs of det per group")
+    sigma = property(lambda self: self.measures[-1], doc="smallest relative singular value bound")
+
+    def advance(self, start: int, q_last, u_last, stop: int | None = None) -> int:
+        """Solve poses start, start + 1, ... (before `stop`, default N) from the solved pose
+        (q_last, u_last) until one is rejected, and return its index (`stop` if none was).
+        The poses before it are accepted; the rejected pose keeps its `info` (why) and NaN in
+        `Q` and `values`. q_last None: go on from where the last call stopped, unrejected."""
+        sw, stop = self.sweeper, self.n if stop is None else min(stop, self.n)
+        if start >= stop or not (sw.nq and sw.nu):  # nothing to predict: all careful
+            return min(start, stop)
+        if q_last is not None or self._s is None:
+            self._s = sw.state(q_last, u_last, self.p, out=self._state)
+        s = self._s  # the C loop leaves the last accepted pose's state in it
+        lib = sw.backend.compiled(self.n)
+        self.backend = "virtual machine" if lib is None else "compiled"
+        if lib is not None:
+            if self._addr is None:  # addresses of the run's block and of its inputs
+                self._addr = (ptr(self._block), ptr(self.U), ptr(self.p), ptr(self.Ud[0]), ptr(self.Udd[0]))
+            a, aU, ap, aUd, aUdd = self._addr
+            o, sud, sudd, nq = self._off, self.Ud[1], self.Udd[1], sw.nq
+            k = start + lib.kincas_sweep(
+                stop - start, aU + 8 * start * sw.nu, ap, a, a + 8, sw.max_evals, a + 8 * o[1],
+                a + 8 * (o[2] + start * nq), a + 8 * (o[3] + start), self.n, aUd + 8 * start * sud, sud,
+                aUdd + 8 * start * sudd, sudd, a + 8 * (o[4] + start), a + 8 * (o[5] + start))
+        else:
+            k = sw._vm_advance(self, start, stop, s)
+        self.accepted[start:k] = self.solved[start:k] = True
+        if k < stop:
+            self.Q[k] = self.values[:, k] = self.measures[:, k] = np.nan
+        self.first_bad = k
+        return k
+
+    def record(self, k: int, sol) -> None:
+        """Store a carefully solved pose (an object with q, residual, iterations, ok, J)."""
+        self.recorded += 1
+        self.solved[k] = bool(sol.ok)
+        self.Q[k], self.values[:, k] = (sol.q if sol.ok else np.nan), np.nan  # values: see sweep
+        self.measures[:, k] = self.sweeper.measures(sol, self.U[k], self.p, self.L[0]) if sol.ok else np.nan
+        self.info[:, k] = [sol.residual, np.nan, np.nan, np.nan, sol.iterations]
+
+def _rows(a, n: int, width: int) -> tuple[np.ndarray, int]:
+    """`rows` (kincas/core/compiled.py) with its usual cases first: a C-contiguous (n, width)
+    table as it is, one row (or a table broadcast from one) as that row with stride 0."""
+    a = np.asarray(a, dtype=float)
+    if a.ndim == 2 and a.shape == (n, width) and width:
+        if a.strides[0] == 0:
+            return np.ascontiguousarray(a[0]), 0
+        if a.flags.c_contiguous:
+            return a, width
+    if a.size == width and width:
+        return np.ascontiguousarray(a.reshape(width)), 0
+    return rows(a, n, width)
+
+
+def _take(table, idx):
+    a, stride = table
+    return a if stride == 0 else a[idx]
