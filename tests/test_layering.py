@@ -198,12 +198,13 @@ def test_reading_a_scene_builds_no_model(monkeypatch):
     import tomllib
 
     import kincas.core.numeric as numeric
+    from kincas.core.caches import Memo
     from kincas.cli.scene import load
     from kincas.model.names import plain_quantity
     from conftest import EXAMPLES
 
     built = []
-    monkeypatch.setattr(numeric, "_CACHE", {})  # nothing cached: any model asked for is built
+    monkeypatch.setattr(numeric, "_CACHE", Memo(bound=64))  # nothing cached: any model asked for is built
     init = numeric.Model.__init__
 
     def spy(self, *a, **k):

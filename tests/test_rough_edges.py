@@ -193,13 +193,14 @@ def test_the_size_checks_build_no_model(capsys, tmp_path, monkeypatch):
     import kincas
     import kincas.core.numeric as numeric
     from kincas.cli.scene import loads
+    from kincas.core.caches import Memo
     from kincas.model.mechanism import solved_unknowns
     from conftest import EXAMPLES
     for path in sorted(EXAMPLES.glob("*.toml")):  # the same count as the model's own
         m = loads(path.read_text(encoding="utf-8")).mechanism
         assert solved_unknowns(m) == kincas.model_of(m).nq, path.name
     built = []
-    monkeypatch.setattr(numeric, "_CACHE", {})
+    monkeypatch.setattr(numeric, "_CACHE", Memo(bound=64))
     monkeypatch.setattr(numeric.Model, "__init__", lambda self, *a, **k: built.append(1) or 1 / 0)
     text = FAIRBAIRN + "\n[tolerance]\nstd = { a1 = 0.1 }\nsamples = 100000000\n"
     code, out, err = run_cli(capsys, "tolerance", write_scene(tmp_path, text))

@@ -30,6 +30,7 @@ from collections import OrderedDict
 import numpy as np
 
 from ..core.assembly import Placement, ambiguous, assemble
+from ..core.caches import Memo
 from ..core.fast import sweeper_for
 from ..core.guessed import guessed_start
 from ..model.mechanism import Mechanism
@@ -136,8 +137,8 @@ def prepared(model, m: Mechanism) -> Prepared:
 
 # --- the mechanisms last swept, by identity: their model and prepared data in one look-up ---
 
-_SEEN: dict = {}  # id(m) -> (m, model, Prepared); each entry keeps its m, so its id is its own
-_SEEN_LOCK = threading.Lock()
+# id(m) -> (m, model, Prepared); each entry keeps its m, so its id is its own
+_SEEN = Memo("mechanisms last swept", bound=RECENT)
 
 
 def model_and_prepared(m: Mechanism, model_of):
@@ -146,13 +147,8 @@ def model_and_prepared(m: Mechanism, model_of):
     structure key is every link and joint) nor repeats the deferred mobility check, which
     `model_of` runs (a mechanism is immutable: what was decided for it stays decided; a
     mechanism refused raises every time, since nothing is kept for it)."""
-    hit = _SEEN.get(id(m))  # (a dict read is atomic: no lock)
-    if hit is not None and hit[0] is m:
-        return hit[1], hit[2]
-    model = model_of(m)
-    pm = prepared(model, m)
-    with _SEEN_LOCK:
-        _SEEN[id(m)] = (m, model, pm)
-        while len(_SEEN) > RECENT:
-            del _SEEN[next(iter(_SEEN))]
+    def build():
+        model = model_of(m)
+        return m, model, prepared(model, m)
+    _, model, pm = _SEEN.get_or_build(id(m), build)
     return model, pm

@@ -19,10 +19,11 @@ in kincas/core/designs_kernel.py.
 from __future__ import annotations
 
 import threading
-import weakref
 
 import casadi as ca
 import numpy as np
+
+from .caches import Memo
 
 # --- g and its derivatives at many columns ---
 
@@ -96,11 +97,10 @@ def batched_solve(J, b):
 
 # --- one lock per compiled model for the Python-side numerics (Model keeps work buffers) ---
 
-_LOCKS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
-_LOCKS_LOCK = threading.Lock()
+# unnamed: clear_all() must not forget a lock some thread holds
+_LOCKS = Memo(weak=True)
 
 
 def model_lock(model) -> threading.RLock:
     """The one lock of `model` (reentrant), for the callers of its numerics on threads."""
-    with _LOCKS_LOCK:
-        return _LOCKS.setdefault(model, threading.RLock())
+    return _LOCKS.get_or_build(model, threading.RLock)

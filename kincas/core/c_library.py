@@ -23,7 +23,8 @@ import threading
 import time
 from pathlib import Path
 
-from .cancel import WAIT, checkpoint, held
+from .caches import Memo
+from .cancel import WAIT, checkpoint
 
 import casadi as ca
 
@@ -33,8 +34,9 @@ MAX_CACHED = 200  # libraries kept in the cache directory; the least recently us
 # never read. Without fast-math: IEEE arithmetic, NaN tests intact. _PLAIN: a second try.
 _FLAGS = ["-O3", "-fno-semantic-interposition", "-fno-math-errno", "-shared", "-fPIC", "-Wl,-Bsymbolic"]
 _PLAIN = ["-O2", "-shared", "-fPIC"]
-_LIBS: dict[str, ctypes.CDLL] = {}  # loaded libraries by path (the path holds the hash)
-_LIBS_LOCK = threading.Lock()  # threads of this process load (and compile) one at a time
+# loaded libraries by path (the path holds the hash); threads of this process load (and
+# compile) one at a time
+_LIBS = Memo("compiled libraries", gate=threading.RLock())
 
 try:
     import fcntl
@@ -97,24 +99,23 @@ class Library:
         processes an exclusive `flock` on a lock file beside the library, and whoever gets it
         second finds the library built. A library is written under a temporary name and
         renamed into place, so nobody ever loads a half-written one."""
-        key = str(self.path)
-        with held(_LIBS_LOCK):  # Ctrl-C heard while another thread compiles
-            if key not in _LIBS:
-                if not self.path.exists():
-                    self.path.parent.mkdir(parents=True, exist_ok=True)
-                    with _file_lock(self.path.with_suffix(".lock")):
-                        if not self.path.exists():  # another process may have built it meanwhile
-                            self._compile()
-                            _prune(self.path.parent)
-                else:
-                    os.utime(self.path)  # recently used: pruned last
-                t0 = time.perf_counter()
-                lib = ctypes.CDLL(key)
-                for name, args in self.signatures.items():
-                    getattr(lib, name).argtypes, getattr(lib, name).restype = args, ctypes.c_int
-                _LIBS[key] = lib
-                self.times["load"] = time.perf_counter() - t0
-            return _LIBS[key]
+        return _LIBS.get_or_build(str(self.path), self._build)  # waiting, Ctrl-C is heard
+
+    def _build(self) -> ctypes.CDLL:
+        if not self.path.exists():
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            with _file_lock(self.path.with_suffix(".lock")):
+                if not self.path.exists():  # another process may have built it meanwhile
+                    self._compile()
+                    _prune(self.path.parent)
+        else:
+            os.utime(self.path)  # recently used: pruned last
+        t0 = time.perf_counter()
+        lib = ctypes.CDLL(str(self.path))
+        for name, args in self.signatures.items():
+            getattr(lib, name).argtypes, getattr(lib, name).restype = args, ctypes.c_int
+        self.times["load"] = time.perf_counter() - t0
+        return lib
 
     def _compile(self):
         if self.cc is None:

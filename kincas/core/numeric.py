@@ -29,6 +29,7 @@ import casadi as ca
 import numpy as np
 
 from ..model.mechanism import Mechanism, needs_rank_test
+from .caches import Memo
 from .first_pose import FirstPose
 from .newton import lsolve as _lsolve, newton as _newton
 from .redundant import decide
@@ -46,8 +47,7 @@ def _structure_key(m: Mechanism):
             m.gears, m.racks, m.cams, m.gravity, m.loads)
 
 
-_CACHE: dict = {}
-_CACHE_LOCK = threading.Lock()
+_CACHE = Memo("models by structure", bound=64)
 
 
 def model_of(m: Mechanism, check: bool = True) -> "Model":
@@ -80,15 +80,8 @@ def model_of(m: Mechanism, check: bool = True) -> "Model":
     >>> model.nq, [b.size for b in model.blocks], model_of(m.with_parameters()) is model
     (2, [2], True)
     """
-    key = _structure_key(m)
-    with _CACHE_LOCK:
-        model = _CACHE.get(key)
-    if model is None:
-        model = Model(Symbolic(m))  # Symbolic never reads parameter values
-        with _CACHE_LOCK:  # another thread may have built it meanwhile: keep the first
-            model = _CACHE.setdefault(key, model)
-            while len(_CACHE) > 64:
-                _CACHE.pop(next(iter(_CACHE)))
+    # built once per structure, however many threads ask (Symbolic never reads parameter values)
+    model = _CACHE.get_or_build(_structure_key(m), lambda: Model(Symbolic(m)))
     if check and needs_rank_test(m):
         decide(m, model)
     return model
@@ -166,9 +159,9 @@ class Model(FirstPose):
                                            [self.f_local(sym.u, sym.p), self.f_ground(sym.u, sym.p)]))
         self._nlp = None
         self._qfun: dict[tuple, ca.Function] = {}
-        self._memo: dict = {}
         self._blocks = None
         self._lock = threading.RLock()  # guards the lazily built members above
+        self._memo = Memo(gate=self._lock)  # builds of one model never overlap (CasADi symbols)
         self._resjac, self._tangent = _Call(sym.f_resjac), _Call(sym.f_tangent)
         self._res = _Call(sym.f_res)
         self.structure = Structure(sym)
@@ -302,10 +295,7 @@ class Model(FirstPose):
     def memo(self, key, build):
         """`build()` once per `key` for this structure (a Function that other modules derive
         from the model), kept with the model; safe from several threads."""
-        with self._lock:
-            if key not in self._memo:
-                self._memo[key] = build()
-            return self._memo[key]
+        return self._memo.get_or_build(key, build)
 
     # --- quantities over many poses ---
     def quantity_function(self, names: tuple[str, ...]) -> ca.Function:

@@ -47,12 +47,12 @@ that overdrive the chain (moved independently, they find no assembly).
 from __future__ import annotations
 
 import math
-import threading
 
 import numpy as np
 
 from ..errors import ModelError
 from ..model import mechanism as _mechanism
+from .caches import Memo
 from .newton import newton
 from .tolerances import GENERIC_MOVE as MOVE, JITTER, RANK as RANK_TOL, RANK_GAP, SAME_ASSEMBLY
 
@@ -233,8 +233,8 @@ def rank_test(m, model):
 
 # --- the decision, once per mechanism ---
 
-_DECIDED: dict = {}  # mechanism -> redundant equations, or the ModelError message
-_LOCK = threading.Lock()
+# mechanism -> redundant equations, or the ModelError message
+_DECIDED = Memo("redundant-joint decisions", bound=256)
 
 
 def decide(m, model) -> int:
@@ -253,16 +253,13 @@ def decide(m, model) -> int:
     """
     if not _mechanism.needs_rank_test(m):
         return 0
-    with _LOCK:
-        known = _DECIDED.get(m)
-    if known is None:
-        free, redundant, ok = rank_test(m, model)
-        known = redundant if ok else _mechanism.mobility_problem(m, free, tested=True)
-        with _LOCK:
-            _DECIDED[m] = known
-            while len(_DECIDED) > 256:
-                _DECIDED.pop(next(iter(_DECIDED)))
+    known = _DECIDED.get_or_build(m, lambda: _decision(m, model))
     if isinstance(known, str):
         raise ModelError([known])
     return known
+
+
+def _decision(m, model):
+    free, redundant, ok = rank_test(m, model)
+    return redundant if ok else _mechanism.mobility_problem(m, free, tested=True)
 
