@@ -79,7 +79,26 @@ class SweepMethod(ABC):
         """
 
 
-class Fast(SweepMethod):
+class _Shipped(SweepMethod):
+    """The methods kincas ships: values, equal where their settings (their __slots__) are,
+    printed as they are written."""
+
+    __slots__ = ()
+
+    def _settings(self) -> tuple:
+        return tuple((k, getattr(self, k)) for k in type(self).__slots__)
+
+    def __eq__(self, other):
+        return type(other) is type(self) and other._settings() == self._settings()
+
+    def __hash__(self):
+        return hash((type(self), self._settings()))
+
+    def __repr__(self):
+        return f"kincas.{type(self).__name__}({', '.join(f'{k}={v!r}' for k, v in self._settings())})"
+
+
+class Fast(_Shipped):
     """The default method: a compiled pass over the poses, checked pose by pose; every pose
     it does not accept is re-solved on the careful path, and the pass restarts after it.
 
@@ -126,17 +145,8 @@ class Fast(SweepMethod):
         run = problem.fast_pass(self.compile)
         return run if run is not None else problem.careful_pass()
 
-    def __eq__(self, other):
-        return type(other) is Fast and other.compile is self.compile
 
-    def __hash__(self):
-        return hash((Fast, self.compile))
-
-    def __repr__(self):
-        return f"kincas.Fast(compile={self.compile!r})"
-
-
-class Careful(SweepMethod):
+class Careful(_Shipped):
     """The careful path at every pose: Newton from the last solved pose (predicted along the
     exact tangent), cutting the step where it fails; slower than `Fast`, for checking it.
 
@@ -168,15 +178,6 @@ class Careful(SweepMethod):
         True
         """
         return problem.careful_pass()
-
-    def __eq__(self, other):
-        return type(other) is Careful
-
-    def __hash__(self):
-        return hash(Careful)
-
-    def __repr__(self):
-        return "kincas.Careful()"
 
 
 # the strings' methods, made once: a warm sweep pays one dictionary look-up for them
