@@ -94,7 +94,9 @@ def test_ctrl_c_stops_a_multistart_optimisation(tmp_path):
     # 3,000 starts: about two minutes; most of it inside IPOPT, which must not swallow Ctrl-C
     scene = write_scene(tmp_path, (EXAMPLES / "synthesis_function.toml").read_text(encoding="utf-8"))
     proc = kincas("optimize", scene, "--starts", "3000")
-    waited, err = interrupt(proc)
+    # 5 s: the starts are surely under way (in a fresh venv on a loaded machine, 3.5 s once fell
+    # in the setup, and the process did not exit within 10 s: noted on issue [15], not masked here)
+    waited, err = interrupt(proc, after=5.0)
     assert_interrupted(proc, waited, err)
 
 
