@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.assembly import NEAR, assemble, modes
+from ..core.assembly import assemble, modes
 # the first pose of a sweep (its home is the core: `kincas modes` and `range` start there too)
 from ..core.assembly import ambiguous as _ambiguous, first_pose as _first, no_assembly as _no_assembly  # noqa: F401
 from ..core import branch
 from ..core.numeric import Model, Solution
 from ..core.limits import on_step, polish_singular
-from ..core.tolerances import BRANCH, STRAIGHT, WATCH
+from ..core.tolerances import BRANCH, NEAR_SINGULAR, STRAIGHT, WATCH
 from ..model.mechanism import Mechanism
 from .resume import carry_groups, larger_groups, resume_label
 
@@ -221,7 +221,7 @@ def _crossed(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
     s1, c1 = modes(model, sol.J, L)
     for i in np.flatnonzero(branch.changed(s0, s1)):
         start, d = ((q0, u0), u1 - u0) if c0[i] <= c1[i] else ((sol.q, u1), u0 - u1)
-        if min(c0[i], c1[i]) < NEAR and polish_singular(model, *start, p, L, [int(i)]) is not None:
+        if min(c0[i], c1[i]) < NEAR_SINGULAR and polish_singular(model, *start, p, L, [int(i)]) is not None:
             continue  # that end is the singular position (within rounding)
         found = locate_singular(model, start[0], start[1], p, L, d, group=int(i))
         if not on_step(found):

@@ -389,4 +389,4 @@ def _modes(model, J, L) -> np.ndarray:
 def _thresholds() -> np.ndarray:
     """The fast pass's acceptance thresholds, as `FastRun` sets them."""
     from ..core import fast
-    return np.array([fast.RESIDUAL, fast.STEP, fast.JAC_CHANGE, fast.CORRECTION, fast.NEAR])
+    return np.array([fast.RESIDUAL, fast.STEP, fast.JAC_CHANGE, fast.CORRECTION, fast.KERNEL_NEAR])

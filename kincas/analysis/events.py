@@ -4,7 +4,7 @@ The sweep hands over, for every solved pose, each Assur group's mode (the sign o
 of g_q's determinant) and conditioning (its block's sigma_min / sigma_max, columns scaled to
 O(1): a pure number, the same at 1e-6 m and at 1e6 m); see kincas/core/assembly.py. Then:
 
-- a pose where a group's conditioning is below NEAR may sit *at* a singular position (Newton
+- a pose where a group's conditioning is below NEAR_SINGULAR may sit *at* a singular position (Newton
   stops about sqrt(TOL) from one): `polish_singular` decides, and where it converges the
   pose is moved exactly onto it, flagged, and its velocities and accelerations are null
   (g_q has no inverse there: `null_derivatives`), so no wrong number is ever reported;
@@ -34,9 +34,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..core import branch
-from ..core.assembly import NEAR, group_links, modes, refine
+from ..core.assembly import group_links, modes, refine
 from ..core.limits import on_step, polish_singular
-from ..core.tolerances import CLASSIFY, REACHED, SAME_INPUT
+from ..core.tolerances import CLASSIFY, NEAR_SINGULAR, REACHED, SAME_INPUT
 from ..model.names import parse_quantity
 from .singular import FLAG_SIGMA, classify, locate_singular, scaled_jacobians
 
@@ -104,15 +104,15 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
         return classify(*scaled_jacobians(model, q, u, p, L), tol=tol) or "singular"
 
     # poses at a singular position: exactly onto it, flagged, one event per group
-    for k in np.flatnonzero(ok & ~(sigma > NEAR)):
-        groups = [int(i) for i in np.flatnonzero(measure(k)[1] < NEAR)]
+    for k in np.flatnonzero(ok & ~(sigma > NEAR_SINGULAR)):
+        groups = [int(i) for i in np.flatnonzero(measure(k)[1] < NEAR_SINGULAR)]
         if not groups:
             continue
         q = polish_singular(model, Q[k], U[k], p, L, groups)
         if q is None:  # next to one, not at it: positions to rounding, derivatives null,
             # since an error of rounding in the input moves them by more than 1e-6 there
             Q[k], at[k] = refine(model, Q[k], U[k], p, L), True
-            flags[k] = flags[k] or kind_at(Q[k], U[k], tol=NEAR)
+            flags[k] = flags[k] or kind_at(Q[k], U[k], tol=NEAR_SINGULAR)
             step = U[k + 1] - U[k] if k + 1 < n else U[k] - U[k - 1] if k else None
             for i in groups if step is not None and np.any(step) else ():
                 found = locate_singular(model, Q[k], U[k], p, L, step, group=i)
@@ -176,9 +176,9 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
 
 def _nothing_met(ok, signs, sigma) -> bool:
     """Whether the sweep met no singular position and no gap: every pose solved, every
-    group well conditioned at every pose (none near NEAR or FLAG_SIGMA) and in one mode
+    group well conditioned at every pose (none near NEAR_SINGULAR or FLAG_SIGMA) and in one mode
     throughout. The usual sweep: then none of the searches below has anything to look at."""
-    if not ok.all() or not sigma.min(initial=np.inf) > max(NEAR, 1e3 * FLAG_SIGMA):  # (NaN: not)
+    if not ok.all() or not sigma.min(initial=np.inf) > max(NEAR_SINGULAR, 1e3 * FLAG_SIGMA):  # (NaN: not)
         return False
     signs = np.asarray(signs)
     return bool((signs == signs[:1]).all())

@@ -37,7 +37,7 @@ import numpy as np
 from .newton import newton
 from .turns import nearest, settle, tied, turns, wandered
 from .numeric import Solution
-from .tolerances import ACCEPT, NEAR_SINGULAR as NEAR, ROUNDING_REL, SIGN_TOL, TOL  # noqa: F401
+from .tolerances import ACCEPT, NEAR_SINGULAR, ROUNDING_REL, SIGN_TOL, TOL  # noqa: F401
 
 
 # --- the groups: blocks of g_q ---

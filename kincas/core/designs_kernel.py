@@ -7,7 +7,7 @@ truly at once (a ctypes call releases the GIL):
 1. its first pose is continued from the nominal design's solved first pose q0 (parameters
    p0) to its own parameters p along p(t) = p0 + t (p - p0), in steps of at most STEP times
    its size in every parameter: a predictor dq = -g_q^-1 g_p dp (a directional derivative,
-   solved group by group), then Newton until its step is below NEAR (at most NEWTON steps);
+   solved group by group), then Newton until its step is below KERNEL_NEAR (at most NEWTON steps);
    a step is kept only when max |g| / L <= ACCEPT and every Assur group's det g_q kept the
    nominal's sign (the assembly branch, group by group);
 2. the kernel's state is made there (g_q's diagonal blocks, the tangent dq/du), and the
@@ -45,7 +45,7 @@ import numpy as np
 from .blocks import block_measures, block_solve, diagonal_blocks
 from .compiled import Backend, Library, ptr, rows
 from .fast import COMPILE_MAX, SWEEP_SIG, sweeper_for
-from .kernel import NEAR, SWEEP_C
+from .kernel import KERNEL_NEAR, SWEEP_C
 from .tolerances import ACCEPT, PARAM_STEP as STEP  # largest parameter change per step, over the size
 MAX_STEPS = 64  # continuation steps per design at most
 NEWTON = 8  # Newton steps per continuation step at most
@@ -74,7 +74,7 @@ def continuation_functions(sym, blocks) -> list[ca.Function]:
             ca.Function("kT", [q, u, p], [diagonal_blocks(Jq, blocks), d(-block_solve(Jq, Ju, blocks))], o)]
 
 
-# --- the C loop (NQ, NU, NO, NJ, NP, NG sizes; c = STEP, MAX_STEPS, NEWTON, ACCEPT, NEAR) ---
+# --- the C loop (NQ, NU, NO, NJ, NP, NG sizes; c = STEP, MAX_STEPS, NEWTON, ACCEPT, KERNEL_NEAR) ---
 
 _LOOP_C = """
 /* q <- design p's first pose, continued from (q0, p0) at u0; 0 if it leaves the branch */
@@ -241,7 +241,7 @@ class DesignsLoop:
             return stops.astype(int)
         (Udv, sud), (Uddv, sudd) = rows(Ud, n, self.nu), rows(Udd, n, self.nu)
         info = np.empty(5 * n)
-        c = np.array([STEP, MAX_STEPS, NEWTON, ACCEPT, NEAR])
+        c = np.array([STEP, MAX_STEPS, NEWTON, ACCEPT, KERNEL_NEAR])
         q0, p0 = np.ascontiguousarray(q0, dtype=float), np.ascontiguousarray(p0, dtype=float)
         L0 = np.array([float(L0)])
         lib.kincas_designs_full(nd, n, ptr(U), ptr(P), ptr(Ls), ptr(q0), ptr(p0), ptr(L0), ptr(c),

@@ -47,7 +47,7 @@ from .compiled import CHUNK, Backend, Library, QuantityEvaluator  # noqa: F401 (
 from .fast_run import INFO, FastRun, _rows, _take  # noqa: F401 (INFO, _rows: their old home)
 from .fast_vm import VM_CHUNKS, VM_FLAT, VM_SKIP, VirtualMachineSweep, _Buffered  # noqa: F401
 from .group_kernel import kernel_sizes
-from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, NEAR, RESIDUAL, STEP, SWEEP_C,  # noqa: F401
+from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, KERNEL_NEAR, RESIDUAL, STEP, SWEEP_C,  # noqa: F401
                      kernel_functions, state_function)
 
 # Kernel size, in casadi instructions, beyond which compiling costs more than it saves: gcc

@@ -18,13 +18,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .compiled import ptr, rows, table
-from .kernel import CORRECTION, JAC_CHANGE, NEAR, RESIDUAL, STEP
+from .kernel import CORRECTION, JAC_CHANGE, KERNEL_NEAR, RESIDUAL, STEP
 
 if TYPE_CHECKING:
     from .fast import FastSweeper
 
 INFO = ("residual", "step", "jac_change", "correction", "steps")
-_HEAD = np.array([np.nan, RESIDUAL, STEP, JAC_CHANGE, CORRECTION, NEAR])  # L, then thresholds
+_HEAD = np.array([np.nan, RESIDUAL, STEP, JAC_CHANGE, CORRECTION, KERNEL_NEAR])  # L, then thresholds
 
 
 class FastRun:

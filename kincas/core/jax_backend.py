@@ -5,7 +5,7 @@ backend="jax")`. The arithmetic is the fast kernel's (kincas/core/kernel.py), no
 its casadi SX Functions kP (the prediction along the tangent), kN (a Newton step, group by
 group) and kF (g_q, the tangent, the acceptance measures and the reported quantities) are
 translated instruction by instruction into JAX functions by `jaxadi`, and driven as the C
-loop drives them: kP, kN until its step is below NEAR (at most MAX_EVALS times, a
+loop drives them: kP, kN until its step is below KERNEL_NEAR (at most MAX_EVALS times, a
 `lax.while_loop`), kF. For each design a `lax.scan` carries the kernel's state (q, g_q's
 diagonal blocks, the tangents and inputs of the last two poses) over the poses, and `vmap`
 runs the designs side by side; `jit` compiles it once per structure and shape (kept by the

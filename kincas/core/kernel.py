@@ -17,7 +17,7 @@ so their size grows with the number of groups, not with nq^3:
 One stopping rule: a pose is converged when the Newton step that would follow is below STEP
 (radians, or lengths / L) and the residual below RESIDUAL; that last step is applied, so a
 pose ends where quadratic convergence puts it (rounding). kN iterates until its step is
-below NEAR (quadratic convergence then makes the next one ~NEAR^2), and kF, which needs g
+below KERNEL_NEAR (quadratic convergence then makes the next one ~KERNEL_NEAR^2), and kF, which needs g
 and g_q at the final q anyway, gives that next step: a pose usually costs one or two kN and
 one kF. Where convergence is not quadratic (near a singular position) the next step stays
 above STEP and the pose goes to the careful path, whose Newton goes on while its steps
@@ -31,13 +31,13 @@ import casadi as ca
 from .group_kernel import GroupFunctions, _max_abs
 from .structure import Structure
 from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size
-from .tolerances import ACCEPT, CORRECTION, JAC_CHANGE, KERNEL_NEAR as NEAR, MAX_EVALS, TOL  # noqa: F401
+from .tolerances import ACCEPT, CORRECTION, JAC_CHANGE, KERNEL_NEAR, MAX_EVALS, TOL  # noqa: F401
 
 RESIDUAL = ACCEPT  # max |g| / L at an accepted pose, as on the careful path
 # The next Newton step's largest entry (radians, or lengths / L), applied before stopping: the
 # largest entry, not a sum, so that rounding in a long chain of groups does not add up past it
 STEP = TOL
-# JAC_CHANGE, CORRECTION, MAX_EVALS and NEAR (KERNEL_NEAR): kincas/core/tolerances.py
+# JAC_CHANGE, CORRECTION, MAX_EVALS and KERNEL_NEAR: kincas/core/tolerances.py
 # From this many groups on, kN and kF call one small function per kind of group
 # (kincas/core/group_kernel.py) instead of being one expression. Measured on 40 chained
 # four-bars: gcc -O3 takes 1.6 s of CPU instead of 6.3, a pose 7.4 us instead of 5.0 (the
@@ -120,7 +120,7 @@ def state_function(sym, blocks) -> ca.Function:
 
 def vm_step(kP, kN, kF, kL, nq, nu, max_evals, skip: bool = True) -> ca.Function:
     """One pose for the virtual machine, the compiled loop's arithmetic: kN evaluated until
-    its step is below NEAR (at most max_evals times), then kF.
+    its step is below KERNEL_NEAR (at most max_evals times), then kF.
     With `skip`, each later evaluation is a switch that the virtual machine skips once
     converged, so a pose costs what it costs in C (a large kernel: 40 chained four-bars);
     without, the pose is one flat SX function evaluating kN max_evals times, q held once
