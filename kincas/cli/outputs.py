@@ -60,6 +60,9 @@ def check_outputs(args, mechanism=None, poses: int | None = None) -> None:
         bad = [p for p in _names(args.paths) if p not in known]
         if bad:
             _fail(f"--paths: unknown point(s) {', '.join(bad)} (points: {', '.join(sorted(known))})")
+    if (getattr(args, "forces", False) or getattr(args, "centres", False)) and not any(
+            getattr(args, a, None) for a in ("plot", "animate", "html", "svg", "dxf")):
+        _fail("--forces, --centres: they draw on the pictures; give --plot, --animate, --html, --svg or --dxf")
     geo = {k: _names(getattr(args, k, None) or "") for k in ("evolute", "centrodes")}
     if any(geo.values()):
         if not getattr(args, "plot", None):
@@ -123,15 +126,17 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
     captions = [_caption(scene, sweep, inputs, i) for i in range(len(sweep))]
     solved = _SharedPaths(m, sweep, paths, [a for a in ("plot", "animate", "html", "svg", "dxf")
                                             if getattr(args, a, None)])
+    over = {"forces": bool(getattr(args, "forces", False)), "centres": bool(getattr(args, "centres", False))}
     jobs = [("csv", lambda p: write_csv(p, sweep, scene)),
             ("plot", lambda p: _save_drawing(p, m, sweep, pose, paths, captions, length,
                                              _names(getattr(args, "evolute", None) or ""),
-                                             _names(getattr(args, "centrodes", None) or ""), solved())),
-            ("animate", lambda p: _animate(p, m, sweep, paths, captions, length, _rendering(args), solved())),
+                                             _names(getattr(args, "centrodes", None) or ""), solved(), **over)),
+            ("animate", lambda p: _animate(p, m, sweep, paths, captions, length, _rendering(args), solved(),
+                                           **over)),
             ("plot_quantities", lambda p: savefig(plot_quantities(sweep, scene=scene), p, dpi=100)),
-            ("html", lambda p: _html(p, m, sweep, scene, paths, solved.dense())),
-            ("svg", lambda p: _svg(p, m, sweep, scene, pose, paths, solved.dense())),
-            ("dxf", lambda p: _dxf(p, m, sweep, scene, pose, paths, solved.dense()))]
+            ("html", lambda p: _html(p, m, sweep, scene, paths, solved.dense(), **over)),
+            ("svg", lambda p: _svg(p, m, sweep, scene, pose, paths, solved.dense(), **over)),
+            ("dxf", lambda p: _dxf(p, m, sweep, scene, pose, paths, solved.dense(), **over))]
     for attr, job in jobs:
         path = getattr(args, attr, None)
         if path:
@@ -175,20 +180,20 @@ class _SharedPaths:
         return 0 if xy is None else xy
 
 
-def _html(path, m, sweep, scene, paths, dense=0):
+def _html(path, m, sweep, scene, paths, dense=0, **over):
     from ..views.html import write_html
-    write_html(path, m, sweep, scene, paths, dense=dense)
+    write_html(path, m, sweep, scene, paths, dense=dense, **over)
 
 
-def _svg(path, m, sweep, scene, pose, paths, dense=0):
+def _svg(path, m, sweep, scene, pose, paths, dense=0, **over):
     from ..views.svg import write_svg
-    write_svg(path, m, sweep, pose, paths=paths, scene=scene, dense=dense)
+    write_svg(path, m, sweep, pose, paths=paths, scene=scene, dense=dense, **over)
 
 
-def _dxf(path, m, sweep, scene, pose, paths, dense=0):
+def _dxf(path, m, sweep, scene, pose, paths, dense=0, **over):
     from ..views.dxf import write_dxf
     write_dxf(path, m, sweep, pose, paths=paths, dense=dense,
-              units=scene.study.units.get("length", "") if scene is not None else "")
+              units=scene.study.units.get("length", "") if scene is not None else "", **over)
 
 
 def _caption(scene, sweep, inputs, i) -> str:
@@ -201,11 +206,13 @@ def _caption(scene, sweep, inputs, i) -> str:
     return head + ", ".join(parts) + ("" if sweep.status[i] == "ok" else f" ({sweep.status[i]})")
 
 
-def _save_drawing(path, m, sweep, pose, paths, captions, length, evolute=(), centrodes=(), path_xy=None):
+def _save_drawing(path, m, sweep, pose, paths, captions, length, evolute=(), centrodes=(), path_xy=None,
+                  forces=False, centres=False):
     from ..views.plot import default_pose, draw, new_figure
     fig = new_figure()
     i = default_pose(sweep) if pose is None else pose % len(sweep)
-    ax = draw(m, sweep, i, ax=fig.subplots(), paths=paths, title=captions[i], units=length, path_xy=path_xy)
+    ax = draw(m, sweep, i, ax=fig.subplots(), paths=paths, title=captions[i], units=length, path_xy=path_xy,
+              forces=forces, centres=centres)
     if evolute or centrodes:  # kinematic geometry over the drawing (kincas/views/draw_geometry.py)
         from ..views.draw_geometry import draw_geometry
         draw_geometry(ax, m, sweep, i, evolute, centrodes)
@@ -221,5 +228,6 @@ def _rendering(args):
     return bar
 
 
-def _animate(path, m, sweep, paths, captions, length, progress=None, path_xy=None):
-    animate(m, sweep, path, paths=paths, captions=captions, units=length, progress=progress, path_xy=path_xy)
+def _animate(path, m, sweep, paths, captions, length, progress=None, path_xy=None, forces=False, centres=False):
+    animate(m, sweep, path, paths=paths, captions=captions, units=length, progress=progress, path_xy=path_xy,
+            forces=forces, centres=centres)

@@ -11,11 +11,12 @@ from ..results import Sweep
 
 def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, fps: int = 20,
             captions=None, units: str = "", dpi: int = 80, size=(6.4, 4.8), progress=None,
-            path_xy=None) -> int:
+            path_xy=None, forces: bool = False, centres: bool = False) -> int:
     """Write an animated GIF of the sweep's solved poses (at most `frames` of them, evenly
     spread); returns the number of frames written. `captions[i]` titles pose i;
     `progress(done, total)` is called after each frame (a progress bar, say); `path_xy`: the
-    paths already solved (point -> M x 2, `kincas.views.plot.smooth_paths`), else solved here.
+    paths already solved (point -> M x 2, `kincas.views.plot.smooth_paths`), else solved here;
+    `forces`, `centres`: arrows and instant centres on every frame (kincas/views/forces.py).
 
     >>> import os, tempfile, numpy as np, kincas
     >>> m = kincas.Mechanism(ground={"O": (0, 0)},
@@ -36,7 +37,11 @@ def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, 
     fig = new_figure(size)
     chosen = check_paths(m, paths)
     smooth = smooth_paths(m, sweep, chosen) if path_xy is None else {p: path_xy[p] for p in chosen}
-    d = Drawing(fig.subplots(), m, geometry(m, sweep), chosen, True, units, smooth)
+    ov = None
+    if forces or centres:
+        from .forces import overlay
+        ov = overlay(m, sweep, forces=forces, centres=centres)
+    d = Drawing(fig.subplots(), m, geometry(m, sweep), chosen, True, units, smooth, ov)
     cap = captions if captions is not None else [caption(sweep, i) for i in range(len(sweep))]
     d.update(int(pick[0]), cap[pick[0]])
     fig.canvas.draw()  # lay the figure out once; every frame keeps that layout

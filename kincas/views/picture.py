@@ -66,6 +66,18 @@ class Picture:
     first: int = 0  # the first solved pose
     # pose -> [(label, body, polyline)] of the gears, racks and cams (views/draw_joints.py)
     joint_curves: object = field(default=lambda i, fine=121: [], repr=False)
+    springs: list = field(default_factory=list)  # (label, index a, index b): views/forces.py
+    overlay: object = None  # force arrows and instant centres when asked (views/forces.Overlay)
+
+    def spring_lines(self, i: int) -> list[tuple[str, np.ndarray]]:
+        """(label, zigzag K x 2) of each spring at pose i whose ends are known."""
+        from .forces import zigzag
+        out = []
+        for label, a, b in self.springs:
+            pa, pb = self.xy[i, a], self.xy[i, b]
+            if np.isfinite(pa).all() and np.isfinite(pb).all():
+                out.append((label, zigzag(pa, pb, self.r)))
+        return out
 
     def box(self) -> np.ndarray:
         """[[xmin, ymin], [xmax, ymax]] of everything drawn over the sweep, with a margin."""
@@ -81,11 +93,13 @@ class Picture:
         return np.array([pts.min(axis=0) - 5 * self.r, pts.max(axis=0) + 5 * self.r])
 
 
-def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0) -> Picture:
+def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0, *, forces: bool = False,
+            centres: bool = False) -> Picture:
     """The Picture of `sweep`; `paths` names the points whose paths are drawn (default: every
     moving point); `dense` > 0 solves that many extra poses between each two of the sweep's
     for smooth paths, or is those paths already solved (point -> M x 2, from `dense_paths`:
-    several pictures of one sweep share one solve)."""
+    several pictures of one sweep share one solve); `forces`, `centres`: the arrows of the
+    loads, efforts and reactions, the instant centres (views/forces.py)."""
     geo = geometry(m, sweep)
     names, xy = geo.names, geo.xy
     i0 = default_pose(geo.ok)
@@ -119,8 +133,11 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0) -> Pi
         path_xy = {p: dense[p] for p in chosen}
     else:
         path_xy = dense_paths(m, sweep, chosen, dense) if dense > 0 else {p: geo.point(p) for p in chosen}
+    from .forces import overlay, springs
+    over = overlay(m, sweep, forces=forces, centres=centres, extent=span) if forces or centres else None
     return Picture(names, xy, geo.ok, [names.index(g) for g in m.ground_points], bodies, guides,
-                   path_xy, r, i0, _joint_curves(m, geo, r))
+                   path_xy, r, i0, _joint_curves(m, geo, r),
+                   [(label, names.index(a), names.index(b)) for label, a, b in springs(m)], over)
 
 
 def _joint_curves(m: Mechanism, geo, r: float):
