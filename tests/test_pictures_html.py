@@ -154,3 +154,25 @@ def test_the_ring_gear_is_a_true_circle():
     d = page_data(sc.mechanism, sw, sc)
     circles = [c["circle"] for c in d["joints"][0] if "circle" in c]
     assert any(abs(c[2] - rr) < 1e-6 for c in circles)
+
+
+def test_study_map_has_units_on_axes_and_colour_bars(tmp_path, monkeypatch):
+    pytest.importorskip("matplotlib")
+    from kincas.views import mapplot
+    seen = {}
+
+    def keep(fig, path, **kw):  # the figure as drawn, before it is written
+        seen["fig"] = fig
+    monkeypatch.setattr("kincas.views.atomic.savefig", keep)
+    text = (EXAMPLES / "study_fourbar.toml").read_text().replace("grid = [41, 41]", "grid = [4, 3]")
+    scene = tmp_path / "s.toml"
+    scene.write_text(text)
+    import kincas.cli
+    assert kincas.cli.main(["study", str(scene), "--plot", str(tmp_path / "m.png"), "--no-progress"]) in (0, 3)
+    fig = seen["fig"]
+    panels = [a for a in fig.axes if a.get_xlabel()]
+    assert [a.get_xlabel() for a in panels] == ["a4 [mm]", "a4 [mm]"]
+    assert panels[0].get_ylabel() == "a5 [mm]"
+    bars = sorted(a.get_ylabel() for a in fig.axes if not a.get_xlabel())
+    assert bars == ["max(C.y) [mm]", "max(rocker.angle) - min(rocker.angle) [deg]"]
+    assert mapplot is not None
