@@ -195,3 +195,21 @@ def test_cli_forces_and_centres_flags(tmp_path, capsys):
     text = out.read_text()
     assert 'data-force="effort(crank.angle)"' in text and 'data-centre="coupler"' in text
     assert re.search(r'data-spring="spring S-P"', text)
+
+
+def test_the_animation_moves_the_arrows(tmp_path):
+    from matplotlib.figure import Figure
+    from kincas.views.draw_forces import OverlayArtists  # noqa: F401  (what the frames move)
+    from kincas.views.forces import overlay
+    from kincas.views.plot import Drawing, geometry
+    m = crank_under_load()
+    sw = kincas.sweep(m, {"crank.angle": TH})
+    d = Drawing(Figure().subplots(), m, geometry(m, sw), [], True, "", None, overlay(m, sw))
+    ends = []
+    for i in range(3):
+        d.update(i)
+        line, _ = d.overlay.arrows["load at A"]
+        ends.append(np.array(line.get_data())[:, -1])  # the head: at A, which turns with the crank
+    np.testing.assert_allclose(ends, 2 * np.stack([np.cos(TH), np.sin(TH)], axis=1), atol=1e-9)
+    from kincas.views.animation import animate
+    assert animate(m, sw, tmp_path / "a.gif", frames=3, size=(2, 1.5), dpi=40, forces=True, centres=True) == 3

@@ -54,8 +54,10 @@ def label_spots(xy: np.ndarray, r: float, *, segments=(), polygons=(), skip=()) 
         if not known[k] or k in skip:
             continue
         cand = np.concatenate([xy[k] + 3.0 * r * _RING, xy[k] + 4.5 * r * _RING])
-        if len(obstacles):
-            d = np.sqrt(((cand[:, None, :] - obstacles[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
+        near = obstacles[(np.abs(obstacles - xy[k]) < 7.5 * r).all(axis=1)]  # beyond: never the closest
+        if len(near):
+            diff = cand[:, None, :] - near[None, :, :]
+            d = np.sqrt(np.einsum("ijk,ijk->ij", diff, diff).min(axis=1))
         else:
             d = np.full(len(cand), np.inf)
         d = np.minimum(d, 2.5 * r)  # far enough is far enough: then the nearer circle wins
