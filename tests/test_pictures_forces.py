@@ -213,3 +213,9 @@ def test_the_animation_moves_the_arrows(tmp_path):
     np.testing.assert_allclose(ends, 2 * np.stack([np.cos(TH), np.sin(TH)], axis=1), atol=1e-9)
     from kincas.views.animation import animate
     assert animate(m, sw, tmp_path / "a.gif", frames=3, size=(2, 1.5), dpi=40, forces=True, centres=True) == 3
+
+
+def test_forces_without_a_picture_is_one_line(capsys):
+    from conftest import run_cli
+    code, _, err = run_cli(capsys, "solve", "examples/forces_toggle.toml", "--forces")
+    assert code == 2 and "--forces" in err and len(err.strip().splitlines()) == 1, err
