@@ -219,3 +219,32 @@ def test_forces_without_a_picture_is_one_line(capsys):
     from conftest import run_cli
     code, _, err = run_cli(capsys, "solve", "examples/forces_toggle.toml", "--forces")
     assert code == 2 and "--forces" in err and len(err.strip().splitlines()) == 1, err
+
+
+@pytest.mark.parametrize("example", ["whitworth.toml", "slider_crank.toml", "fairbairn.toml"])
+def test_svg_names_keep_off_the_blocks(example):
+    """In the SVG, no name's text box (estimated from its font size: 0.6 em a letter, 0.75 em
+    tall, placed by its anchor and baseline) overlaps a slide's block."""
+    from matplotlib.path import Path
+    from matplotlib.transforms import Bbox
+    from kincas.cli.scene import load
+    from kincas.views.svg import svg_text
+    sc = load(f"examples/{example}")
+    sw = sc.run()
+    ns = "{http://www.w3.org/2000/svg}"
+    hits = []
+    for i in range(0, len(sw), max(1, len(sw) // 8)):
+        root = ET.fromstring(svg_text(sc.mechanism, sw, i))
+        blocks = [Path(np.array([[float(v) for v in p.split(",")] for p in e.get("points").split()]))
+                  for e in root.iter(ns + "polygon") if e.get("data-block")]
+        (g,) = [e for e in root.iter(ns + "g") if e.get("id") == "labels"]
+        fs = float(g.get("font-size"))
+        anchor, base = g.get("text-anchor", "start"), g.get("dominant-baseline", "alphabetic")
+        for t in g.iter(ns + "text"):
+            x, y = float(t.get("x")), -float(t.get("y"))  # back to the world's y
+            w, h = 0.6 * fs * len(t.text), 0.75 * fs
+            x0 = x - w / 2 if anchor == "middle" else x
+            y0 = y - h / 2 if base == "central" else y
+            box = Bbox([[x0, y0], [x0 + w, y0 + h]])
+            hits += [(i, t.text) for p in blocks if p.intersects_bbox(box, filled=True)]
+    assert not hits
