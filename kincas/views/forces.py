@@ -120,13 +120,14 @@ def zigzag(a, b, r: float, turns: int = 6) -> np.ndarray:
 
 
 def overlay(m: Mechanism, sweep: Sweep, *, forces: bool = True, centres: bool = True,
-            extent: float | None = None) -> Overlay:
+            extent: float | None = None, geo=None) -> Overlay:
     """The arrows, torques and instant centres over the sweep (see the module's text);
-    `extent`: the picture's size that sets the arrows' scale (default: the points' span)."""
+    `extent`: the picture's size that sets the arrows' scale (default: the points' span);
+    `geo`: the sweep's `views.poses.geometry`, when already made."""
     from ..core.numeric import compile
     from ..core.dynamics import bodies_at
     from .poses import geometry
-    geo = geometry(m, sweep)
+    geo = geometry(m, sweep) if geo is None else geo
     n, ok = len(sweep), sweep.ok
     point = geo.point
     ov = Overlay()

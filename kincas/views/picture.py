@@ -134,7 +134,7 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0, *, fo
     else:
         path_xy = dense_paths(m, sweep, chosen, dense) if dense > 0 else {p: geo.point(p) for p in chosen}
     from .forces import overlay, springs
-    over = overlay(m, sweep, forces=forces, centres=centres, extent=span) if forces or centres else None
+    over = overlay(m, sweep, forces=forces, centres=centres, extent=span, geo=geo) if forces or centres else None
     return Picture(names, xy, geo.ok, [names.index(g) for g in m.ground_points], bodies, guides,
                    path_xy, r, i0, _joint_curves(m, geo, r),
                    [(label, names.index(a), names.index(b)) for label, a, b in springs(m)], over)

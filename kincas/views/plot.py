@@ -307,11 +307,11 @@ def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=
     paths = check_paths(m, paths)
     i = default_pose(sweep) if pose is None else int(pose) % max(len(sweep), 1)  # -1: the last
     smooth = smooth_paths(m, sweep, paths) if path_xy is None else {p: path_xy[p] for p in paths}
-    ov = None
+    geo, ov = geometry(m, sweep), None
     if forces or centres:
         from .forces import overlay
-        ov = overlay(m, sweep, forces=forces, centres=centres)
-    d = Drawing(ax, m, geometry(m, sweep), paths, labels, units, smooth, ov)
+        ov = overlay(m, sweep, forces=forces, centres=centres, geo=geo)
+    d = Drawing(ax, m, geo, paths, labels, units, smooth, ov)
     d.update(i, caption(sweep, i) if title is None else title)
     return ax
 
