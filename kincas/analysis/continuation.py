@@ -23,7 +23,7 @@ from ..core.assembly import ambiguous as _ambiguous, first_pose as _first, no_as
 from ..core import branch
 from ..core.numeric import Model, Solution
 from ..core.limits import on_step, polish_singular
-from ..core.tolerances import ACCEPT, BRANCH, CAREFUL_DEPTH, NEAR_SINGULAR, SLOW, STRAIGHT, WATCH
+from ..core.tolerances import ACCEPT, BRANCH, CAREFUL_DEPTH, ILL, NEAR_SINGULAR, SLOW, STRAIGHT, WATCH
 from ..model.mechanism import Mechanism
 from .path import Bisect, Steps, Walk, follow, follow_all, wandered
 from .resume import carry_groups, larger_groups, resume_label
@@ -269,7 +269,7 @@ def _ill(model: Model, J, L) -> bool:
     with np.errstate(all="ignore"):
         # (2-norm, from singular values, for a tall g_q: redundant joints)
         c = np.linalg.cond(J * model.column_scale(L), 1 if model.square else None)
-    return not c < 1e2 * max(1.0, np.sqrt(J.shape[0]))
+    return not c < ILL * max(1.0, np.sqrt(J.shape[0]))
 
 
 def _secant(q0, u0, u1, prev):

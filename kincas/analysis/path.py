@@ -185,13 +185,14 @@ class Walk:
         return self.control.before(self)
 
 
-def follow_all(walks: list[Walk], step, *, stop=None, budget: int | None = None) -> list[Walk]:
+def follow_all(walks: list[Walk], step, *, stop=None, budget: int | None = None, reach: bool = True) -> list[Walk]:
     """Walk every path of `walks` to its end, in lockstep: each round, one call
     `step(live)` tries the next step of every walk still going and returns, per walk,
     (pose, None) for an accepted step or (anything, reason) for a rejected one (a key of
     `STOPS`). An accepted step moves the walk to the step's target (and, where the step
     control has no end, `stop(walk)` may end it with a reason); a rejected one is cut by the
-    walk's step control, or ends it. `budget`: steps tried per walk at most.
+    walk's step control, or ends it. `budget`: steps tried per walk at most. `reach`: keep
+    every pose passed in `Walk.reach` (False: a long walk that needs only its ends).
 
     Parameters
     ----------
@@ -201,6 +202,7 @@ def follow_all(walks: list[Walk], step, *, stop=None, budget: int | None = None)
     stop : callable, optional
         Walk -> reason or None, after each accepted step.
     budget : int, optional
+    reach : bool
 
     Returns
     -------
@@ -237,7 +239,8 @@ def follow_all(walks: list[Walk], step, *, stop=None, budget: int | None = None)
                 if done:
                     w.reason = "reached"
                 else:
-                    w.reach.append((new, target))
+                    if reach:
+                        w.reach.append((new, target))
                     w.reason = stop(w) if stop is not None else None
             else:
                 w.reason = w.control.rejected(w, why)
@@ -245,7 +248,8 @@ def follow_all(walks: list[Walk], step, *, stop=None, budget: int | None = None)
     return walks
 
 
-def follow(at, where, control, step, *, before=None, stop=None, budget: int | None = None) -> Walk:
+def follow(at, where, control, step, *, before=None, stop=None, budget: int | None = None,
+           reach: bool = True) -> Walk:
     """Walk one path from the pose `at` at its point `where` (see `follow_all`; `step` takes
     and answers for one walk). `before`: (pose, point) before the start, for a secant.
 
@@ -258,7 +262,7 @@ def follow(at, where, control, step, *, before=None, stop=None, budget: int | No
     if isinstance(control, Bisect) and before is not None:
         control.stack[0] = control.stack[0][:2] + (before,)
     walk = Walk(at, where, control)
-    return follow_all([walk], lambda live: [step(live[0])], stop=stop, budget=budget)[0]
+    return follow_all([walk], lambda live: [step(live[0])], stop=stop, budget=budget, reach=reach)[0]
 
 
 def wandered(q0, pred, q1, scale) -> bool:

@@ -189,7 +189,7 @@ def _follow(model, q, u, p, L, i, direction, scale, is_angle, max_steps):
             return "full turn"
         return None
     w = follow((z, t), None, Arclength(ARC_FIRST, ARC_LONGEST, ARC_GROW, MIN_ARC_STEP), step,
-               stop=stop, budget=max_steps)
+               stop=stop, budget=max_steps, reach=False)
     if w.reason == "limit":  # locate it exactly, from the end nearer it
         (z, t), (zn, tn) = w.prev, w.at
         qn, un = zn[:nq] * scale[:nq], _with(u, i, zn[-1] * scale[-1])

@@ -51,6 +51,7 @@ WATCH = 0.5  # a group conditioned below this at either end of a step is checked
 # A corrected pose farther than WANDER_SHARE of the predicted move (or WANDER_FLOOR, scaled)
 # from its prediction went elsewhere on the branch: the step is cut
 WANDER_FLOOR, WANDER_SHARE = 0.02, 0.5
+ILL = 1e2  # g_q's condition number (scaled, per sqrt of its rows) above which a step is predicted by the secant
 SLOW = 8  # Newton iterations a step that is not the shortest may take (more: cut it)
 CAREFUL_DEPTH = 8  # halvings of one step of a sweep's careful path
 CARRY_DEPTH, CARRY_BUDGET = 10, 200  # halvings of, and solves spent on, one input step of a gap
