@@ -14,12 +14,7 @@ import pytest
 import kincas
 from kincas.cli.app import main
 from kincas.synthesis.cam_design import Segment, design_cam
-
-
-def _crank():
-    return kincas.Mechanism(parameters={"a": 2.0}, ground={"O": (0, 0)},
-                            links=[kincas.Link.bar("crank", "O", "A", "a")],
-                            inputs=[kincas.Input.angle("crank")])
+from test_public_names import _crank  # a crank of length a = 2
 
 
 def test_a_tolerance_analysis_counts_draws_and_samples_warns():
