@@ -202,5 +202,5 @@ def test_bisect_walks_as_the_recursive_halving_did(depth):
     def step(w):
         got.append((w.where, w.target, w.before[1]))
         return w.target, None if w.target - w.where <= 0.25 else "slow"
-    w = path.follow(0.0, 0.0, path.Bisect(1.0, depth), step, before=(None, -1.0))
+    w = path.follow(0.0, 0.0, path.Bisect(1.0, depth, (None, -1.0)), step)
     assert got == expected and w.ok == ok

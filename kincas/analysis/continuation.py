@@ -188,7 +188,7 @@ def walk_inputs(model: Model, q0, u0, u1, p, L, depth: int, prev=None) -> Walk:
         return sol, None
     start = _Pose(np.asarray(q0))
     before = None if prev is None else (_Pose(np.asarray(prev[0])), prev[1])
-    return follow(start, u0, Bisect(u1, depth), step, before=before)
+    return follow(start, u0, Bisect(u1, depth, before), step)
 
 
 def _continue(model: Model, q0, u0, u1, p, L, depth: int, prev=None, reach=None) -> Solution | None:

@@ -66,8 +66,8 @@ STOPS = {
 class Bisect:
     """A step to `end`, cut in two halves where rejected (each walked in turn), at most
     `depth` times: the careful path's. A half is predicted from the pose before its start
-    as a recursive bisection has it: the first half from the pose before the step, the
-    second from the step's start."""
+    as a recursive bisection has it: the first half from the pose before the step (`before`,
+    (pose, point) or None), the second from the step's start."""
 
     def __init__(self, end, depth: int, before=None):
         self.stack = [(end, depth, before)]  # (end, cuts left, the pose before its start)
@@ -109,7 +109,7 @@ class Steps:
     last = True
 
     def before(self, walk):
-        return walk.prev
+        return _accepted_before(walk)
 
     def accepted(self, walk) -> bool:
         self.i += 1
@@ -134,7 +134,7 @@ class Arclength:
     last = False
 
     def before(self, walk):
-        return walk.prev
+        return _accepted_before(walk)
 
     def accepted(self, walk) -> bool:
         self.h = min(self.longest, self.h * self.grow)
@@ -143,6 +143,11 @@ class Arclength:
     def rejected(self, walk, why):
         self.h /= 2
         return "step too small" if self.h < self.shortest else None
+
+
+def _accepted_before(walk):
+    """(pose, point) accepted before the walk's current one; None at its start."""
+    return None if walk.prev is None else (walk.prev, walk.prev_where)
 
 
 # --- the walk ---
@@ -248,10 +253,9 @@ def follow_all(walks: list[Walk], step, *, stop=None, budget: int | None = None,
     return walks
 
 
-def follow(at, where, control, step, *, before=None, stop=None, budget: int | None = None,
-           reach: bool = True) -> Walk:
+def follow(at, where, control, step, *, stop=None, budget: int | None = None, reach: bool = True) -> Walk:
     """Walk one path from the pose `at` at its point `where` (see `follow_all`; `step` takes
-    and answers for one walk). `before`: (pose, point) before the start, for a secant.
+    and answers for one walk).
 
     >>> def step(w):  # x = s, exactly, where s <= 2
     ...     return w.target, None if w.target <= 2 else "not converged"
@@ -259,8 +263,6 @@ def follow(at, where, control, step, *, before=None, stop=None, budget: int | No
     >>> w.reason, w.where, [s for _, s in w.reach]
     ('not converged', 1.5, [1.5])
     """
-    if isinstance(control, Bisect) and before is not None:
-        control.stack[0] = control.stack[0][:2] + (before,)
     walk = Walk(at, where, control)
     return follow_all([walk], lambda live: [step(live[0])], stop=stop, budget=budget, reach=reach)[0]
 
