@@ -153,7 +153,7 @@ def _check_args(args) -> None:
     write = getattr(args, "write", None)
     if write and Path(write).exists() and not Path(write).is_dir():
         raise OutputError(f"--write: {write} exists and is not a directory (--write names a directory)")
-    starts, samples = getattr(args, "starts", None), getattr(args, "samples", None)
+    starts = getattr(args, "starts", None)
     if not (starts or args.command in ("tolerance", "range")):
         return
     from ..model.mechanism import solved_unknowns
@@ -169,7 +169,9 @@ def _check_args(args) -> None:
             bounds.check("--starts", starts, bounds.per_sample(nq, 0, 0))
         if args.command == "tolerance":
             t = sc.study.raw.get("tolerance", {})
-            field, n = ("--samples", samples) if samples else ("[tolerance] samples", t.get("samples"))
+            from .tolerance import draws_option
+            flag, n = draws_option(args, note=False)
+            field, n = (flag, n) if n else ("[tolerance] samples", t.get("samples"))
             if isinstance(n, int) and not isinstance(n, bool) and n > 0:
                 std = t.get("std", {})
                 poses = max((len(v) for v in sc.study.inputs.values()), default=1)

@@ -49,7 +49,7 @@ def report(sc, r: Optimization) -> dict:
     curve = {}
     if "curve" in r.info:  # the fitted input at each target and the distance left there
         c = r.info["curve"]
-        fitted = user(key, r.samples[key])
+        fitted = user(key, r.inputs[key])
         if key.endswith(".angle"):  # within one turn from the sweep's start, not 677 deg
             turn, lo = (360.0 if deg else 2 * math.pi), float(np.min(sc.study.written[key]))
             fitted = lo + np.mod(fitted - lo, turn)
@@ -66,7 +66,7 @@ def report(sc, r: Optimization) -> dict:
         "bounds": {p: list(bounds[p]) for p in r.varied},
         "at_bound": {p: side for p in r.varied if (side := _at_bound(r.varied[p], *bounds[p]))},
         "parameter_units": {p: _optimized_unit(sc, p) for p in r.varied},
-        "samples": {k: _list(user(k, v)) for k, v in r.samples.items()},
+        "samples": {k: _list(user(k, v)) for k, v in r.inputs.items()},  # the scene's word
         "values": {n: _list(user(n, v)) for n, v in r.values.items()},
         "constraints": [{**{k: c[k] for k in ("expr", "min", "max", "satisfied")},
                          "value": _list(np.atleast_1d(c["value"]))} for c in r.constraints],
