@@ -280,9 +280,9 @@ class FastSweeper(VirtualMachineSweep):
         bad = r.advance(k, None, None, stop)
         if bad > k and r.measures[:len(self.blocks), k].tolist() == before:
             # each group's sum of |q - q0| / qs over its own unknowns
-            dq = np.abs(r.Q[k] - q0) * inv_qs
-            moved = (float(dq.sum()) if self._one_group else
-                     np.bincount(self._group_of, dq, len(self.blocks) + 1)[:-1].max(initial=0.0))
+            dq = np.abs(r.Q[k] - q0)
+            moved = (float(np.dot(dq, inv_qs)) if self._one_group else
+                     np.bincount(self._group_of, dq * inv_qs, len(self.blocks) + 1)[:-1].max(initial=0.0))
             if moved <= CORRECTION:
                 return bad
         r._s = None  # nothing of this attempt is kept: the careful path starts afresh
