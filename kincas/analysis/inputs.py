@@ -10,7 +10,6 @@
 """
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 
 import numpy as np
@@ -32,9 +31,7 @@ def input_table(m: Mechanism, inputs, what: str, default: float | None, keys=Non
         c = inputs[keys[0]]  # the common case, one input: no copy
         if not (type(c) is np.ndarray and c.dtype == np.float64):
             c = _floats(c, what, keys[0])
-        # finite: c.c is (NaN and infinities stay; a huge value that overflows it takes the
-        # general path below, which tells); a dot product costs a third of isfinite().all()
-        if c.ndim <= 1 and c.size and math.isfinite(np.dot(c.ravel(), c.ravel())):
+        if c.ndim <= 1 and c.size and np.isfinite(c).all():
             return c.reshape(-1, 1)
     if inputs is None:
         if default is None and keys:
