@@ -106,8 +106,8 @@ class Fast(_Shipped):
     ----------
     compile : bool, optional
         None (the default) compiles the pass to C when a compiled library is cached or the
-        sweep is long, compiles it in a background thread once a structure's sweeps add up
-        to 20,000 poses, and leaves the fast pass out where it would not pay (a large
+        sweep is long, compiles it in a background thread when a structure is swept again
+        (500 poses in all) or its sweeps add up to 20,000 poses, and leaves the fast pass out where it would not pay (a large
         mechanism, a short sweep); True compiles it (unless the kernel is too large for the
         compiler to be worth waiting for); False runs it in CasADi's virtual machine.
         Whichever runs, `Sweep.info["fast pass"]` says.

@@ -61,8 +61,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     uses the careful path for every pose; a subclass of `kincas.SweepMethod` is called as
     they are. The strings "fast" (with `compile`) and "careful" mean the same two. `compile`:
     None compiles the fast pass to C when a compiled library is cached or the sweep is long,
-    compiles it in a background thread once a structure's sweeps add up to 20,000 poses (the
-    virtual machine serving until it is loaded), and leaves out the fast pass where it would
+    compiles it in a background thread when a structure is swept again (500 poses in all) or
+    its sweeps add up to 20,000 poses (the virtual machine serving until it is loaded), and leaves out the fast pass where it would
     not pay (a large mechanism, a short sweep); True compiles it (unless the kernel is too
     large for the compiler to be worth waiting for), False runs it in CasADi's virtual machine.
 
