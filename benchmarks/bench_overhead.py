@@ -12,8 +12,7 @@ on a shared machine the wall clock also counts other processes' turns; `--wall` 
 `--first-use` instead runs each tool in a fresh process, kincas's cache of compiled libraries
 empty (numba's, which holds pylinkage's compiled loop, as it is), and gives the wall time from the tool's setup to the end of the 1st,
 100th, ... call of a 360-pose sweep, compiles and JIT included (kincas compiles its kernel
-in a background thread once its sweeps add up to 20,000 poses, the virtual machine serving
-meanwhile). Prints only: benchmarks/run.py writes RESULTS.md.
+in a background thread from its second sweep on, the virtual machine serving meanwhile). Prints only: benchmarks/run.py writes RESULTS.md.
 """
 from __future__ import annotations
 

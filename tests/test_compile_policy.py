@@ -1,8 +1,9 @@
-"""compile=None: repeated short sweeps get the compiled kernel (issue [8]).
+"""compile=None: repeated short sweeps get the compiled kernel (issues [8], [15]).
 
-Short sweeps of a structure run in the virtual machine and compile nothing until they add
-up to BACKGROUND_POSES; then the kernel compiles in a background thread while the virtual
-machine keeps serving, and once it is loaded the sweeps run compiled. Every sweep, before, during and
+A one-off short sweep runs in the virtual machine and compiles nothing; a structure swept
+again (its sweeps adding up to BACKGROUND_MIN_POSES), or whose sweeps add up to
+BACKGROUND_POSES, compiles its kernel in a background thread while the virtual machine keeps
+serving, and once it is loaded the sweeps run compiled. Every sweep, before, during and
 after, gives the circle-intersection answer written here. compile=False never compiles;
 $KINCAS_NO_COMPILE is obeyed.
 """
@@ -52,19 +53,37 @@ def poses(monkeypatch):  # compile after 1,000 poses (20,000 by default): quick 
     monkeypatch.setattr(kincas.core.fast, "BACKGROUND_POSES", 1000)
 
 
-def test_repeated_short_sweeps_compile_in_the_background(cache, poses):
+def test_a_structure_swept_again_compiles_in_the_background(cache):
     m, th = fourbar(3.5, "policy_b1"), np.linspace(0, 2 * np.pi, 360)
     fast = sweeper_for(kincas.model_of(m), REPORT, None)
-    for _ in range(2):  # 720 poses so far: nothing compiled
-        check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.5)
+    sw = kincas.sweep(m, {"crank.angle": th}, report=list(REPORT))  # a one-off sweep: nothing compiled
+    check(sw, th, 3.5)
+    assert sw.info["fast pass"] == "virtual machine"
     assert fast.backend.lib is None and fast.backend._thread is None
     assert not list(cache.glob("*.so"))
-    check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.5)  # 1,080: starts it
+    check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.5)  # again: starts it
     assert fast.backend._thread is not None
     fast.backend._thread.join(timeout=120)
     assert fast.backend.lib is not None and list(cache.glob("kincas_sweep-*.so"))
     assert not [p for p in cache.iterdir() if p.is_dir()]  # no half-written build left
-    check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.5)  # compiled now
+    sw = kincas.sweep(m, {"crank.angle": th}, report=list(REPORT))  # compiled now
+    check(sw, th, 3.5)
+    assert sw.info["fast pass"] == "compiled"
+
+
+def test_short_sweeps_compile_once_they_add_up(cache, poses):
+    # swept again, but briefly (fewer than BACKGROUND_MIN_POSES poses in all): nothing, until
+    # the sweeps add up to BACKGROUND_POSES (1,000 here)
+    m, th = fourbar(3.52, "policy_b0"), np.linspace(0, 1, 120)
+    fast = sweeper_for(kincas.model_of(m), REPORT, None)
+    for _ in range(4):  # 480 poses
+        check(kincas.sweep(m, {"crank.angle": th}, report=list(REPORT)), th, 3.52)
+    assert fast.backend._thread is None and not list(cache.glob("*.so"))
+    check(kincas.sweep(m, {"crank.angle": np.linspace(0, 1, 600)}, report=list(REPORT)),
+          np.linspace(0, 1, 600), 3.52)  # 1,080 poses
+    assert fast.backend._thread is not None
+    fast.backend._thread.join(timeout=120)
+    assert fast.backend.lib is not None
 
 
 def test_sweeps_from_threads_while_the_kernel_compiles(cache, poses):

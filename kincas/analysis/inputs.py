@@ -26,8 +26,11 @@ def input_table(m: Mechanism, inputs, what: str, default: float | None, keys=Non
     keys = [i.key for i in m.inputs] if keys is None else list(keys)
     if inputs is None and default is not None:  # every input at its default: one row
         return np.full((1, len(keys)), float(default))
-    if len(keys) == 1 and isinstance(inputs, Mapping) and len(inputs) == 1 and keys[0] in inputs:
-        c = _floats(inputs[keys[0]], what, keys[0])  # the common case, one input: no copy
+    if len(keys) == 1 and (type(inputs) is dict or isinstance(inputs, Mapping)) and len(inputs) == 1 \
+            and keys[0] in inputs:
+        c = inputs[keys[0]]  # the common case, one input: no copy
+        if not (type(c) is np.ndarray and c.dtype == np.float64):
+            c = _floats(c, what, keys[0])
         if c.ndim <= 1 and c.size and np.isfinite(c).all():
             return c.reshape(-1, 1)
     if inputs is None:

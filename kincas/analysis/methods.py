@@ -106,8 +106,8 @@ class Fast(_Shipped):
     ----------
     compile : bool, optional
         None (the default) compiles the pass to C when a compiled library is cached or the
-        sweep is long, compiles it in a background thread once a structure's sweeps add up
-        to 20,000 poses, and leaves the fast pass out where it would not pay (a large
+        sweep is long, compiles it in a background thread when a structure is swept again
+        (500 poses in all) or its sweeps add up to 20,000 poses, and leaves the fast pass out where it would not pay (a large
         mechanism, a short sweep); True compiles it (unless the kernel is too large for the
         compiler to be worth waiting for); False runs it in CasADi's virtual machine.
         Whichever runs, `Sweep.info["fast pass"]` says.
@@ -190,15 +190,15 @@ def method_of(method, compile) -> SweepMethod:
     as `Fast(compile)`, "careful" as `Careful()` (which ignores `compile`, as 0.1 did).
     ModelError naming `method` for anything else, and naming `compile` beside an instance
     (which carries its own, as `Fast(compile=...)`)."""
-    if isinstance(method, SweepMethod):
-        if compile is not None:
-            raise ModelError(f"compile: {method!r} is a method object; give compile to it, "
-                             f"as kincas.Fast(compile={compile!r})")
-        return method
-    if isinstance(method, str):
+    if isinstance(method, str):  # (first: the default; an ABC's isinstance costs ~1 us)
         if method == "fast":
             return _FAST[compile] if compile is None or type(compile) is bool else Fast(compile)
         if method == "careful":
             return _CAREFUL
+    elif isinstance(method, SweepMethod):
+        if compile is not None:
+            raise ModelError(f"compile: {method!r} is a method object; give compile to it, "
+                             f"as kincas.Fast(compile={compile!r})")
+        return method
     raise ModelError(f"method: {method!r:.80} is neither \"fast\", \"careful\" nor a "
                      f"kincas.SweepMethod (kincas.Fast(), kincas.Careful())")

@@ -57,6 +57,7 @@ class Prepared:
         self._places = Memo(bound=PLACEMENTS)  # (inputs, guess) -> Placement or None
         self._sweepers: dict = {}  # (report, compile) -> FastSweeper
         self._names: set = set()  # reports whose names were checked
+        self.reports: dict = {}  # report as given (None, a name, a tuple of names) -> the names
 
     def sweeper(self, model, report: tuple, compile):
         """The model's `FastSweeper` for `report` and `compile` (`sweeper_for`), found here

@@ -39,6 +39,7 @@ from .methods import SweepMethod, method_of
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
 
 NO_ASSEMBLY = "no assembly"
+REPORTS_KEPT = 64  # lists of reported names remembered as checked, per mechanism
 
 
 # --- sweeps ---
@@ -60,8 +61,8 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     uses the careful path for every pose; a subclass of `kincas.SweepMethod` is called as
     they are. The strings "fast" (with `compile`) and "careful" mean the same two. `compile`:
     None compiles the fast pass to C when a compiled library is cached or the sweep is long,
-    compiles it in a background thread once a structure's sweeps add up to 20,000 poses (the
-    virtual machine serving until it is loaded), and leaves out the fast pass where it would
+    compiles it in a background thread when a structure is swept again (500 poses in all) or
+    its sweeps add up to 20,000 poses (the virtual machine serving until it is loaded), and leaves out the fast pass where it would
     not pay (a large mechanism, a short sweep); True compiles it (unless the kernel is too
     large for the compiler to be worth waiting for), False runs it in CasADi's virtual machine.
 
@@ -118,9 +119,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     solver = method_of(method, compile)  # a wrong `method` fails before any work
     # the model and the parameter values, size, guess, input keys: once per mechanism
     model, pm = model_and_prepared(m, _model_of)
-    report = report_names(m, report)
-    names = tuple(report)
-    pm.check_report(model, names)  # unknown names fail here, before any solving
+    report, names = _report(m, model, pm, report)  # unknown names fail here, before any solving
     U = _input_table(m, inputs, "inputs", None, pm.keys)
     n = U.shape[0]
     Ud = _per_pose(m, rates, "rates", 1.0, n, pm.keys)
@@ -194,11 +193,13 @@ def _per_pose(m, values, what: str, default: float, n: int, keys) -> np.ndarray:
     pays every microsecond): the usual cases, none given or one number for the one input,
     without building a table first."""
     if values is None:
-        return np.full((n, len(keys)), default)
+        return np.zeros((n, len(keys))) if default == 0.0 else np.full((n, len(keys)), default)
     if len(keys) == 1 and type(values) is dict and len(values) == 1:
         v = values.get(keys[0])
         if type(v) is float and math.isfinite(v) or type(v) is int:
-            return np.full((n, 1), float(v))
+            out = np.empty((n, 1))  # (np.full checks its arguments: twice the time)
+            out.fill(v)
+            return out
     return np.array(derivative_table(m, values, what, default, n, keys), dtype=float)  # (a copy:
     # the user's array stays theirs)
 
@@ -335,6 +336,25 @@ def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
                              f"(kincas.sweep solves several)")
     return sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
                  guess=guess, jerks=jerks).pose(0)
+
+
+def _report(m, model, pm, report) -> tuple[list, tuple]:
+    """(list, tuple) of the quantity names to report (`report_names`), checked against the
+    model (`Prepared.check_report`): a list of names or the default once per mechanism, a
+    look-up afterwards."""
+    key = report if report is None or type(report) is str else tuple(report) if type(report) in (list, tuple) else ()
+    try:
+        names = pm.reports.get(key) if key != () else None
+    except TypeError:  # something unhashable in the list: not a name (report_names says so)
+        key, names = (), None
+    if names is None:
+        names = tuple(report_names(m, report))
+        pm.check_report(model, names)
+        if key != ():
+            if len(pm.reports) >= REPORTS_KEPT:  # (a loop over many lists: kept bounded)
+                pm.reports.clear()
+            pm.reports[key] = names
+    return list(names), names
 
 
 def report_names(m: Mechanism, report) -> list[str]:

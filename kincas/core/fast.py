@@ -58,11 +58,17 @@ COMPILE_MAX = 40_000
 # virtual machine took 0.3 ms a pose against 26 ms on the careful path: only a far larger
 # kernel could lose (and it is never compiled either).
 VM_MAX = 200_000
-# With compile=None, a sweeper compiles its kernel in the background once its sweeps add up
-# to this many poses (one long sweep, or ~56 of 360 poses): the virtual machine costs ~1-3 us
-# a pose more than the compiled loop, compiling a small kernel ~1 s of a background thread.
-# Repeated use pays for it; a one-off short sweep (`kincas solve`) compiles nothing, and a
-# test suite sweeping hundreds of structures a few times each does not compile them all.
+# With compile=None, a sweeper compiles its kernel in the background once it is used again: at
+# its BACKGROUND_CALLS-th sweep when its sweeps add up to BACKGROUND_MIN_POSES poses, or once
+# they add up to BACKGROUND_POSES (one long sweep, or many short ones). The virtual machine
+# costs ~2-10 us a pose more than the compiled loop (a four-bar, Jansen's leg), compiling a
+# small kernel 0.3-1 s of a background thread (the C compiler runs outside the GIL): a
+# mechanism swept again is likely swept many times (a user's loop, an optimiser), and
+# started at its second sweep the compile lands while the virtual machine serves. A one-off
+# sweep (`kincas solve`) compiles nothing, nor does a structure swept again only briefly (a
+# test suite sweeping hundreds of structures a few times each).
+BACKGROUND_CALLS = 2
+BACKGROUND_MIN_POSES = 500
 BACKGROUND_POSES = 20_000
 BLOCK = 65536  # poses per call when a progress callback wants news
 _I, _V = ctypes.c_longlong, ctypes.c_void_p
@@ -96,7 +102,7 @@ class FastSweeper(VirtualMachineSweep):
         self._one_group = len(self.blocks) == 1 and not self._group_of.any()
         self.nj = diagonal_size(self.blocks)  # g_q's diagonal blocks, all the state keeps of it
         self.state_size = self.nq + self.nj + 2 * (self.nq * self.nu + self.nu)
-        self._functions, self._size, self._poses = None, None, 0  # _poses: swept so far
+        self._functions, self._size, self._poses, self._calls = None, None, 0, 0  # swept so far
         self._lock = threading.RLock()
         self._local = threading.local()  # the virtual machine's buffers, one set per thread
         self.backend = Backend(compile, self._library, "fast sweep kernel")
@@ -200,8 +206,9 @@ class FastSweeper(VirtualMachineSweep):
         then solves pose k from q0 (`_from_guess`), and the careful path only where the
         kernel's answer is not certainly the careful path's."""
         r = FastRun(self, U, p, L, Ud, Udd)
-        self._poses += r.n
-        if self._poses >= BACKGROUND_POSES and self.size <= COMPILE_MAX:  # worth compiling now
+        self._poses, self._calls = self._poses + r.n, self._calls + 1
+        if (self._poses >= BACKGROUND_POSES or self._calls >= BACKGROUND_CALLS and self._poses >= BACKGROUND_MIN_POSES) \
+                and self.backend.lib is None and self.size <= COMPILE_MAX:  # worth compiling now
             self.backend.start()  # (compile=None only; the virtual machine serves meanwhile)
         k, last, going = 0, None, False  # going: the last block ended with no rejection
 
@@ -273,9 +280,9 @@ class FastSweeper(VirtualMachineSweep):
         bad = r.advance(k, None, None, stop)
         if bad > k and r.measures[:len(self.blocks), k].tolist() == before:
             # each group's sum of |q - q0| / qs over its own unknowns
-            dq = np.abs(r.Q[k] - q0) * inv_qs
-            moved = (float(dq.sum()) if self._one_group else
-                     np.bincount(self._group_of, dq, len(self.blocks) + 1)[:-1].max(initial=0.0))
+            dq = np.abs(r.Q[k] - q0)
+            moved = (float(np.dot(dq, inv_qs)) if self._one_group else
+                     np.bincount(self._group_of, dq * inv_qs, len(self.blocks) + 1)[:-1].max(initial=0.0))
             if moved <= CORRECTION:
                 return bad
         r._s = None  # nothing of this attempt is kept: the careful path starts afresh

@@ -43,22 +43,32 @@ class FastRun:
 
     def __init__(self, sweeper: "FastSweeper", U, p, L, Ud=None, Udd=None):
         self.sweeper, nq, nu = sweeper, sweeper.nq, sweeper.nu
-        self.U = np.ascontiguousarray(table(U, nu))
-        self.n = n = self.U.shape[0]
-        self.Ud = _rows(np.ones(nu) if Ud is None else Ud, n, nu)
-        self.Udd = _rows(np.zeros(nu) if Udd is None else Udd, n, nu)
-        self.p = np.ascontiguousarray(np.asarray(p, dtype=float).ravel())
-        # everything the kernel reads or writes of this run, inputs aside, in one block of
-        # memory: L and the thresholds, the state, Q, info, values, measures (its address
-        # is taken once, not per array and per call)
+        U = table(U, nu)
+        self.n = n = U.shape[0]
+        Ud, sud = _rows(np.ones(nu) if Ud is None else Ud, n, nu)
+        Udd, sudd = _rows(np.zeros(nu) if Udd is None else Udd, n, nu)
+        p = np.asarray(p, dtype=float).ravel()
+        # everything the kernel reads or writes of this run in one block of memory: L and
+        # the thresholds, the state, Q, info, values, measures, then copies of the inputs
+        # (U, rates, accelerations: a table, or one row for every pose) and the parameters
+        # (one address per run: numpy's array interface costs ~1.5 us an array)
         no, nm = len(sweeper.report), len(sweeper.blocks) + 1
-        o = self._off = list(accumulate([0, 6, sweeper.state_size, n * nq, 5 * n, no * n, nm * n]))
+        o = self._off = list(accumulate([0, 6, sweeper.state_size, n * nq, 5 * n, no * n, nm * n, n * nu,
+                                         (n if sud else 1) * nu, (n if sudd else 1) * nu, p.size]))
         block = self._block = np.empty(o[-1])
         block[:6] = _HEAD  # the thresholds, then L in its place
         block[0] = L
         self.L, self.thr, self._state = block[0:1], block[1:6], block[o[1]:o[2]]
         self.Q, self.info = block[o[2]:o[3]].reshape(n, nq), block[o[3]:o[4]].reshape(5, n)
         self.values, self.measures = block[o[4]:o[5]].reshape(no, n), block[o[5]:o[6]].reshape(nm, n)
+        self.U = block[o[6]:o[7]].reshape(n, nu)
+        self.U[...] = U
+        self.Ud = (block[o[7]:o[8]].reshape(-1, nu) if sud else block[o[7]:o[8]], sud)
+        self.Ud[0][...] = Ud
+        self.Udd = (block[o[8]:o[9]].reshape(-1, nu) if sudd else block[o[8]:o[9]], sudd)
+        self.Udd[0][...] = Udd
+        self.p = block[o[9]:o[10]]
+        self.p[...] = p
         self.accepted, self.solved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
         self.first_bad, self._s, self._addr, self.recorded = 0, None, None, 0
         self.backend = None  # "compiled" or "virtual machine": what `advance` ran last
@@ -86,14 +96,13 @@ class FastRun:
         lib = sw.backend.compiled(self.n)
         self.backend = "virtual machine" if lib is None else "compiled"
         if lib is not None:
-            if self._addr is None:  # addresses of the run's block and of its inputs
-                self._addr = (ptr(self._block), ptr(self.U), ptr(self.p), ptr(self.Ud[0]), ptr(self.Udd[0]))
-            a, aU, ap, aUd, aUdd = self._addr
-            o, sud, sudd, nq = self._off, self.Ud[1], self.Udd[1], sw.nq
+            if self._addr is None:  # the address of the run's block (inputs included)
+                self._addr = ptr(self._block)
+            a, o, sud, sudd, nq, nu = self._addr, self._off, self.Ud[1], self.Udd[1], sw.nq, sw.nu
             k = start + lib.kincas_sweep(
-                stop - start, aU + 8 * start * sw.nu, ap, a, a + 8, sw.max_evals, a + 8 * o[1],
-                a + 8 * (o[2] + start * nq), a + 8 * (o[3] + start), self.n, aUd + 8 * start * sud, sud,
-                aUdd + 8 * start * sudd, sudd, a + 8 * (o[4] + start), a + 8 * (o[5] + start))
+                stop - start, a + 8 * (o[6] + start * nu), a + 8 * o[9], a, a + 8, sw.max_evals, a + 8 * o[1],
+                a + 8 * (o[2] + start * nq), a + 8 * (o[3] + start), self.n, a + 8 * (o[7] + start * sud), sud,
+                a + 8 * (o[8] + start * sudd), sudd, a + 8 * (o[4] + start), a + 8 * (o[5] + start))
         else:
             k = sw._vm_advance(self, start, stop, s)
         self.accepted[start:k] = self.solved[start:k] = True

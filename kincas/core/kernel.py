@@ -119,44 +119,75 @@ def state_function(sym, blocks) -> ca.Function:
 
 
 def vm_step(kP, kN, kF, kL, nq, nu, max_evals, skip: bool = True) -> ca.Function:
-    """One pose for the virtual machine, the compiled loop's arithmetic: kN evaluated until
-    its step is below KERNEL_NEAR (at most max_evals times), then kF.
-    With `skip`, each later evaluation is a switch that the virtual machine skips once
-    converged, so a pose costs what it costs in C (a large kernel: 40 chained four-bars);
-    without, the pose is one flat SX function evaluating kN max_evals times, q held once
-    converged (a small kernel: the switch's function calls cost more than a 2x2 kN).
+    """One pose for the virtual machine, the compiled loop's arithmetic: where the last pose
+    was predicted to within STEP (`near`), kF at the prediction first, its step the last if
+    negligible; else kN evaluated until its step is below KERNEL_NEAR (at most max_evals
+    times; kF's step at the prediction, the same as kN's there, counts as the first), then kF.
+    With `skip`, the first evaluation is a switch on `near`, each later one a switch that the
+    virtual machine skips once converged, and the last kF a switch that passes the first one's
+    on where it converged, so a pose costs what it costs in C (a large kernel: 40 chained
+    four-bars); without, the pose is one flat SX function evaluating kF at the prediction
+    (as the first Newton step where it does not converge) and kN max_evals - 1 times, q held
+    once converged (a small kernel: the switch's function calls cost more than a 2x2 kN).
     info = (residual, next step, Jacobian change, correction, kN steps, converged). The
     groups' lengths Lb are an input, computed once per sweep as the compiled loop does.
     Functions written group by group are inlined (`expand`) for the virtual machine."""
     kP, kN, kF = (f.expand() if f.is_a("MXFunction") else f for f in (kP, kN, kF))
     X = ca.MX if skip else ca.SX
-    if skip:
-        x, u, p = ca.SX.sym("q", nq), ca.SX.sym("u", nu), ca.SX.sym("p", kN.size1_in(2))
-        Lx, t4 = ca.SX.sym("Lb", kL.size1_out(0)), ca.SX.sym("t4")
-        dq, rs = kN(x, u, p, Lx)
-        once = ca.Function.conditional(  # index 0 (not converged): one Newton step; else stay
-            "vm_newton", [ca.Function("vm_step", [x, u, p, Lx, t4], [x - dq, rs[1] <= t4])],
-            ca.Function("vm_stay", [x, u, p, Lx, t4], [x, ca.SX(1)]))
-    else:
-        def once(done, q, u, p, Lb, t4):  # every step evaluated, q held once converged
-            dq, rs = kN(q, u, p, Lb)
-            return ca.if_else(done, q, q - dq), rs[1] <= t4
     q0, J0, T0, u0 = X.sym("q0", nq), X.sym("J0", kF.size1_in(6)), X.sym("T0", nq, nu), X.sym("u0", nu)
     u, p, L, thr = X.sym("u", nu), X.sym("p", kN.size1_in(2)), X.sym("L"), X.sym("t", 5)
-    Lb = X.sym("Lb", kL.size1_out(0))
+    Lb, near = X.sym("Lb", kL.size1_out(0)), X.sym("near")
     ud, udd, T1, u1 = X.sym("ud", nu), X.sym("udd", nu), X.sym("T1", nq, nu), X.sym("u1", nu)
-    q = qp = kP(q0, T0, u0, u, T1, u1)
-    done, evals = X(0), X(0)
-    for _ in range(max_evals):
-        evals += 1 - done
-        q, conv = once(done, q, u, p, Lb, thr[4])
-        done = ca.logic_or(done, conv)
-    J, T, rs, mc, meas, y, dq = kF(q, u, p, L, ud, udd, J0, qp, Lb)
-    conv = ca.logic_and(rs[0] <= thr[0], rs[1] <= thr[1])
+    qp = kP(q0, T0, u0, u, T1, u1)
+    converged = lambda rs: ca.logic_and(rs[0] <= thr[0], rs[1] <= thr[1])
+    if skip:
+        x, ux, px = ca.SX.sym("q", nq), ca.SX.sym("u", nu), ca.SX.sym("p", kN.size1_in(2))
+        Lx, t4 = ca.SX.sym("Lb", kL.size1_out(0)), ca.SX.sym("t4")
+        dq, rs = kN(x, ux, px, Lx)
+        once = ca.Function.conditional(  # index 0 (not converged): one Newton step; else stay
+            "vm_newton", [ca.Function("vm_step", [x, ux, px, Lx, t4], [x - dq, rs[1] <= t4])],
+            ca.Function("vm_stay", [x, ux, px, Lx, t4], [x, ca.SX(1)]))
+        # the first evaluation: kN at the prediction, or (near) kF there, whose outputs the
+        # last evaluation passes on where it converged
+        fin = [ca.MX.sym(f"f{i}", kF.sparsity_out(i)) for i in range(kF.n_out())]
+        ins = [qp, u, p, L, ud, udd, J0, Lb, thr]
+        sym_ins = [ca.MX.sym(f"i{i}", v.sparsity()) for i, v in enumerate(ins)]
+        sq, su, sp, sL, sud, sudd, sJ0, sLb, st = sym_ins
+        dq, rs = kN(sq, su, sp, sLb)
+        zero = [ca.MX.zeros(f.sparsity()) for f in fin]
+        by_newton = ca.Function("vm_first_newton", sym_ins, [sq - dq, rs[1] <= st[4], ca.MX(1), ca.MX(0), *zero])
+        F = kF(sq, su, sp, sL, sud, sudd, sJ0, sq, sLb)
+        c1 = ca.logic_and(F[2][0] <= st[0], F[2][1] <= st[1])
+        by_final = ca.Function("vm_first_final", sym_ins,
+                               [ca.if_else(c1, sq, sq - F[6]), ca.logic_or(c1, F[2][1] <= st[4]), 1 - c1, c1, *F])
+        first = ca.Function.conditional("vm_first", [by_newton], by_final)
+        q, done, evals, conv1, *F1 = first(near, *ins)
+        for _ in range(max_evals - 1):
+            evals += 1 - done
+            q, conv = once(done, q, u, p, Lb, thr[4])
+            done = ca.logic_or(done, conv)
+        fin_ins = [q, u, p, L, ud, udd, J0, qp, Lb]
+        sym_fin = [ca.MX.sym(f"j{i}", v.sparsity()) for i, v in enumerate(fin_ins)]
+        last = ca.Function.conditional(  # index 0: kF at q; 1 (converged at the prediction): F1
+            "vm_last", [ca.Function("vm_final", [*sym_fin, *fin], kF(*sym_fin))],
+            ca.Function("vm_passed", [*sym_fin, *fin], fin))
+        J, T, rs, mc, meas, y, dq = last(conv1, *fin_ins, *F1)
+    else:  # every evaluation made, q held once converged
+        J, T, rs, mc, meas, y, dq = kF(qp, u, p, L, ud, udd, J0, qp, Lb)  # (its step: kN's there)
+        conv1 = ca.logic_and(near, converged(rs))
+        q = ca.if_else(conv1, qp, qp - dq)
+        done, evals = ca.logic_or(conv1, rs[1] <= thr[4]), 1 - conv1
+        for _ in range(max_evals - 1):
+            evals += 1 - done
+            dq, rs = kN(q, u, p, Lb)
+            q, done = ca.if_else(done, q, q - dq), ca.logic_or(done, rs[1] <= thr[4])
+        J, T, rs, mc, meas, y, dq = kF(q, u, p, L, ud, udd, J0, qp, Lb)
+    conv = converged(rs)
     q = ca.if_else(conv, q - dq, q)
     info = ca.vertcat(rs, mc, evals, conv)
-    return ca.Function("kS", [q0, J0, T0, u0, T1, u1, u, p, L, thr, ud, udd, Lb],
-                       [q, J, T, u, T0, u0, info, y, meas])
+    near_next = ca.logic_or(evals == 0, mc[1] <= thr[1])
+    return ca.Function("kS", [q0, J0, T0, u0, T1, u1, near, u, p, L, thr, ud, udd, Lb],
+                       [q, J, T, u, T0, u0, near_next, info, y, meas])
 
 
 def _group_correction(dx, blocks):
@@ -180,6 +211,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
   casadi_real qp[NQ], q[NQ], dq[NQ], J[NJ > 0 ? NJ : 1], T[NQ*NU], rs[2], rf[2], mc[2], ms[NM], y[NO > 0 ? NO : 1];
   casadi_real Lb[NM > 1 ? NM - 1 : 1];  /* each group's length, from the parameters */
   casadi_int k, i, it;
+  int near = 0;  /* the last pose was predicted to within STEP: try kF at the prediction first */
   if (n > 0) {
     arg[0] = U; arg[1] = p; res[0] = Lb;
     if (kL(arg, res, iw, w, 0)) return 0;
@@ -191,6 +223,13 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     arg[4] = s + NQ + NJ + NQ*NU + NU; arg[5] = s + NQ + NJ + 2*NQ*NU + NU; res[0] = qp;
     if (kP(arg, res, iw, w, 0)) break;
     for (i = 0; i < NQ; ++i) q[i] = qp[i];
+    if (near) {  /* kF at the prediction first: where its (next) step is negligible, no kN */
+      arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = L; arg[4] = Ud + k*sud; arg[5] = Udd + k*sudd;
+      arg[6] = s + NQ; arg[7] = qp; arg[8] = Lb;
+      res[0] = J; res[1] = T; res[2] = rf; res[3] = mc; res[4] = ms; res[5] = y; res[6] = dq;
+      if (kF(arg, res, iw, w, 0)) break;
+      if (rf[0] <= thr[0] && rf[1] <= thr[1]) { it = 0; goto evaluated; }
+    }  /* (else Newton from the prediction, as without: kN's first step is the same as kF's) */
     for (it = 1; ; ++it) {  /* Newton until the step just applied makes the next negligible */
       arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = Lb; res[0] = dq; res[1] = rs;
       if (kN(arg, res, iw, w, 0)) break;
@@ -201,6 +240,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     arg[6] = s + NQ; arg[7] = qp; arg[8] = Lb;
     res[0] = J; res[1] = T; res[2] = rf; res[3] = mc; res[4] = ms; res[5] = y; res[6] = dq;
     if (kF(arg, res, iw, w, 0)) break;
+  evaluated:
     conv = rf[0] <= thr[0] && rf[1] <= thr[1];  /* the next step is negligible: apply it */
     if (conv) for (i = 0; i < NQ; ++i) q[i] -= dq[i];
     for (i = 0; i < NQ; ++i) Q[k*NQ + i] = q[i];
@@ -209,6 +249,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     info[k] = rf[0]; info[ld + k] = rf[1]; info[2*ld + k] = mc[0]; info[3*ld + k] = mc[1];
     info[4*ld + k] = (casadi_real) it;
     if (!(conv && mc[0] <= thr[2] && mc[1] <= thr[3])) break;
+    near = it == 0 || mc[1] <= thr[1];
     for (i = 0; i < NQ*NU + NU; ++i) s[NQ + NJ + NQ*NU + NU + i] = s[NQ + NJ + i];
     for (i = 0; i < NQ; ++i) s[i] = q[i];
     for (i = 0; i < NJ; ++i) s[NQ + i] = J[i];
