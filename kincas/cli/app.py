@@ -32,6 +32,7 @@ COMMANDS = {
     "tolerance": ("kincas.cli.tolerance", "first-order and Monte-Carlo spread of outputs from parameter tolerances"),
     "study": ("kincas.cli.study", "many designs at once: the scene's [study] section, one row per design"),
     "cam": ("kincas.cli.cam", "design a disc cam from the scene's [cam_design] section (profile, pressure angle, curvature)"),
+    "app": ("kincas.cli.serve", "the mechanism in a live page on this machine: sliders, dragging, plots (kincas[app])"),
 }
 
 

@@ -1,0 +1,103 @@
+"""What the live page draws of a sweep, as JSON-ready lists: the bodies, the slides' guides, the
+gears', racks' and cams' curves, every point at every pose (from `kincas.views.picture`, so
+the page draws what the other pictures draw), the loads as arrows, and each link's instant
+centre of rotation relative to the ground.
+
+The instant centre I of a link turning at angular velocity w, one of whose points P moves at
+velocity v: v = w k x (P - I), so P - I = (v_y, -v_x) / w and I = (P_x - v_y / w, P_y + v_x / w).
+A link that does not turn (w = 0) translates: its centre is at infinity (None).
+
+>>> import numpy as np, kincas
+>>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+...            kincas.Link.bar("rocker", "D", "C", 3)],
+...     inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)})
+>>> sw = kincas.sweep(m, {"crank.angle": [0.5]},
+...                   report=["crank.omega", "A.vx", "A.vy", "coupler.omega", "B.vx", "B.vy"])
+>>> [round(c, 9) for c in instant_centres(m, sw)["crank"][0]]   # the crank turns about A
+[0.0, 0.0]
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...model.mechanism import Mechanism
+from ...results import Sweep
+from ..picture import INK, picture
+
+FAR = 50  # instant centres farther than this many mechanism sizes are drawn as at infinity
+
+
+def _list(a):
+    from .engine import _list as lst
+    return lst(a)
+
+
+def drawing(m: Mechanism, sw: Sweep, handles: dict) -> dict:
+    """Names, points per pose, bodies, guides, joint curves, loads; `draggable` lists the ground
+    points (they move the ground) and the moving points (they move the input)."""
+    n = len(sw)
+    if not sw.ok.any():  # nothing to draw (the page keeps showing the last solved sweep)
+        from ..poses import geometry
+        names = list(geometry(m, sw).names)
+        return {"names": names, "xy": [[None] * len(names)] * n, "r": 0.0, "box": [[0, 0], [1, 1]],
+                "ground": [names.index(g) for g in m.ground_points],
+                "moving": [names.index(p) for p in m.moving_points if p in names],
+                "bodies": [], "guides": [], "joints": None, "loads": []}
+    pic = picture(m, sw, paths=[])
+    joints = None
+    if m.gears or m.racks or m.cams:  # coarse curves per pose (the page stays small)
+        colours = {b.name: b.colour for b in pic.bodies}
+        joints = [[{"colour": "#c0392b" if len(a) == 1 else colours.get(body, INK), "pts": _list(a)}
+                   for _, body, a in pic.joint_curves(i, 41)] for i in range(n)]
+    return {
+        "names": pic.names, "xy": _list(pic.xy), "r": float(pic.r), "box": _list(pic.box()),
+        "ground": pic.ground, "moving": [pic.names.index(p) for p in m.moving_points if p in pic.names],
+        "bodies": [{"name": b.name, "ring": b.ring, "colour": b.colour, "driven": b.driven}
+                   for b in pic.bodies],
+        "guides": [{"name": g.name, "point": g.point, "ground": g.ground, "colour": g.colour,
+                    "lo": g.lo, "hi": g.hi, "through": _list(g.through), "direction": _list(g.direction)}
+                   for g in pic.guides],
+        "joints": joints, "loads": _loads(m, pic),
+    }
+
+
+def _loads(m: Mechanism, pic) -> list[dict]:
+    """Each force load as {point, vector} and each spring as {points}; torques as {link,
+    value} (the page draws an arc about the link's first point)."""
+    out = []
+    for ld in m.loads:
+        if ld.kind == "force" and ld.at in pic.names:
+            out.append({"kind": "force", "point": pic.names.index(ld.at),
+                        "vector": [m.value(ld.value[0]), m.value(ld.value[1])]})
+        elif ld.kind == "spring" and all(p in pic.names for p in ld.points):
+            out.append({"kind": "spring", "points": [pic.names.index(p) for p in ld.points]})
+        elif ld.kind == "torque":
+            lk = next((lk for lk in m.links if lk.name == ld.at), None)
+            if lk is not None:
+                out.append({"kind": "torque", "point": pic.names.index(lk.point_names[0]),
+                            "value": m.value(ld.value)})
+    return out
+
+
+def instant_centres(m: Mechanism, sw: Sweep) -> dict[str, list]:
+    """Link -> per pose its instant centre [x, y] relative to the ground (None where the
+    link translates, or the centre is too far to draw, or the pose is not solved)."""
+    from ..poses import geometry
+    geo = geometry(m, sw)
+    far = FAR * m.size()
+    out = {}
+    for lk in m.links:
+        w = sw.values.get(f"{lk.name}.omega")
+        p = next((q for q in lk.point_names if f"{q}.vx" in sw.values), None)
+        if w is None or p is None:
+            continue
+        xy = geo.point(p)
+        vx, vy = np.asarray(sw.values[f"{p}.vx"], float), np.asarray(sw.values[f"{p}.vy"], float)
+        w = np.asarray(w, float)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            c = np.stack([xy[:, 0] - vy / w, xy[:, 1] + vx / w], axis=1)
+        bad = ~np.isfinite(c).all(axis=1) | (np.hypot(*(c - xy).T) > far)
+        out[lk.name] = [None if b else [float(a), float(b_)] for b, (a, b_) in zip(bad, c)]
+    return out
+
