@@ -27,7 +27,7 @@ from conftest import ROOT
 starlette = pytest.importorskip("starlette", reason="kincas[app] is not installed")
 pytest.importorskip("httpx", reason="Starlette's test client needs httpx")
 with warnings.catch_warnings():  # Starlette 1.x would rather have httpx2; httpx still works
-    warnings.simplefilter("ignore", DeprecationWarning)
+    warnings.simplefilter("ignore")
     from starlette.testclient import TestClient  # noqa: E402
 
 from kincas.cli.serve import HOST, application, bind  # noqa: E402

@@ -19,6 +19,8 @@ A link that does not turn (w = 0) translates: its centre is at infinity (None).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ...model.mechanism import Mechanism
@@ -28,9 +30,27 @@ from ..picture import INK, picture
 FAR = 50  # instant centres farther than this many mechanism sizes are drawn as at infinity
 
 
-def _list(a):
-    from .engine import _list as lst
-    return lst(a)
+def _plain(v):
+    """A JSON number, None for NaN or infinity."""
+    v = float(v)
+    return v if math.isfinite(v) else None
+
+
+def _list(a) -> list:
+    """A nested list of JSON numbers (None where not finite)."""
+    a = np.asarray(a, float)
+    if a.ndim == 0:
+        return _plain(a)
+    out = a.round(12).tolist() if a.size else a.tolist()
+    if np.isfinite(a).all():
+        return out
+    return _nulls(out)
+
+
+def _nulls(v):
+    if isinstance(v, list):
+        return [_nulls(x) for x in v]
+    return v if math.isfinite(v) else None
 
 
 def drawing(m: Mechanism, sw: Sweep, handles: dict) -> dict:

@@ -35,34 +35,12 @@ import numpy as np
 from ...model.mechanism import Mechanism, Param
 from ...results import Sweep
 from .. import columns
+from .drawing import _list
 
 HIDDEN = "_ground_"  # prefix of the lifted ground coordinates' parameter names
 STEPS = 361  # poses of the default sweep of an angle input (one per degree)
 CONTINUATION = math.radians(3)  # largest step of an angle input between two continuation poses
 PARTS = 60  # continuation steps over a slide's or parameter input's whole range
-
-
-def _plain(v):
-    """A JSON number, None for NaN or infinity."""
-    v = float(v)
-    return v if math.isfinite(v) else None
-
-
-def _list(a) -> list:
-    """A nested list of JSON numbers (None where not finite)."""
-    a = np.asarray(a, float)
-    if a.ndim == 0:
-        return _plain(a)
-    out = a.round(12).tolist() if a.size else a.tolist()
-    if np.isfinite(a).all():
-        return out
-    return _nulls(out)
-
-
-def _nulls(v):
-    if isinstance(v, list):
-        return [_nulls(x) for x in v]
-    return v if math.isfinite(v) else None
 
 
 @dataclass
