@@ -238,3 +238,20 @@ def test_the_command_serves_on_127_0_0_1_and_ctrl_c_stops_it_within_a_second():
             proc.kill()
     assert waited < 1.0, f"exited {waited:.2f} s after Ctrl-C\n{err}"
     assert proc.returncode == 130 and "interrupted" in err and "Traceback" not in err, err
+
+
+def test_the_widget_answers_the_page_through_its_messages():
+    pytest.importorskip("anywidget", reason="anywidget (kincas[app]) is not installed")
+    sc = load(FOURBAR)
+    w = kincas.widget(sc)
+    assert "export default" in w._esm and "kincasApp" in w._esm and ".kincas-app" in w._css
+    sent = []
+    w.send = sent.append
+    w._answer(w, {"id": 7, "name": "change", "body": {"parameters": {"r2": 35}}})
+    assert sent[-1]["id"] == 7 and all(sent[-1]["ok"]["ok"])
+    want = kincas.sweep(sc.mechanism.with_parameters(r2=35), sc.study.inputs, report=["P.x"])
+    np.testing.assert_allclose(column(sent[-1]["ok"], "P.x"), want["P.x"], rtol=1e-9, atol=1e-9)
+    w._answer(w, {"id": 8, "name": "change", "body": {"parameters": {"nope": 1}}})
+    assert sent[-1] == {"id": 8, "error": "nothing to change called 'nope'"}
+    m = kincas.widget(sc.mechanism).live  # a bare mechanism: its crank turns a full circle
+    assert m.state()["poses"] == 361 and all(m.state()["ok"])

@@ -58,28 +58,11 @@ class Session:
 
     def request(self, what: str, body: dict | None = None) -> dict:
         """Answer one request of the page (docs/app.md): "state", "change" or "drag"."""
-        body = body or {}
-        if not isinstance(body, dict):
-            raise RequestError("expected a JSON object")
         with self.lock:
             try:
-                if what == "state":
-                    return self.live.state()
-                if what == "change":
-                    extra = set(body) - {"parameters", "inputs"}
-                    if extra:
-                        raise RequestError(f"change: unknown field(s) {sorted(extra)}")
-                    p, i = body.get("parameters") or {}, body.get("inputs") or {}
-                    if not isinstance(p, dict) or not isinstance(i, dict):
-                        raise RequestError("change: parameters and inputs are objects name -> number")
-                    return self.live.change(p, i)
-                if what == "drag":
-                    if not isinstance(body.get("point"), str):
-                        raise RequestError("drag: point: expected a point's name")
-                    return self.live.drag(body["point"], body.get("x"), body.get("y"))
+                return self.live.request(what, body)
             except (KeyError, ValueError, TypeError, KincasError) as e:
                 raise RequestError(str(e.args[0]) if isinstance(e, KeyError) and e.args else str(e)) from None
-        raise RequestError(f"no request called {what!r}")
 
     def toml(self) -> str:
         """The scene with its edits, as TOML text (reads back to the edited mechanism)."""

@@ -449,7 +449,8 @@ function kincasApp(root, transport) {
   });
   for (const s of [".k-paths", ".k-centres", ".k-forces"]) $(s).addEventListener("change", draw);
   $(".k-fit").addEventListener("click", () => { fit(); draw(); });
-  if (transport.toml) {  // in a notebook: the kernel writes the file's text
+  if (transport.download === false) $(".k-download").style.display = "none";
+  else if (transport.toml) {  // the host writes the file's text
     $(".k-download").addEventListener("click", e => {
       e.preventDefault();
       transport.toml().then(text => {

@@ -228,6 +228,29 @@ class Live:
             raise KeyError(f"drag: no point called {point!r}")
         return self._follow(point, np.array([x, y], float))
 
+    def request(self, what: str, body: dict | None = None) -> dict:
+        """Answer one request of the page (docs/app.md): "state", "change" ({"parameters":
+        {...}, "inputs": {...}}) or "drag" ({"point", "x", "y"}). A request that cannot be
+        honoured raises ValueError (or KeyError) with one line, and changes nothing."""
+        body = {} if body is None else body
+        if not isinstance(body, dict):
+            raise ValueError("expected a JSON object")
+        if what == "state":
+            return self.state()
+        if what == "change":
+            extra = set(body) - {"parameters", "inputs"}
+            if extra:
+                raise ValueError(f"change: unknown field(s) {sorted(extra)}")
+            p, i = body.get("parameters") or {}, body.get("inputs") or {}
+            if not isinstance(p, dict) or not isinstance(i, dict):
+                raise ValueError("change: parameters and inputs are objects name -> number")
+            return self.change(p, i)
+        if what == "drag":
+            if not isinstance(body.get("point"), str):
+                raise ValueError("drag: point: expected a point's name")
+            return self.drag(body["point"], body.get("x"), body.get("y"))
+        raise ValueError(f"no request called {what!r}")
+
     # --- solving ---
 
     def table(self) -> dict[str, np.ndarray]:
