@@ -36,55 +36,11 @@ from ...model.mechanism import Mechanism, Param
 from ...results import Sweep
 from .. import columns
 from .drawing import _list
+from .setting import Setting  # noqa: F401  (the page's setting of a bare mechanism)
 
 HIDDEN = "_ground_"  # prefix of the lifted ground coordinates' parameter names
-STEPS = 361  # poses of the default sweep of an angle input (one per degree)
 CONTINUATION = math.radians(3)  # largest step of an angle input between two continuation poses
 PARTS = 60  # continuation steps over a slide's or parameter input's whole range
-
-
-@dataclass
-class Setting:
-    """What `Live` edits, shaped as a scene (kincas/cli/scene.py's `Scene` is one): the
-    `mechanism`, a `study` (inputs in radians, rates, accelerations, report, units, title,
-    ranges) and the scene's unit conversions. `Setting.of(m)` makes one from a bare
-    mechanism: angle inputs turn a full circle, other inputs stay at their first values."""
-
-    mechanism: Mechanism
-    study: object
-
-    @classmethod
-    def of(cls, m: Mechanism, inputs=None, report=None) -> "Setting":
-        from types import SimpleNamespace
-        from ..notebook import first_inputs
-        from ...model.names import default_report
-        first = first_inputs(m)
-        if inputs is None:
-            inputs, swept = {}, False
-            for inp in m.inputs:
-                v = first[inp.key]
-                if inp.kind == "angle" and not swept:
-                    inputs[inp.key], swept = v + np.linspace(0, 2 * np.pi, STEPS), True
-                else:
-                    inputs[inp.key] = np.array([v])
-            n = max((len(v) for v in inputs.values()), default=1)
-            inputs = {k: np.resize(v, n) if len(v) == 1 else v for k, v in inputs.items()}
-        inputs = {k: np.atleast_1d(np.asarray(v, float)) for k, v in inputs.items()}
-        study = SimpleNamespace(title="", units={"length": "", "angle": "rad", "time": "s"},
-                                inputs=inputs, rates={}, accelerations={}, ranges={},
-                                report=list(report) if report is not None else default_report(m),
-                                sensitivity=[], deg=False)
-        return cls(m, study)
-
-    @property
-    def quantities(self) -> list[str]:
-        return list(self.study.report)
-
-    def user_inputs(self, s: Sweep) -> dict:
-        return dict(s.inputs)
-
-    def user_values(self, s: Sweep) -> dict:
-        return dict(s.values)
 
 
 @dataclass
@@ -299,9 +255,9 @@ class Live:
 
     def _follow(self, point: str, target: np.ndarray) -> dict:
         """The pose of the sweep (or the fixed input's value) nearest `target` for `point`."""
+        from ..poses import geometry
         swept = [i for i in self.inputs if i.swept]
         if swept or not self.inputs:
-            from ..poses import geometry
             xy = geometry(self.m, self.sweep).point(point)
             d = np.hypot(*(xy - target).T)
             d[~np.isfinite(d)] = np.inf
@@ -318,7 +274,6 @@ class Live:
                 table = {i.key: np.full(n, i.values[0]) for i in self.inputs}
                 table[inp.key] = np.linspace(v0, end, n)
                 sw = sweep(self.m, table, report=[], guess=self.guess0)
-                from ..poses import geometry
                 xy = geometry(self.m, sw).point(point)
                 d = np.hypot(*(xy - target).T)
                 run = np.cumprod(sw.ok).astype(bool)  # up to the first pose that fails
