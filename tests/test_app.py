@@ -255,3 +255,35 @@ def test_the_widget_answers_the_page_through_its_messages():
     assert sent[-1] == {"id": 8, "error": "nothing to change called 'nope'"}
     m = kincas.widget(sc.mechanism).live  # a bare mechanism: its crank turns a full circle
     assert m.state()["poses"] == 361 and all(m.state()["ok"])
+
+
+def test_instant_centres_meet_kennedys_lines(client):
+    """The coupler's instant centre relative to the ground is where the crank's line O2-A meets
+    the rocker's line O4-B (Aronhold-Kennedy); the crank's is its pivot."""
+    c, _ = client
+    st = c.get("/api/state").json()
+    o2, a, o4, b = (points(st, p) for p in ("O2", "A", "O4", "B"))
+    crank = np.array([[np.nan] * 2 if v is None else v for v in st["centres"]["crank"]], float)
+    np.testing.assert_allclose(crank, o2, atol=1e-9)
+    for i, ic in enumerate(st["centres"]["coupler"]):
+        d1, d2 = a[i] - o2[i], b[i] - o4[i]
+        det = d1[0] * -d2[1] + d2[0] * d1[1]
+        if abs(det) < 1e-6 * np.hypot(*d1) * np.hypot(*d2):  # parallel: at infinity
+            assert ic is None or np.hypot(*(np.array(ic) - b[i])) > 1e3
+            continue
+        t = ((o4[i] - o2[i])[0] * -d2[1] + d2[0] * (o4[i] - o2[i])[1]) / det
+        want = o2[i] + t * d1
+        if np.hypot(*(want - b[i])) < 50 * 100:  # drawn only within 50 mechanism sizes
+            np.testing.assert_allclose(ic, want, rtol=1e-7, atol=1e-7)
+
+
+def test_reported_reactions_and_efforts_are_drawn_as_forces():
+    sc = load(ROOT / "examples" / "forces_toggle.toml")
+    with TestClient(application(Session(sc))) as c:
+        st = c.get("/api/state").json()
+    f = {x["label"]: x for x in st["drawing"]["forces"]}
+    b = f["reaction(B, rocker)"]
+    assert st["drawing"]["names"][b["point"]] == "B"
+    np.testing.assert_allclose(np.array(b["vectors"])[:, 0], column(st, "reaction(B, rocker).x"))
+    np.testing.assert_allclose(f["effort(crank.angle)"]["values"], column(st, "effort(crank.angle)"))
+    assert {x["kind"] for x in st["drawing"]["loads"]} == {"torque", "spring"}

@@ -43,7 +43,7 @@ function kincasApp(root, transport) {
   <div class="k-bar">
    <label><input class="k-paths" type="checkbox" checked> paths</label>
    <label><input class="k-centres" type="checkbox"> instant centres</label>
-   <label><input class="k-forces" type="checkbox"> loads</label>
+   <label><input class="k-forces" type="checkbox"> forces</label>
    <button class="k-fit" type="button">fit view</button>
    <a class="k-download" href="api/scene.toml" download="scene.toml">download scene (TOML)</a>
   </div>
@@ -253,7 +253,7 @@ function kincasApp(root, transport) {
         ctx.lineCap = "round"; line(pts, b.colour, 7); ctx.lineCap = "butt";
       }
     }
-    if ($(".k-forces").checked) drawLoads(D, xy);
+    if ($(".k-forces").checked) { drawLoads(D, xy); drawForces(D, xy, i); }
     if ($(".k-centres").checked) drawCentres(st, i);
     for (let k = 0; k < D.names.length; k++) {  // joints and points, with their names
       const p = xy[k]; if (!fin(p)) continue;
@@ -282,12 +282,31 @@ function kincasApp(root, transport) {
         }
         pts.push(b); line(pts, "#8e44ad", 1.5);
       } else if (l.kind === "torque" && fin(xy[l.point])) {
-        const p = xy[l.point], r = 18, s = l.value >= 0 ? 1 : -1;
-        ctx.beginPath(); ctx.strokeStyle = "#c0392b"; ctx.lineWidth = 2;
-        ctx.arc(X(p), Y(p), r, -0.2, -0.2 - s * 4.5, s > 0); ctx.stroke();
-        const e = -0.2 - s * 4.5, ex = X(p) + r * Math.cos(e), ey = Y(p) + r * Math.sin(e);
-        ctx.beginPath(); ctx.arc(ex, ey, 3.5, 0, 2 * Math.PI); ctx.fillStyle = "#c0392b"; ctx.fill();
-        ctx.font = "11px sans-serif"; ctx.fillText(fmt(l.value, 3), X(p) + r + 3, Y(p) - r);
+        torque(xy[l.point], l.value, "#c0392b", fmt(l.value, 3));
+      }
+    }
+  }
+
+  function torque(p, value, colour, label) {  // an arc about p, turning as the torque's sign says
+    const r = 18, s = value >= 0 ? 1 : -1, e = -0.2 - s * 4.5;
+    ctx.beginPath(); ctx.strokeStyle = colour; ctx.lineWidth = 2;
+    ctx.arc(X(p), Y(p), r, -0.2, e, s > 0); ctx.stroke();
+    ctx.beginPath(); ctx.arc(X(p) + r * Math.cos(e), Y(p) + r * Math.sin(e), 3.5, 0, 2 * Math.PI);
+    ctx.fillStyle = colour; ctx.fill();
+    ctx.font = "11px sans-serif"; ctx.fillText(label, X(p) + r + 3, Y(p) - r);
+  }
+  function drawForces(D, xy, i) {  // reported reactions (arrows) and input efforts (arcs)
+    const reactions = D.forces.filter(f => f.kind === "reaction");
+    let most = 1e-300;
+    for (const f of reactions) for (const v of f.vectors) if (fin(v)) most = Math.max(most, Math.hypot(v[0], v[1]));
+    const L = 0.12 * Math.min(mech.width, mech.height);
+    for (const f of D.forces) {
+      const p = xy[f.point]; if (!fin(p)) continue;
+      if (f.kind === "reaction" && fin(f.vectors[i])) {
+        const v = f.vectors[i];
+        arrow(p, [L * v[0] / most, L * v[1] / most], "#2c7fb8", f.label + " " + fmt(Math.hypot(v[0], v[1]), 3));
+      } else if (f.kind === "effort" && f.values[i] !== null) {
+        torque(p, f.values[i], "#2c7fb8", f.label + " " + fmt(f.values[i], 3));
       }
     }
   }

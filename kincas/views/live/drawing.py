@@ -78,8 +78,32 @@ def drawing(m: Mechanism, sw: Sweep, handles: dict) -> dict:
         "guides": [{"name": g.name, "point": g.point, "ground": g.ground, "colour": g.colour,
                     "lo": g.lo, "hi": g.hi, "through": _list(g.through), "direction": _list(g.direction)}
                    for g in pic.guides],
-        "joints": joints, "loads": _loads(m, pic),
+        "joints": joints, "loads": _loads(m, pic), "forces": forces(m, sw, pic.names),
     }
+
+
+def forces(m: Mechanism, sw: Sweep, names: list[str]) -> list[dict]:
+    """The reported reactions at pins, as arrows per pose ({point, label, vectors}), and the
+    reported efforts of angle inputs, as torques per pose ({point, label, values}) at the
+    driven link's first point. A slide's reaction acts at the slide's point."""
+    from ...core.dynamics import _EFFORT, _REACTION
+    out, v = [], sw.values
+    for name in v:
+        r = _REACTION.match(name)
+        if r and r["attr"] == "x" and name[:-1] + "y" in v:
+            a = r["a"]
+            point = a if r["b"] else next((sl.point for sl in m.slides if sl.name == a), None)
+            if point in names:
+                xy = np.stack([np.asarray(v[name], float), np.asarray(v[name[:-1] + "y"], float)], axis=1)
+                out.append({"kind": "reaction", "point": names.index(point), "label": name[:-2],
+                            "vectors": _list(xy)})
+        e = _EFFORT.match(name)
+        if e and e["key"].endswith(".angle"):
+            lk = next((lk for lk in m.links if f"{lk.name}.angle" == e["key"]), None)
+            if lk is not None and lk.point_names[0] in names:
+                out.append({"kind": "effort", "point": names.index(lk.point_names[0]), "label": name,
+                            "values": _list(v[name])})
+    return out
 
 
 def _loads(m: Mechanism, pic) -> list[dict]:
