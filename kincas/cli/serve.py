@@ -22,7 +22,7 @@ from ..errors import OutputError
 
 HOST = "127.0.0.1"  # this machine only: the page edits files' worth of data, and runs no login
 PORT = 8765  # the default port; another free one when it is taken
-SHUTDOWN = 0.5  # seconds given to open requests when Ctrl-C comes (then they are dropped)
+SHUTDOWN = 0.25  # seconds given to open requests when Ctrl-C comes (then they are dropped)
 
 
 def cli_arguments(ap: argparse.ArgumentParser) -> None:

@@ -63,7 +63,7 @@ def drawing(m: Mechanism, sw: Sweep, handles: dict) -> dict:
         return {"names": names, "xy": [[None] * len(names)] * n, "r": 0.0, "box": [[0, 0], [1, 1]],
                 "ground": [names.index(g) for g in m.ground_points],
                 "moving": [names.index(p) for p in m.moving_points if p in names],
-                "bodies": [], "guides": [], "joints": None, "loads": []}
+                "bodies": [], "guides": [], "joints": None, "loads": [], "forces": [], "centres": {}}
     pic = picture(m, sw, paths=[])
     joints = None
     if m.gears or m.racks or m.cams:  # coarse curves per pose (the page stays small)
@@ -79,6 +79,7 @@ def drawing(m: Mechanism, sw: Sweep, handles: dict) -> dict:
                     "lo": g.lo, "hi": g.hi, "through": _list(g.through), "direction": _list(g.direction)}
                    for g in pic.guides],
         "joints": joints, "loads": _loads(m, pic), "forces": forces(m, sw, pic.names),
+        "centres": instant_centres(m, sw, pic.names, pic.xy),
     }
 
 
@@ -124,11 +125,14 @@ def _loads(m: Mechanism, pic) -> list[dict]:
     return out
 
 
-def instant_centres(m: Mechanism, sw: Sweep) -> dict[str, list]:
+def instant_centres(m: Mechanism, sw: Sweep, names=None, xy=None) -> dict[str, list]:
     """Link -> per pose its instant centre [x, y] relative to the ground (None where the
-    link translates, or the centre is too far to draw, or the pose is not solved)."""
-    from ..poses import geometry
-    geo = geometry(m, sw)
+    link translates, or the centre is too far to draw, or the pose is not solved); the
+    points' positions `xy` (pose, point, 2) in the order of `names` when already at hand."""
+    if xy is None:
+        from ..poses import geometry
+        geo = geometry(m, sw)
+        names, xy = geo.names, geo.xy
     far = FAR * m.size()
     out = {}
     for lk in m.links:
@@ -136,12 +140,11 @@ def instant_centres(m: Mechanism, sw: Sweep) -> dict[str, list]:
         p = next((q for q in lk.point_names if f"{q}.vx" in sw.values), None)
         if w is None or p is None:
             continue
-        xy = geo.point(p)
+        at = xy[:, list(names).index(p)]
         vx, vy = np.asarray(sw.values[f"{p}.vx"], float), np.asarray(sw.values[f"{p}.vy"], float)
         w = np.asarray(w, float)
         with np.errstate(divide="ignore", invalid="ignore"):
-            c = np.stack([xy[:, 0] - vy / w, xy[:, 1] + vx / w], axis=1)
-        bad = ~np.isfinite(c).all(axis=1) | (np.hypot(*(c - xy).T) > far)
-        out[lk.name] = [None if b else [float(a), float(b_)] for b, (a, b_) in zip(bad, c)]
+            c = np.stack([at[:, 0] - vy / w, at[:, 1] + vx / w], axis=1)
+            c[~(np.hypot(*(c - at).T) <= far)] = np.nan  # (NaN compares false: dropped too)
+        out[lk.name] = [None if v is None or None in v else v for v in _list(c)]
     return out
-

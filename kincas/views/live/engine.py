@@ -307,12 +307,13 @@ class Live:
 
     def state(self) -> dict:
         """Everything the page draws and prints, JSON-ready (see docs/app.md)."""
-        from .drawing import drawing, instant_centres
+        from .drawing import drawing
         sw, sc = self.sweep, replace(self.setting, mechanism=self.m) if hasattr(self.setting, "__dataclass_fields__") else self.setting
         inputs, values = columns.user_columns(sw, sc)
         values = {k: values[k] for k in self.report if k not in inputs}
         xkey, x = columns._abscissa(sw, inputs)
         units = sc.study.units
+        drawn = drawing(self.m, sw, self.handles)
         return {
             "version": self.version, "title": getattr(sc.study, "title", "") or "kincas",
             "units": {"length": units.get("length", ""), "angle": units.get("angle", "rad")},
@@ -322,8 +323,8 @@ class Live:
             "ok": [bool(v) for v in sw.ok], "status": [str(s) for s in sw.status],
             "flags": [f or None for f in sw.flags],
             "events": [{"pose": int(e["pose"]), "kind": str(e.get("kind", ""))} for e in sw.events],
-            "drawing": drawing(self.m, sw, self.handles),
-            "centres": instant_centres(self.m, sw),
+            "drawing": drawn,
+            "centres": drawn.pop("centres"),
             "plot": {"x": {"name": xkey or "pose", "unit": columns.quantity_unit(sc, xkey) if xkey else "",
                            "values": _list(x)},
                      "quantities": [{"name": k, "unit": columns.quantity_unit(sc, k), "values": _list(v)}
