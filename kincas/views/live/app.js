@@ -405,8 +405,10 @@ function kincasApp(root, transport) {
       pctx.save(); pctx.beginPath(); pctx.rect(ML, top, Wp - ML - MR, bot - top); pctx.clip();
       pctx.beginPath(); pctx.strokeStyle = "#1f77b4"; pctx.lineWidth = 1.5;
       let pen = false;
+      const wrap = q.unit === "deg" ? 180 : q.unit === "rad" ? Math.PI : Infinity;  // angles wrap
       q.values.forEach((v, k) => {
         if (v === null || xs[k] === null || !S.ok[k]) { pen = false; return; }
+        if (k > 0 && q.values[k - 1] !== null && Math.abs(v - q.values[k - 1]) > wrap) pen = false;
         if (pen) pctx.lineTo(PX(xs[k]), PY(v)); else pctx.moveTo(PX(xs[k]), PY(v));
         pen = true;
       });
