@@ -39,7 +39,7 @@ FOURBAR = ROOT / "examples" / "fourbar_coupler.toml"
 @pytest.fixture
 def client():
     sc = load(FOURBAR)
-    with TestClient(application(Session(sc, "fourbar.toml"))) as c:
+    with TestClient(application(Session(sc, "fourbar.toml", FOURBAR.read_text(encoding="utf-8")))) as c:
         yield c, sc
 
 
@@ -136,6 +136,7 @@ def test_the_edited_scene_reads_back_to_the_same_mechanism(client):
     st = c.get("/api/state").json()
     r = c.get("/api/scene.toml")
     assert r.status_code == 200 and 'filename="fourbar.toml"' in r.headers["content-disposition"]
+    assert "r3 = 95.5         # coupler A-B" in r.text and "# Grashof" in r.text  # comments kept
     again = loads(r.text)
     want = replace(sc.mechanism.with_parameters(r3=95.5), ground={"O2": (2.25, 1.0), "O4": ("r1", 0)})
     assert again.mechanism == want
@@ -303,3 +304,14 @@ def test_a_taken_port_or_a_wrong_scene_is_one_line_and_exit_2(capsys, tmp_path):
                    "[links]\ncrank = { points = [\"A\", \"B\"], length = \"r\" }\n", encoding="utf-8")
     assert main(["app", str(bad), "--no-browser", "--port", "0"]) == 2
     assert "[parameters] r: range" in capsys.readouterr().err
+
+
+def test_an_edit_that_cannot_be_made_in_place_rewrites_the_whole_scene():
+    from kincas.cli.scene_toml import edited
+    text = "[parameters]  # sizes\nr = 1  # crank\n[ground]\nA = [\n  0,\n  0,\n]\n"
+    old = tomllib.loads(text)
+    new = {"parameters": {"r": 2}, "ground": {"A": [0.5, 0]}}
+    out = edited(text, old, new)
+    assert tomllib.loads(out) == new  # the array over several lines: written afresh
+    same = edited(text, old, {"parameters": {"r": 2}, "ground": {"A": [0, 0]}})
+    assert same.startswith("[parameters]  # sizes\nr = 2  # crank\n")  # in place, comments kept

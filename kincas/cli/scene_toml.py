@@ -9,7 +9,7 @@ blocks.
 >>> doc = {"title": "a \\"four\\"-bar", "parameters": {"r": 1.5, "a1": {"value": 130, "range": [100, 160]}},
 ...        "ground": {"A": [0, 0], "O 4": ["r", 0]}, "inputs": [{"angle": "crank", "value": 90}]}
 >>> text = dumps(doc)
->>> import tomllib; tomllib.loads(text) == doc
+>>> tomllib.loads(text) == doc
 True
 >>> print(text.splitlines()[0])
 title = "a \\"four\\"-bar"
@@ -17,6 +17,7 @@ title = "a \\"four\\"-bar"
 from __future__ import annotations
 
 import datetime
+import tomllib
 import json
 import math
 import re
@@ -83,3 +84,61 @@ def number(v: float, like=None):
     if isinstance(like, int) and not isinstance(like, bool) and v.is_integer() and abs(v) < 2 ** 53:
         return int(v)
     return v
+
+
+_HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_-]+)\s*\]\]?\s*(#.*)?$")
+_ENTRY = re.compile(r"^(\s*)([A-Za-z0-9_-]+|\"[^\"]*\")(\s*=\s*)(.*?)(\s*(#.*)?)$")
+
+
+def edited(text: str, old: dict, new: dict) -> str:
+    """`text` (whose document is `old`) with the entries that differ in `new` written anew in
+    place, so that its comments and layout stay: each changed `key = value` line of a table or
+    of the n-th block of an array of tables gets the new value, its comment kept. Where that
+    does not give exactly `new` (a value over several lines, a dotted key, a change of shape),
+    the whole document is written afresh (`dumps`).
+
+    >>> text = '[parameters]\\nr = 1   # crank\\n\\n[[inputs]]\\nangle = "crank"\\nvalue = 30\\n'
+    >>> old = tomllib.loads(text)
+    >>> new = {"parameters": {"r": 1.5}, "inputs": [{"angle": "crank", "value": 45}]}
+    >>> print(edited(text, old, new), end="")
+    [parameters]
+    r = 1.5   # crank
+    <BLANKLINE>
+    [[inputs]]
+    angle = "crank"
+    value = 45
+    """
+    table, seen, out = None, {}, []
+    for line in text.splitlines(keepends=True):
+        body, end = (line[:-1], "\n") if line.endswith("\n") else (line, "")
+        h = _HEADER.match(body)
+        if h:
+            name = h.group(2)
+            if h.group(1) == "[[":
+                seen[name] = seen.get(name, -1) + 1
+                table = _get(new, name, seen[name]), _get(old, name, seen[name])
+            else:
+                table = new.get(name), old.get(name)
+            out.append(line)
+            continue
+        if body.lstrip().startswith("["):  # a dotted table, or an array's line: not ours to edit
+            table = None
+        e = _ENTRY.match(body.rstrip("\r"))
+        if e and table is not None and isinstance(table[0], dict) and isinstance(table[1], dict):
+            k = e.group(2).strip('"')
+            if k in table[0] and table[0][k] != table[1].get(k):
+                line = f"{e.group(1)}{e.group(2)}{e.group(3)}{value(table[0][k])}{e.group(5)}" \
+                       + ("\r" if body.endswith("\r") else "") + end
+        out.append(line)
+    result = "".join(out)
+    try:
+        if tomllib.loads(result) == new:
+            return result
+    except tomllib.TOMLDecodeError:
+        pass
+    return dumps(new)
+
+
+def _get(doc: dict, name: str, i: int):
+    v = doc.get(name)
+    return v[i] if isinstance(v, list) and i < len(v) and isinstance(v[i], dict) else None

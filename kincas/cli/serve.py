@@ -114,7 +114,8 @@ def cli_run(args) -> int:
     import uvicorn
     from .serve_scene import Session
     from .scene import load
-    session = Session(load(args.scene), Path(args.scene).name)
+    scene = load(args.scene)  # (a file it cannot read fails here, with the scene's message)
+    session = Session(scene, Path(args.scene).name, Path(args.scene).read_bytes().decode("utf-8-sig"))
     sock = bind(args.port)
     url = f"http://{HOST}:{sock.getsockname()[1]}/"
     config = uvicorn.Config(application(session), log_level="warning", lifespan="off",

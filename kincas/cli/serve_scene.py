@@ -1,6 +1,7 @@
 """One scene being edited by `kincas app`: the live model of its mechanism (kincas/views/live/
 engine.py) and the scene file written back with the edits (its parameters, its ground points'
-numeric coordinates, its fixed inputs' values), everything else as the file had it.
+numeric coordinates, its fixed inputs' values), everything else as the file had it, its
+comments too where the edited lines can be rewritten in place (kincas/cli/scene_toml.py).
 
 Requests come from the server's threads: one lock serialises them (each is a few milliseconds).
 
@@ -36,7 +37,7 @@ import threading
 from ..errors import KincasError
 from ..model.mechanism import Input
 from .scene import Scene, loads
-from .scene_toml import dumps, number
+from .scene_toml import dumps, edited, number
 
 
 class RequestError(ValueError):
@@ -46,15 +47,15 @@ class RequestError(ValueError):
 class Session:
     """The scene `scene` (parsed from the document `doc`) being edited."""
 
-    def __init__(self, scene: Scene, name: str = "scene.toml"):
+    def __init__(self, scene: Scene, name: str = "scene.toml", text: str | None = None):
         from ..views.live.engine import Live
-        self.scene, self.name = scene, name
+        self.scene, self.name, self.text = scene, name, text  # text: the file, comments and all
         self.live = Live(scene)
         self.lock = threading.Lock()
 
     @classmethod
     def from_text(cls, text: str, name: str = "scene.toml") -> "Session":
-        return cls(loads(text), name)
+        return cls(loads(text), name, text)
 
     def request(self, what: str, body: dict | None = None) -> dict:
         """Answer one request of the page (docs/app.md): "state", "change" or "drag"."""
@@ -88,4 +89,6 @@ class Session:
                 key = Input(kind, t[kind]).key if kind else None
                 if key in fixed and "value" in t:
                     t["value"] = number(fixed[key], t["value"])
-            return dumps(doc)
+            if self.text is None:
+                return dumps(doc)
+            return edited(self.text.removeprefix("\ufeff"), self.scene.study.raw, doc)
