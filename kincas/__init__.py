@@ -48,5 +48,5 @@ __all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "swe
            "SweepMethod", "Fast", "Careful",
            "sweep_designs", "study", "model_of",
            "sensitivities", "analyse", "optimize", "find_modes", "input_range",
-           "Pose", "Sweep", "KincasError", "ModelError", "SceneError"]
+           "Pose", "Sweep", "KincasError", "ModelError", "SceneError", "widget"]
 __version__ = "0.1.0"

@@ -46,7 +46,7 @@ EXAMPLES = {
     "input_range": lambda: kincas.input_range(four_bar(), {"crank.angle": 0.5}),
 }
 # public functions that return no result (a compiled model)
-NOT_RESULTS = {"model_of", "compile"}
+NOT_RESULTS = {"model_of", "compile", "widget"}  # widget: a Jupyter widget, no result
 
 
 def test_every_public_function_is_classified():

@@ -32,6 +32,7 @@ COMMANDS = {
     "tolerance": ("kincas.cli.tolerance", "spread of the outputs from parameter tolerances"),
     "study": ("kincas.cli.study", "many designs at once, one row each, as [study] says"),
     "cam": ("kincas.cli.cam", "design a disc cam as [cam_design] says"),
+    "app": ("kincas.cli.serve", "the mechanism in a live page on this machine (kincas[app])"),
 }
 SOLVE_HELP = "positions, speeds, forces over the scene's inputs"
 
@@ -45,6 +46,7 @@ EXAMPLES = {
     "optimize": ["kincas optimize examples/forces_vtwin.toml"],
     "tolerance": ["kincas tolerance examples/fairbairn.toml"],
     "study": ["kincas study examples/study_fourbar.toml --csv designs.csv"],
+    "app": ["kincas app examples/fourbar_coupler.toml --port 8765"],
     "cam": ["kincas cam my_cam.toml --out profile.toml   (a scene with [cam_design]: docs/scene-format.md)"],
 }
 

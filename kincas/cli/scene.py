@@ -57,6 +57,8 @@ class Study:
     written: dict[str, np.ndarray] = field(default_factory=dict)  # inputs as the file gives them
     jerks: dict[str, float] = field(default_factory=dict)  # the inputs' third derivatives
     raw: dict = field(default_factory=dict, repr=False)  # the parsed TOML, for extensions
+    # parameter -> (lo, hi), from `{ value = v, range = [lo, hi] }` in [parameters]
+    ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     @property
     def deg(self) -> bool:
@@ -200,6 +202,7 @@ class _Reader(StudyReader):
         self.params = {}
         self.jerks: dict[str, float] = {}
         self.bad_params = set()  # reported once, where declared; not again where used
+        self.ranges: dict[str, tuple[float, float]] = {}  # [parameters] ranges, for sliders
 
     def err(self, msg: str):
         self.problems.append(msg)
@@ -262,6 +265,9 @@ class _Reader(StudyReader):
         if not isinstance(title, str):
             self.err("title: expected a string")
         for k, v in self.table("parameters").items():
+            v = self.ranged(k, v)
+            if v is None:
+                continue
             if isinstance(v, bool) or not isinstance(v, (int, float)):
                 self.err(f"[parameters] {k}: expected a number, got {v!r}")
                 self.bad_params.add(k)
@@ -300,8 +306,34 @@ class _Reader(StudyReader):
         self.check_quantities(m, report, sens)
         study = Study(title=title if isinstance(title, str) else "", units=self.units,
                       inputs=values, rates=rates, accelerations=accs, report=report,
-                      sensitivity=sens, written=written, raw=doc, jerks=self.jerks)
+                      sensitivity=sens, written=written, raw=doc, jerks=self.jerks,
+                      ranges=self.ranges)
         return Scene(m, study)
+
+    def ranged(self, name: str, v):
+        """A parameter's value; the table form `{ value = 130, range = [100, 160] }` also
+        gives the range a slider of `kincas app` spans (kept in `Study.ranges`). None when the
+        table is wrong (the problem is noted, the parameter reported once)."""
+        if not isinstance(v, dict):
+            return v
+        where = f"[parameters] {name}"
+        self.fields(where, v, {"value", "range"})
+        if "value" not in v:
+            self.err(f"{where}: value: missing (the table form is {{ value = v, range = [lo, hi] }})")
+            self.bad_params.add(name)
+            return None
+        r = v.get("range")
+        if r is not None:
+            good = (isinstance(r, list) and len(r) == 2
+                    and all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+                            for x in r) and r[0] < r[1])
+            if not good:
+                self.err(f"{where}: range: expected [lo, hi], two finite numbers with lo < hi, got {r!r}")
+            elif isinstance(v["value"], (int, float)) and not r[0] <= v["value"] <= r[1]:
+                self.err(f"{where}: value {v['value']!r} is outside its range {r!r}")
+            else:
+                self.ranges[name] = (float(r[0]), float(r[1]))
+        return v["value"]
 
     def lean_parameters(self) -> dict:
         """The parameters the model is built with: all of them, unless more than LEAN are
