@@ -30,6 +30,9 @@ def cli_arguments(parser) -> None:
     parser.add_argument("--paths", metavar="P,Q", help="points whose paths --plot and --animate draw (default: every moving point)")
     parser.add_argument("--evolute", metavar="P,Q", help="with --plot: draw the evolutes (centres of curvature) of these points' paths")
     parser.add_argument("--centrodes", metavar="L,M", help="with --plot: draw the fixed and moving centrodes of these links")
+    parser.add_argument("--view", choices=["iso", "xy", "yz", "zx"], metavar="iso|xy|yz|zx",
+                        help="a spatial scene's projection in --plot, --animate, --svg and the view --html opens "
+                             "with (default iso); a planar scene is drawn in its plane (xy only)")
     parser.add_argument("--pose", type=int, metavar="I", help="the pose --plot draws, by index (default: the first solved; -1: the last)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar, even on a terminal")
 
@@ -41,7 +44,7 @@ def cli_run(args) -> int:
         sc = load(args.scene)
     wants_files = (args.csv or args.plot or args.animate or args.plot_quantities or args.html
                    or args.svg or args.dxf)
-    if wants_files or args.pose is not None or args.evolute or args.centrodes:  # fail before a long solve
+    if wants_files or args.pose is not None or args.evolute or args.centrodes or args.view:  # fail before a long solve
         from .outputs import check_outputs
         check_outputs(args, sc.mechanism, len(next(iter(sc.study.inputs.values()))))
     sw = sc.run(progress=progress_for(args))

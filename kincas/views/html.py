@@ -46,10 +46,12 @@ def _arr(a, digits=9):
     return [_arr(x, digits) for x in a]
 
 
-def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0) -> dict:
-    """Everything the page draws, as JSON-ready lists (scene units when a scene is given)."""
+def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0,
+              view: str | None = None) -> dict:
+    """Everything the page draws, as JSON-ready lists (scene units when a scene is given); a
+    spatial mechanism's in space, with the `camera` the page opens with (`html3d.camera`)."""
     from .columns import heading, user_columns, _abscissa
-    pic = picture(m, sweep, paths, dense)
+    pic = picture(m, sweep, paths, dense, view, world=True)
     n = len(sweep)
     keep = np.unique(np.round(np.linspace(0, n - 1, min(n, MAX_FRAMES))).astype(int)) if n else np.zeros(0, int)
     inputs, values = user_columns(sweep, scene)
@@ -59,7 +61,7 @@ def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0
     box = pic.box()
     caption = [", ".join(f"{k} = {float(v[i]):.6g}" for k, v in inputs.items())
                + ("" if sweep.status[i] == "ok" else f" ({sweep.status[i]})") for i in keep]
-    return {
+    out = {
         "title": (getattr(getattr(scene, "study", None), "title", "") or "kincas"),
         "units": units, "names": pic.names, "ground": pic.ground, "r": pic.r,
         "box": _arr(box), "ok": [bool(v) for v in sweep.ok[keep]],
@@ -75,6 +77,11 @@ def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0
         "quantities": [{"name": heading(k, scene), "values": _arr(np.asarray(v)[keep])}
                        for k, v in values.items()],
     }
+    if pic.xy.shape[-1] == 3:
+        from .html3d import camera
+        from .projection import check_view
+        out.update(camera(check_view(view, True)))
+    return out
 
 
 def _joints(pic, keep) -> list:
@@ -85,22 +92,29 @@ def _joints(pic, keep) -> list:
              for _, body, a in pic.joint_curves(int(i), 41)] for i in keep]
 
 
-def html_page(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0) -> str:
-    """The page as text."""
-    data = json.dumps(page_data(m, sweep, scene, paths, dense), allow_nan=False, separators=(",", ":"))
+def html_page(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0,
+              view: str | None = None) -> str:
+    """The page as text (a spatial mechanism's turns with the mouse, opening in `view`)."""
+    data = page_data(m, sweep, scene, paths, dense, view)
+    page = _PAGE
+    if "camera" in data:  # a spatial mechanism: the view that turns (views/html3d.py)
+        from .html3d import MECHANISM_3D
+        page = _HEAD + MECHANISM_3D + _TAIL
+    data = json.dumps(data, allow_nan=False, separators=(",", ":"))
     data = data.replace("</", "<\\/")  # nothing in the data may close the script element
-    return (_PAGE.replace("@W@", str(WIDTH)).replace("@H@", str(HEIGHT)).replace("@INK@", INK)
+    return (page.replace("@W@", str(WIDTH)).replace("@H@", str(HEIGHT)).replace("@INK@", INK)
             .replace("@DATA@", data))
 
 
-def write_html(path, m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0) -> None:
+def write_html(path, m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0,
+               view: str | None = None) -> None:
     """Write the page to `path`."""
     from .atomic import open_replacing
     with open_replacing(path, "w", encoding="utf-8") as f:
-        f.write(html_page(m, sweep, scene, paths, dense))
+        f.write(html_page(m, sweep, scene, paths, dense, view))
 
 
-_PAGE = r"""<!DOCTYPE html>
+_HEAD = r"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>kincas</title>
 <style>
 body { font: 13px sans-serif; margin: 0; color: #222; }
@@ -131,7 +145,8 @@ const slider = document.getElementById("slider"), play = document.getElementById
 const N = D.xy.length;
 slider.max = Math.max(N - 1, 0);
 document.title = D.title;
-// world -> canvas: equal scales, the whole sweep in view
+"""
+_MECHANISM = r"""// world -> canvas: equal scales, the whole sweep in view
 const W = mech.width, H = mech.height, bx = D.box;
 const sx = Math.min(W / (bx[1][0] - bx[0][0]), H / (bx[1][1] - bx[0][1]));
 const ox = W / 2 - sx * (bx[0][0] + bx[1][0]) / 2, oy = H / 2 + sx * (bx[0][1] + bx[1][1]) / 2;
@@ -204,7 +219,9 @@ function drawMechanism(i) {
   }
 }
 
-// the quantities against the input, one panel each, a cursor at the slider's pose
+"""
+# the quantities against the input, the slider and play button: both pages (views/html3d.py)
+_TAIL = r"""// the quantities against the input, one panel each, a cursor at the slider's pose
 const QH = Math.max(60, Math.min(120, Math.floor((plots.height - 20) / Math.max(D.quantities.length, 1))));
 plots.height = Math.max(plots.height, 20 + QH * D.quantities.length);
 function extent(v) {
@@ -269,3 +286,4 @@ if (wanted) {  // the sweep's pose index; the nearest kept frame
 if (N) show(start);
 </script></body></html>
 """
+_PAGE = _HEAD + _MECHANISM + _TAIL

@@ -25,6 +25,7 @@ import numpy as np
 from ..model.mechanism import GROUND, Mechanism
 from ..results import Sweep
 from .poses import _hull, check_paths, default_pose, geometry
+from .projection import drawn, project_paths, ring_points
 
 COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
            "#7f7f7f", "#bcbd22", "#17becf"]  # matplotlib's tab10, as the PNG drawings use
@@ -56,7 +57,7 @@ class Guide:
 @dataclass
 class Picture:
     names: list[str]
-    xy: np.ndarray  # N x P x 2, NaN where a pose was not solved
+    xy: np.ndarray  # N x P x 2 (x 3: a spatial one in space), NaN where a pose was not solved
     ok: np.ndarray
     ground: list[int]
     bodies: list[Body]
@@ -66,6 +67,8 @@ class Picture:
     first: int = 0  # the first solved pose
     # pose -> [(label, body, polyline)] of the gears, racks and cams (views/draw_joints.py)
     joint_curves: object = field(default=lambda i, fine=121: [], repr=False)
+    depth: np.ndarray | None = field(default=None, repr=False)  # N x P, larger farther (in a view)
+    view: str | None = None  # a spatial picture's view (views/projection.py), None in space or planar
 
     def box(self) -> np.ndarray:
         """[[xmin, ymin], [xmax, ymax]] of everything drawn over the sweep, with a margin."""
@@ -77,16 +80,18 @@ class Picture:
             for s in (g.lo, g.hi):
                 e = g.through + s * g.direction
                 parts.append(e[np.isfinite(e).all(axis=1)])
-        pts = np.concatenate([p for p in parts if p.size] or [np.zeros((1, 2))])
+        pts = np.concatenate([p for p in parts if p.size] or [np.zeros((1, self.xy.shape[-1]))])
         return np.array([pts.min(axis=0) - 5 * self.r, pts.max(axis=0) + 5 * self.r])
 
 
-def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0) -> Picture:
+def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0, view: str | None = None,
+            world: bool = False) -> Picture:
     """The Picture of `sweep`; `paths` names the points whose paths are drawn (default: every
     moving point); `dense` > 0 solves that many extra poses between each two of the sweep's
     for smooth paths, or is those paths already solved (point -> M x 2, from `dense_paths`:
-    several pictures of one sweep share one solve)."""
-    geo = geometry(m, sweep)
+    several pictures of one sweep share one solve). A spatial sweep is drawn in `view`
+    (default isometric, `kincas.views.projection`), or kept in space with `world=True`."""
+    geo = drawn(m, sweep, view, world)
     names, xy = geo.names, geo.xy
     i0 = default_pose(geo.ok)
     pts = xy[np.isfinite(xy).all(axis=2)]
@@ -98,13 +103,14 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0) -> Pi
     for lk in m.links:
         idx = [names.index(p) for p in lk.point_names]
         ring = idx
-        if len(idx) >= 3:
-            p0 = xy[i0, idx]
-            ring = [idx[k] for k in _hull(p0)] if np.isfinite(p0).all() else idx[:2]
-            x, y = xy[i0, ring].T
+        if len(idx) >= 3:  # the outline in the body's plane (a spatial body: its own plane)
+            p0 = ring_points(geo, i0, idx)
+            hull = _hull(p0) if np.isfinite(p0).all() else [0, 1]
+            ring = [idx[k] for k in hull]
+            x, y = p0[hull].T
             area = 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
             if len(ring) < 3 or not area > (0.5 * r) ** 2:  # collinear: a bar between the farthest
-                far = np.hypot(*(xy[i0, idx] - xy[i0, idx[0]]).T)
+                far = np.hypot(*(p0 - p0[0]).T)
                 ring = [idx[0], idx[int(np.nanargmax(far))]]
         bodies.append(Body(lk.name, ring, colour[lk.name], lk.name in driven))
     guides = []
@@ -120,7 +126,7 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0) -> Pi
     else:
         path_xy = dense_paths(m, sweep, chosen, dense) if dense > 0 else {p: geo.point(p) for p in chosen}
     return Picture(names, xy, geo.ok, [names.index(g) for g in m.ground_points], bodies, guides,
-                   path_xy, r, i0, _joint_curves(m, geo, r))
+                   project_paths(path_xy, geo.view), r, i0, _joint_curves(m, geo, r), geo.depth, geo.view)
 
 
 def _joint_curves(m: Mechanism, geo, r: float):
@@ -161,7 +167,7 @@ def dense_paths(m: Mechanism, sweep: Sweep, points: list[str], per_step: int) ->
     g = geometry(mm, fsw)
     out = {}
     for p in points:
-        xy = np.full((len(t), 2), np.nan)
+        xy = np.full((len(t), g.xy.shape[2]), np.nan)  # 3 columns in space
         xy[start:] = g.point(p)
         out[p] = xy
     return out

@@ -25,6 +25,7 @@ import numpy as np
 from ..model.mechanism import GROUND, Mechanism
 from ..results import Sweep
 from .poses import Geometry, _hull, check_paths, default_pose, geometry  # noqa: F401  (their old home)
+from .projection import drawn, project_paths, ring_points
 
 PLOT_EXTRA = 'pip install "kincas[plot]"'
 
@@ -84,10 +85,13 @@ class Drawing:
         self.box = np.array([lo, hi])  # the whole sweep fits: an animation keeps its frame
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(True, color="#e6e6e6", lw=0.6, zorder=0)
-        if units:
+        if units and geo.view is None:
             ax.set_xlabel(f"x [{units}]"), ax.set_ylabel(f"y [{units}]")
+        elif geo.view is not None:  # a spatial mechanism in a view
+            self._view_axes(units)
         self.colour = {lk.name: f"C{k % 10}" for k, lk in enumerate(m.links)}
         owner = {p: lk.name for lk in reversed(m.links) for p in lk.point_names}  # the first link
+        path_xy = project_paths(path_xy, geo.view)  # a spatial sweep's paths, drawn in its view
         for p in paths:  # a path in its link's colour; NaN at unsolved poses breaks the line
             xy = path_xy[p] if path_xy and p in path_xy else geo.point(p)
             if np.isfinite(xy).all(axis=1).sum() >= 2:
@@ -137,17 +141,18 @@ class Drawing:
         for lk in self.m.links:
             idx = [self.geo.names.index(p) for p in lk.point_names]
             c, ring = self.colour[lk.name], idx
-            if len(idx) >= 3:
-                pts = self.geo.xy[self.i0, idx]
-                ring = [idx[k] for k in _hull(pts)] if np.isfinite(pts).all() else idx[:2]
-                x, y = self.geo.xy[self.i0, ring].T
+            if len(idx) >= 3:  # the outline in the body's plane (a spatial body: its own plane)
+                pts = ring_points(self.geo, self.i0, idx)
+                hull = _hull(pts) if np.isfinite(pts).all() else [0, 1]
+                ring = [idx[k] for k in hull]
+                x, y = pts[hull].T
                 area = 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))  # shoelace
                 if len(ring) >= 3 and area > (0.5 * self.r) ** 2:
                     patch = Polygon(np.zeros((len(ring), 2)), closed=True, fc=c, ec=c, alpha=0.45,
                                     lw=2.5, zorder=3)
                     self.bodies.append(("polygon", self.ax.add_patch(patch), ring))
                     continue
-                far = np.hypot(*(self.geo.xy[self.i0, ring] - self.geo.xy[self.i0, ring[0]]).T)
+                far = np.hypot(*(pts[hull] - pts[hull[0]]).T)
                 ring = [ring[0], ring[int(np.argmax(far))]]
             line, = self.ax.plot([], [], "-", lw=5, color=c, solid_capstyle="round",
                                  zorder=4.5 if lk.name in driven else 4, label=lk.name)
@@ -234,6 +239,27 @@ class Drawing:
         v = _unit(v)
         return v if v.any() else np.array([0.6, 0.8])
 
+    def _view_axes(self, units: str):
+        """A spatial mechanism's view: the drawing's axes named after the world's where the view
+        looks along one of them, and a cross of the world axes x, y, z in a corner."""
+        from .projection import triad
+        ax, view = self.ax, self.geo.view
+        u = f" [{units}]" if units else ""
+        if view in ("xy", "yz", "zx"):
+            ax.set_xlabel(view[0] + u), ax.set_ylabel(view[1] + u)
+        else:  # an oblique view has no true scale along its axes: no ticks
+            ax.set_xticklabels([]), ax.set_yticklabels([])
+            ax.set_xlabel(f"{view} view" + u)
+        o = np.array([0.07, 0.09])
+        for k, v in triad(view):
+            if np.hypot(*v) < 1e-9:  # seen end on: a dot
+                ax.plot(*o, "o", ms=3, color=INK, transform=ax.transAxes, zorder=8)
+                continue
+            e = o + 0.06 * v
+            ax.annotate("", xy=e, xytext=o, xycoords="axes fraction",
+                        arrowprops=dict(arrowstyle="->", color=INK, lw=1.0), zorder=8)
+            ax.text(*(o + 0.085 * v), k, transform=ax.transAxes, fontsize=8, ha="center", va="center", zorder=8)
+
     # --- moving to a pose ---
     def update(self, i: int, caption: str = ""):
         """Move every artist to pose i (nothing moving is shown when it was not solved)."""
@@ -245,6 +271,11 @@ class Drawing:
             else:
                 artist.set_visible(bool(np.isfinite(xy[idx]).all()))
                 artist.set_xy(np.nan_to_num(xy[idx]))
+        if geo.depth is not None and 0 <= i < len(geo.ok):  # in space: the nearer bodies over the farther
+            from .projection import depth_order
+            order = depth_order(geo.depth[i], [idx for _, _, idx in self.bodies])
+            for rank, k in enumerate(order):
+                self.bodies[k][1].set_zorder(3 + 1.9 * rank / max(len(order), 1))
         for sl, rails, block, hatch in self.guides:
             through, d, s = (a[i] for a in geo.slides[sl.name])
             fixed = bool(np.isfinite(through).all() and np.isfinite(d).all())  # the guide is there
@@ -284,10 +315,13 @@ def caption(sweep: Sweep, i: int) -> str:
 
 
 def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=None,
-         labels: bool = True, title: str | None = None, units: str = "", path_xy=None):
+         labels: bool = True, title: str | None = None, units: str = "", path_xy=None,
+         view: str | None = None):
     """Draw `m` at pose `pose` of `sweep` (default: the first solved) with the paths of
     `paths` (default: every moving point) over the sweep; returns the matplotlib Axes.
     `path_xy`: those paths already solved (point -> M x 2, `smooth_paths`), else solved here.
+    A spatial mechanism is drawn in `view` ("iso", the default, "xy", "yz" or "zx";
+    `kincas.views.projection`), a planar one in its plane.
 
     Links with two points are bars, links with three or more are filled polygons, ground
     pivots stand on hatched bases, slides show their guide and block; axes have equal scales.
@@ -299,7 +333,7 @@ def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=
     paths = check_paths(m, paths)
     i = default_pose(sweep) if pose is None else int(pose) % max(len(sweep), 1)  # -1: the last
     smooth = smooth_paths(m, sweep, paths) if path_xy is None else {p: path_xy[p] for p in paths}
-    d = Drawing(ax, m, geometry(m, sweep), paths, labels, units, smooth)
+    d = Drawing(ax, m, drawn(m, sweep, view), paths, labels, units, smooth)
     d.update(i, caption(sweep, i) if title is None else title)
     return ax
 

@@ -17,7 +17,10 @@ from ..results import Sweep
 class Geometry:
     """World positions over a sweep: `xy[i, k]` is point `names[k]` at pose i (NaN when the
     pose was not solved); each slide's line at each pose as a point `through` (N x 2), a unit
-    direction `direction` (N x 2) and the slide coordinate `s` (N,) of its point.
+    direction `direction` (N x 2) and the slide coordinate `s` (N,) of its point. A spatial
+    sweep has 3 columns where a planar one has 2; drawn in a view
+    (`kincas.views.projection.project`) it has 2 again, and `depth` (N x K, larger farther from
+    the viewer), `world` (the N x K x 3 positions) and `view` (its name) are set.
 
     >>> import numpy as np, kincas
     >>> m = kincas.Mechanism(ground={"O": (0, 0)},
@@ -34,9 +37,12 @@ class Geometry:
     slides: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]
     ok: np.ndarray
     joints: object = field(default=None, repr=False)  # gears, racks, cams: views/draw_joints.py
+    depth: np.ndarray | None = field(default=None, repr=False)
+    world: np.ndarray | None = field(default=None, repr=False)
+    view: str | None = None
 
     def point(self, name: str) -> np.ndarray:
-        """(N x 2) positions of one point."""
+        """(N x 2) positions of one point (N x 3 in space)."""
         return self.xy[:, self.names.index(name)]
 
 
