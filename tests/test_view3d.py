@@ -142,7 +142,8 @@ def spatial(monkeypatch):
     m = SimpleNamespace(
         space="3d", ground_points=("A", "D"), moving_points=("B", "C", "E", "F"),
         links=[SimpleNamespace(name=k, point_names=v) for k, v in LINKS.items()],
-        slides=[SimpleNamespace(name="pad", point="F", along="ground")],
+        slides=[SimpleNamespace(name="pad", point="F", along="ground"),
+                SimpleNamespace(name="floor", point="E", along="ground")],  # a plane slide: no line drawn
         inputs=[SimpleNamespace(kind="angle", target="crank", key="A.angle")],
         size=lambda: 150.0, parameters=[], gears=[], racks=[], cams=[])
     planar = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "P", 1)],

@@ -114,7 +114,7 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0, view:
                 ring = [idx[0], idx[int(np.nanargmax(far))]]
         bodies.append(Body(lk.name, ring, colour[lk.name], lk.name in driven))
     guides = []
-    for sl in m.slides:
+    for sl in (sl for sl in m.slides if sl.name in geo.slides):  # a spatial plane slide has no line
         through, d, s = geo.slides[sl.name]
         sv = s[np.isfinite(s)] if np.isfinite(s).any() else np.zeros(1)
         guides.append(Guide(sl.name, names.index(sl.point), through, d, float(sv.min() - 4 * r),

@@ -166,7 +166,7 @@ class Drawing:
         from matplotlib.collections import LineCollection
         from matplotlib.patches import Polygon
         self.guides = []  # (slide, [(side, rail)], block, hatch or None)
-        for sl in self.m.slides:
+        for sl in (sl for sl in self.m.slides if sl.name in self.geo.slides):  # a plane slide has no line
             sides = (-1.0, 1.0)
             if sl.along == GROUND:
                 sides = self._free_sides(sl)
