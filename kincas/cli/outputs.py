@@ -73,6 +73,14 @@ def check_outputs(args, mechanism=None, poses: int | None = None) -> None:
                 _fail(str(e))
 
 
+def add_view_argument(parser) -> None:
+    """`--view iso|xy|yz|zx` for a command that draws pictures through `write_outputs`."""
+    from ..views.projection import VIEWS
+    parser.add_argument("--view", choices=list(VIEWS), metavar="|".join(VIEWS),
+                        help="a spatial scene's projection in --plot, --animate, --svg and the view --html opens "
+                             "with (default iso); a planar scene is drawn in its plane (xy only)")
+
+
 def _check_view(args, mechanism) -> None:
     """--view: a spatial scene's projection (kincas/views/projection.py), for the pictures that
     draw one; a planar scene accepts only its own plane, xy. Evolutes and centrodes are planar."""

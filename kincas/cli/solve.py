@@ -30,9 +30,8 @@ def cli_arguments(parser) -> None:
     parser.add_argument("--paths", metavar="P,Q", help="points whose paths --plot and --animate draw (default: every moving point)")
     parser.add_argument("--evolute", metavar="P,Q", help="with --plot: draw the evolutes (centres of curvature) of these points' paths")
     parser.add_argument("--centrodes", metavar="L,M", help="with --plot: draw the fixed and moving centrodes of these links")
-    parser.add_argument("--view", choices=["iso", "xy", "yz", "zx"], metavar="iso|xy|yz|zx",
-                        help="a spatial scene's projection in --plot, --animate, --svg and the view --html opens "
-                             "with (default iso); a planar scene is drawn in its plane (xy only)")
+    from .outputs import add_view_argument
+    add_view_argument(parser)
     parser.add_argument("--pose", type=int, metavar="I", help="the pose --plot draws, by index (default: the first solved; -1: the last)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar, even on a terminal")
 

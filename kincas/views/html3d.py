@@ -34,9 +34,18 @@ def camera(view: str) -> dict:
 MECHANISM_3D = r"""// a spatial mechanism, orthographic, turned with the mouse
 const W = mech.width, H = mech.height, bx = D.box;
 const C0 = [0, 1, 2].map(j => (bx[0][j] + bx[1][j]) / 2);
-// half the box's diagonal: the whole sweep stays in view at every angle
-const RAD = 0.5 * Math.hypot(bx[1][0] - bx[0][0], bx[1][1] - bx[0][1], bx[1][2] - bx[0][2]) || 1;
 const fin = p => p !== null && p[0] !== null && p[1] !== null && p[2] !== null;
+// the sphere about the box's centre holding every point and path, with the picture's margin:
+// the whole sweep stays in view at every angle
+let RAD = 0;
+for (const pts of D.xy.concat(Object.values(D.paths))) for (const p of pts) if (fin(p))
+  RAD = Math.max(RAD, Math.hypot(p[0] - C0[0], p[1] - C0[1], p[2] - C0[2]));
+for (const g of D.guides) g.through.forEach((t, i) => {
+  const d = g.direction[i];
+  if (fin(t) && fin(d)) for (const s of [g.lo, g.hi])
+    RAD = Math.max(RAD, Math.hypot(t[0] + s * d[0] - C0[0], t[1] + s * d[1] - C0[1], t[2] + s * d[2] - C0[2]));
+});
+RAD = RAD > 0 ? RAD + 5 * D.r : 1;
 const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 let cam = D.camera.map(r => r.slice()), up = D.up, zoom = 1, panX = 0, panY = 0;
 let S = 0, OX = 0, OY = 0, R = 0;  // scale, origin, the picture's unit of size (pixels)
@@ -91,15 +100,18 @@ function triad() {  // the world axes, lower left
   }
 }
 
+// each path in the colour of the first body its point belongs to
+const pathColour = {};
+for (const p of Object.keys(D.paths)) {
+  const body = D.bodies.find(b => b.ring.includes(D.names.indexOf(p)));
+  pathColour[p] = body ? body.colour : "@INK@";
+}
+
 function drawMechanism(i) {
   frame();
   ctx.fillStyle = "white"; ctx.fillRect(0, 0, W, H);
   const xy = D.xy[i];
-  const owner = {};
-  for (const b of D.bodies) for (const k of b.ring) if (!(k in owner)) owner[k] = b.colour;
-  for (const [p, pts] of Object.entries(D.paths)) {
-    line(pts, owner[D.names.indexOf(p)] || "@INK@", 1, [5, 4]);
-  }
+  for (const [p, pts] of Object.entries(D.paths)) line(pts, pathColour[p], 1, [5, 4]);
   for (const k of D.ground) {  // a pivot on a base, upright on the screen
     const p = xy[k]; if (!fin(p)) continue;
     const [x, y] = P(p), h = 2.5 * R;
