@@ -141,10 +141,10 @@ def spatial(monkeypatch):
     monkeypatch.setattr(poses, "geometry", fake_geometry)
     m = SimpleNamespace(
         space="3d", ground_points=("A", "D"), moving_points=("B", "C", "E", "F"),
-        links=[SimpleNamespace(name=k, point_names=v) for k, v in LINKS.items()],
+        bodies=[SimpleNamespace(name=k, point_names=v) for k, v in LINKS.items()],  # as SpatialMechanism
         slides=[SimpleNamespace(name="pad", point="F", along="ground"),
                 SimpleNamespace(name="floor", point="E", along="ground")],  # a plane slide: no line drawn
-        inputs=[SimpleNamespace(kind="angle", target="crank", key="A.angle")],
+        inputs=[SimpleNamespace(kind="joint", target="A", key="A.angle")],
         size=lambda: 150.0, parameters=[], gears=[], racks=[], cams=[])
     planar = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "P", 1)],
                               inputs=[kincas.Input.angle("crank")])

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..model.mechanism import GROUND, Mechanism
 from ..results import Sweep
-from .poses import _hull, check_paths, default_pose, geometry
+from .poses import _hull, check_paths, default_pose, geometry, links_of
 from .projection import drawn, project_paths, ring_points
 
 COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
@@ -98,9 +98,10 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0, view:
     span = float(np.ptp(pts, axis=0).max()) if pts.size else 0.0
     r = 0.02 * (span if span > 0 else m.size())
     driven = {i.target for i in m.inputs if i.kind == "angle"}
-    colour = {lk.name: COLOURS[k % 10] for k, lk in enumerate(m.links)}
+    links = links_of(m)
+    colour = {lk.name: COLOURS[k % 10] for k, lk in enumerate(links)}
     bodies = []
-    for lk in m.links:
+    for lk in links:
         idx = [names.index(p) for p in lk.point_names]
         ring = idx
         if len(idx) >= 3:  # the outline in the body's plane (a spatial body: its own plane)

@@ -25,6 +25,7 @@ import numpy as np
 from ..model.mechanism import GROUND, Mechanism
 from ..results import Sweep
 from .poses import Geometry, _hull, check_paths, default_pose, geometry  # noqa: F401  (their old home)
+from .poses import links_of
 from .projection import drawn, project_paths, ring_points
 
 PLOT_EXTRA = 'pip install "kincas[plot]"'
@@ -89,15 +90,16 @@ class Drawing:
             ax.set_xlabel(f"x [{units}]"), ax.set_ylabel(f"y [{units}]")
         elif geo.view is not None:  # a spatial mechanism in a view
             self._view_axes(units)
-        self.colour = {lk.name: f"C{k % 10}" for k, lk in enumerate(m.links)}
-        owner = {p: lk.name for lk in reversed(m.links) for p in lk.point_names}  # the first link
+        self.links = links_of(m)  # a spatial mechanism's bodies
+        self.colour = {lk.name: f"C{k % 10}" for k, lk in enumerate(self.links)}
+        owner = {p: lk.name for lk in reversed(self.links) for p in lk.point_names}  # the first link
         path_xy = project_paths(path_xy, geo.view)  # a spatial sweep's paths, drawn in its view
         for p in paths:  # a path in its link's colour; NaN at unsolved poses breaks the line
             xy = path_xy[p] if path_xy and p in path_xy else geo.point(p)
             if np.isfinite(xy).all(axis=1).sum() >= 2:
                 ax.plot(*xy.T, "--", lw=1.0, color=self.colour.get(owner.get(p), INK), alpha=0.7, zorder=2)
         names = geo.names  # what surrounds each point: the other points of its bodies
-        self.near = {k: sorted({names.index(q) for lk in m.links if p in lk.point_names
+        self.near = {k: sorted({names.index(q) for lk in self.links if p in lk.point_names
                                 for q in lk.point_names if q != p}) for k, p in enumerate(names)}
         self._ground_symbols()
         self._make_bodies()
@@ -138,7 +140,7 @@ class Drawing:
         from matplotlib.patches import Polygon
         self.bodies = []  # (kind, artist, indices of the points drawn)
         driven = {i.target for i in self.m.inputs if i.kind == "angle"}
-        for lk in self.m.links:
+        for lk in self.links:
             idx = [self.geo.names.index(p) for p in lk.point_names]
             c, ring = self.colour[lk.name], idx
             if len(idx) >= 3:  # the outline in the body's plane (a spatial body: its own plane)
@@ -188,7 +190,7 @@ class Drawing:
         t = np.linspace(0.0, 1.0, 17)[None, :, None]
         samples = [xy[:, [names.index(p)]] for p in self.m.ground_points + self.m.moving_points
                    if p != sl.point]
-        for lk in self.m.links:  # points along every pair of a body's points: its bars and edges
+        for lk in self.links:  # points along every pair of a body's points: its bars and edges
             idx = [names.index(p) for p in lk.point_names]
             for a in range(len(idx)):
                 for b in range(a + 1, len(idx)):
@@ -210,7 +212,7 @@ class Drawing:
         """Joints (on two bodies or more, the ground counting as one) as rings, other points
         as dots, and the name of each."""
         names, m = self.geo.names, self.m
-        count = Counter([p for lk in m.links for p in lk.point_names] + list(m.ground_points))
+        count = Counter([p for lk in self.links for p in lk.point_names] + list(m.ground_points))
         joints = [k for k, p in enumerate(names) if count[p] >= 2]
         self.joints = (joints, self.ax.plot([], [], "o", ms=6, mfc=PAPER, mec=INK, mew=1.3,
                                             ls="none", zorder=6)[0])

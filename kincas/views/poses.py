@@ -99,6 +99,18 @@ def default_pose(sweep: Sweep | np.ndarray) -> int:
     return int(k[0]) if k.size else 0
 
 
+def links_of(m) -> tuple:
+    """The bodies a picture draws: a planar mechanism's `links`, a spatial one's `bodies`
+    (each with `name` and `point_names`).
+
+    >>> import kincas
+    >>> [lk.name for lk in links_of(kincas.Mechanism(ground={"O": (0, 0)},
+    ...     links=[kincas.Link.bar("c", "O", "A", 1)], inputs=[kincas.Input.angle("c")]))]
+    ['c']
+    """
+    return tuple(m.links if hasattr(m, "links") else m.bodies)
+
+
 def check_paths(m: Mechanism, paths) -> list[str]:
     """The points whose paths are drawn: `paths`, checked, or every moving point (None).
 
