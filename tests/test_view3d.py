@@ -281,7 +281,7 @@ function element(id) {
     id, width: 640, height: 480, style: {}, dataset: {}, textContent: "", value: "0", max: "0",
     getContext: () => new Proxy({}, { get: (t, k) => (k in t ? t[k] : () => {}), set: (t, k, v) => { t[k] = v; return true; } }),
     addEventListener: (ev, f) => { handlers[ev] = f; }, setPointerCapture: () => {},
-    insertBefore: () => {}, set onclick(f) { handlers["click:" + id] = f; }, set oninput(f) {},
+    insertBefore: () => {}, appendChild: () => {}, set onclick(f) { handlers["click:" + id] = f; }, set oninput(f) {},
   };
   return elements[id];
 }
@@ -378,3 +378,47 @@ def test_check_outputs_of_a_spatial_scene(spatial, tmp_path):
     check_outputs(args, m, N)
     with pytest.raises(OutputError, match="spatial"):
         check_outputs(SimpleNamespace(plot=None, svg=str(tmp_path / "a.svg"), evolute="C"), m, N)
+
+
+# --- end to end: examples/space_rssr.toml through the spatial core ---
+
+RSSR = dict(r=15.0, coupler=125.0, D=np.array([100.0, 40, 30]), rocker=60.0)
+
+
+def test_rssr_pictures_end_to_end(capsys, tmp_path):
+    """The RSSR example drawn by every picture; the DXF read back in space obeys the
+    mechanism's own geometry (crank circle about z, coupler length, rocker circle in the
+    plane x = 100 about D), and the SVG shows those points in the textbook isometric view."""
+    from conftest import EXAMPLES
+    ezdxf = pytest.importorskip("ezdxf")
+    out = {k: tmp_path / f"r.{k}" for k in ("svg", "dxf", "html", "png")}
+    pose = 60  # the crank at 60 deg (361 poses over a turn)
+    code, _, err = run_cli(capsys, "solve", EXAMPLES / "space_rssr.toml", "--svg", out["svg"], "--dxf", out["dxf"],
+                           "--html", out["html"], "--plot", out["png"], "--pose", pose, "--no-progress")
+    assert code == 0, err
+    msp = ezdxf.readfile(out["dxf"]).modelspace()
+    crank, = msp.query('LINE[layer=="crank"]')
+    coupler, = msp.query('LINE[layer=="coupler"]')
+    rocker, = msp.query('LINE[layer=="rocker"]')
+    A, B = np.array(crank.dxf.start), np.array(crank.dxf.end)
+    th = math.radians(pose)
+    assert A == pytest.approx([0, 0, 0], abs=1e-9)
+    assert B == pytest.approx([RSSR["r"] * math.cos(th), RSSR["r"] * math.sin(th), 0], abs=1e-9)
+    C = np.array(coupler.dxf.end)
+    assert np.linalg.norm(C - np.array(coupler.dxf.start)) == pytest.approx(RSSR["coupler"], abs=1e-8)
+    assert np.array(rocker.dxf.start) == pytest.approx(RSSR["D"], abs=1e-9)
+    assert np.array(rocker.dxf.end) == pytest.approx(C, abs=1e-9)
+    assert C[0] == pytest.approx(100, abs=1e-9) and np.linalg.norm(C - RSSR["D"]) == pytest.approx(60, abs=1e-8)
+    # C's path: on the rocker's circle in the plane x = 100 (a 3D polyline, solved densely)
+    path = np.array([tuple(v.dxf.location) for e in msp.query('POLYLINE[layer=="paths"]') for v in e.vertices])
+    on_rocker = np.isclose(path[:, 0], 100, atol=1e-8) & np.isclose(np.linalg.norm(path - RSSR["D"], axis=1), 60, atol=1e-8)
+    on_crank = np.isclose(path[:, 2], 0, atol=1e-9) & np.isclose(np.hypot(path[:, 0], path[:, 1]), 15, atol=1e-9)
+    assert (on_rocker | on_crank).all() and on_rocker.sum() >= 361 and np.ptp(path[on_rocker, 2]) > 5
+    # the SVG: the same points in the isometric view
+    root = ET.parse(out["svg"]).getroot()
+    circles = {c.get("data-point"): (float(c.get("cx")), float(c.get("cy"))) for c in root.iter(SVG + "circle")}
+    for name, p in (("A", A), ("B", B), ("C", C), ("D", RSSR["D"])):
+        assert circles[name] == pytest.approx(iso_textbook(p), abs=1e-7), name
+    page = out["html"].read_text(encoding="utf-8")
+    assert '"camera"' in page and not re.search(r"https?://", page)
+    assert out["png"].stat().st_size > 1000

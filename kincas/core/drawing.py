@@ -30,6 +30,8 @@ from ..model.joints import Circle
 
 def _build_pose_function(model):
     sym, m = model.sym, model.sym.mech
+    if getattr(sym, "dim", 2) == 3:
+        return _build_pose_function_3d(model)
     out = [c for g in m.ground_points for c in sym.points[g]]
     out += [c for p in m.moving_points for c in sym.points[p]]
     for sl in m.slides:
@@ -37,6 +39,21 @@ def _build_pose_function(model):
         tx, ty = (sym.val(v) for v in sl.through)
         out += [ox + ca.cos(th) * tx - ca.sin(th) * ty, oy + ca.sin(th) * tx + ca.cos(th) * ty,
                 th + sym.val(sl.angle)]
+    return ca.Function("pose", [sym.q, sym.u, sym.p], [ca.vertcat(*out)])
+
+
+def _build_pose_function_3d(model):
+    """In space: every point's (x, y, z), then for each slide on a line the point its line
+    goes through and its unit direction, both carried by the body `along` (a slide on a
+    plane has no line to draw)."""
+    from .space_symbolic import apply, rotation
+    sym, m = model.sym, model.sym.mech
+    out = [c for g in m.ground_points for c in sym.points[g]]
+    out += [c for p in m.moving_points for c in sym.points[p]]
+    for sl in m.slides:
+        if sl.on_line:
+            out += sym.world(sl.along, [sym.val(v) for v in sl.through])
+            out += apply(rotation(sym.frames[sl.along][1]), [float(v) for v in sl.direction])
     return ca.Function("pose", [sym.q, sym.u, sym.p], [ca.vertcat(*out)])
 
 
@@ -62,7 +79,8 @@ def pose_values(model, Q, U, p) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        N x (2 (ground + moving points) + 3 slides).
+        N x (2 (ground + moving points) + 3 slides); in space N x (3 points + 6 slides on
+        lines: through, unit direction).
 
     Examples
     --------

@@ -184,11 +184,15 @@ mech.addEventListener("wheel", e => {
 }, { passive: false });
 function look(v) { cam = D.views[v].map(r => r.slice()); up = D.ups[v]; zoom = 1; panX = 0; panY = 0; redraw(); }
 mech.addEventListener("dblclick", () => look(D.view));
-for (const v of Object.keys(D.views)) {  // one button per view
+const bar = document.createElement("div");  // one button per view, on a line of their own
+bar.id = "views"; bar.textContent = "view (drag to turn, wheel to zoom):";
+bar.style.marginTop = "4px";
+for (const v of Object.keys(D.views)) {
   const b = document.createElement("button");
   b.textContent = v; b.id = "view-" + v; b.style.marginLeft = "4px"; b.onclick = () => look(v);
-  document.getElementById("controls").insertBefore(b, document.getElementById("caption"));
+  bar.appendChild(b);
 }
+document.getElementById("controls").insertBefore(bar, document.getElementById("caption"));
 const wantView = /view=(iso|xy|yz|zx)/.exec(location.hash);
 if (wantView) { cam = D.views[wantView[1]].map(r => r.slice()); up = D.ups[wantView[1]]; }
 frame();

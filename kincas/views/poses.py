@@ -60,16 +60,20 @@ def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
     p = np.array([v for _, v in m.parameters], float)
     Q = np.where(ok[:, None], sweep.q, 0.0)  # what depends on q is masked below
     raw = pose_values(model, Q, U, p)
-    ng = len(m.ground_points)
-    xy = raw[:, :2 * len(names)].reshape(n, len(names), 2).copy()
+    ng, dim = len(m.ground_points), getattr(model.sym, "dim", 2)  # 3: a spatial mechanism
+    xy = raw[:, :dim * len(names)].reshape(n, len(names), dim).copy()
     xy[~ok, ng:] = np.nan  # ground points are known at every pose, moving ones when solved
-    slides = {}
-    for k, sl in enumerate(m.slides):
-        c = 2 * len(names) + 3 * k
-        through, angle = raw[:, c:c + 2].copy(), raw[:, c + 2].copy()
+    slides, c = {}, dim * len(names)
+    for sl in m.slides:
+        if dim == 2:  # the line's point and direction angle
+            through, angle = raw[:, c:c + 2].copy(), raw[:, c + 2]
+            d, c = np.stack([np.cos(angle), np.sin(angle)], axis=1), c + 3
+        elif sl.on_line:  # in space: its point and unit direction (a plane slide has no line)
+            through, d, c = raw[:, c:c + 3].copy(), raw[:, c + 3:c + 6].copy(), c + 6
+        else:
+            continue
         if sl.along != GROUND:
-            through[~ok], angle[~ok] = np.nan, np.nan
-        d = np.stack([np.cos(angle), np.sin(angle)], axis=1)
+            through[~ok], d[~ok] = np.nan, np.nan
         s = np.einsum("ij,ij->i", xy[:, names.index(sl.point)] - through, d)  # signed distance
         slides[sl.name] = (through, d, s)
     from .draw_joints import joint_geometry
