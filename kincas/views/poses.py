@@ -60,7 +60,7 @@ def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
     p = np.array([v for _, v in m.parameters], float)
     Q = np.where(ok[:, None], sweep.q, 0.0)  # what depends on q is masked below
     raw = pose_values(model, Q, U, p)
-    ng, dim = len(m.ground_points), getattr(model.sym, "dim", 2)  # 3: a spatial mechanism
+    ng, dim = len(m.ground_points), 3 if is_spatial(m) else 2
     xy = raw[:, :dim * len(names)].reshape(n, len(names), dim).copy()
     xy[~ok, ng:] = np.nan  # ground points are known at every pose, moving ones when solved
     slides, c = {}, dim * len(names)
@@ -101,6 +101,18 @@ def default_pose(sweep: Sweep | np.ndarray) -> int:
     """The pose drawn when none is asked for: the first one solved (0 when none was)."""
     k = np.flatnonzero(sweep.ok if isinstance(sweep, Sweep) else sweep)
     return int(k[0]) if k.size else 0
+
+
+def is_spatial(m) -> bool:
+    """True for a mechanism declared in space (`space = "3d"`): one that has a `space`
+    attribute "3d". Planar mechanisms have none (or "2d").
+
+    >>> import kincas
+    >>> is_spatial(kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("c", "O", "A", 1)],
+    ...                             inputs=[kincas.Input.angle("c")]))
+    False
+    """
+    return str(getattr(m, "space", "2d")).lower() == "3d"
 
 
 def links_of(m) -> tuple:

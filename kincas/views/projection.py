@@ -35,6 +35,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..core.tolerances import END_ON
+from .poses import is_spatial  # noqa: F401  (the command line asks here)
 
 VIEWS = ("iso", "xy", "yz", "zx")
 DEFAULT_VIEW = "iso"
@@ -48,18 +49,6 @@ _AXES = {
 }
 # the world axis drawn upwards in each view: the HTML page turns the mechanism about it
 UP_AXIS = {"xy": 1, "yz": 2, "zx": 0, "iso": 2}
-
-
-def is_spatial(m) -> bool:
-    """True for a mechanism declared in space (`space = "3d"`): one that has a `space`
-    attribute "3d". Planar mechanisms have none (or "2d").
-
-    >>> import kincas
-    >>> is_spatial(kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("c", "O", "A", 1)],
-    ...                             inputs=[kincas.Input.angle("c")]))
-    False
-    """
-    return str(getattr(m, "space", "2d")).lower() == "3d"
 
 
 def check_view(view: str | None, spatial: bool) -> str | None:
