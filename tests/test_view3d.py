@@ -128,7 +128,8 @@ def world():
 
 def fake_geometry(m, sweep):
     names, xyz, s = world()
-    slides = {"pad": (np.tile(GUIDE_T, (N, 1)), np.tile(GUIDE_D, (N, 1)), s)}
+    slides = {"pad": (np.tile(GUIDE_T, (N, 1)), np.tile(GUIDE_D, (N, 1)), s),
+              "floor": (np.zeros((N, 3)), np.tile([0.0, 0, 1], (N, 1)), np.zeros(N))}  # a plane: its normal
     return Geometry(names, xyz, slides, np.ones(N, bool))
 
 
@@ -143,7 +144,7 @@ def spatial(monkeypatch):
         space="3d", ground_points=("A", "D"), moving_points=("B", "C", "E", "F"),
         bodies=[SimpleNamespace(name=k, point_names=v) for k, v in LINKS.items()],  # as SpatialMechanism
         slides=[SimpleNamespace(name="pad", point="F", along="ground"),
-                SimpleNamespace(name="floor", point="E", along="ground")],  # a plane slide: no line drawn
+                SimpleNamespace(name="floor", point="E", along="ground", on_line=False)],  # on a plane: not drawn
         inputs=[SimpleNamespace(kind="joint", target="A", key="A.angle")],
         size=lambda: 150.0, parameters=[], gears=[], racks=[], cams=[])
     planar = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "P", 1)],
@@ -424,37 +425,3 @@ def test_rssr_pictures_end_to_end(capsys, tmp_path):
     page = out["html"].read_text(encoding="utf-8")
     assert '"camera"' in page and not re.search(r"https?://", page)
     assert out["png"].stat().st_size > 1000
-
-
-def test_geometry_of_a_spatial_model(monkeypatch):
-    """poses.geometry on a spatial model (faked here: one body turning about z by the
-    unknown t, point P drawn at (2, 0, 1), a slide on the body's line through (1, -1, 0)
-    along y): points in 3 columns, the slide's line turned with the body, s = 1 at every
-    pose (P - through is (1, 1, 1) turned, d is y turned), NaN where a pose is unsolved."""
-    import casadi as ca
-    import kincas.core.numeric
-    q, u, p = ca.SX.sym("q", 1), ca.SX.sym("u", 1), ca.SX.sym("p", 0)
-    c, s = ca.cos(q[0]), ca.sin(q[0])
-    world = lambda body, P: list(P) if body == "ground" else [c * P[0] - s * P[1], s * P[0] + c * P[1], P[2]]
-    slide = SimpleNamespace(name="rail", point="P", along="arm", on_line=True, through=(1, -1, 0), direction=(0, 1, 0))
-    mech = SimpleNamespace(space="3d", ground_points=("O",), moving_points=("P",), slides=(slide,),
-                           inputs=(SimpleNamespace(key="t"),), parameters=(), gears=(), racks=(), cams=())
-    sym = SimpleNamespace(dim=3, mech=mech, q=q, u=u, p=p, val=ca.SX, world=world,
-                          points={"O": [ca.SX(0)] * 3, "P": world("arm", [2, 0, 1])})
-    model = SimpleNamespace(sym=sym, mech=mech, memo=lambda key, build: build())
-    monkeypatch.setattr(kincas.core.numeric, "compile", lambda m: model)
-    t = np.array([0.0, 0.7, 2.0, -1.2])
-    ok = np.array([True, True, False, True])
-
-    class Sweep(SimpleNamespace):
-        def __len__(self):
-            return len(t)
-    geo = poses.geometry(mech, Sweep(inputs={"t": t}, ok=ok, q=t[:, None]))
-    assert geo.names == ["O", "P"] and geo.xy.shape == (4, 2, 3)
-    want = np.stack([2 * np.cos(t), 2 * np.sin(t), np.ones(4)], axis=1)
-    assert geo.xy[ok, 1] == pytest.approx(want[ok], abs=1e-14) and np.isnan(geo.xy[2, 1]).all()
-    assert (geo.xy[:, 0] == 0).all()  # the ground point, known at every pose
-    through, d, sv = geo.slides["rail"]
-    assert through[ok] == pytest.approx(np.stack([np.cos(t) + np.sin(t), np.sin(t) - np.cos(t), 0 * t], 1)[ok])
-    assert d[ok] == pytest.approx(np.stack([-np.sin(t), np.cos(t), 0 * t], 1)[ok], abs=1e-14)
-    assert sv[ok] == pytest.approx([1, 1, 1]) and np.isnan(sv[2]) and np.isnan(d[2]).all()

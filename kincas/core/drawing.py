@@ -30,8 +30,6 @@ from ..model.joints import Circle
 
 def _build_pose_function(model):
     sym, m = model.sym, model.sym.mech
-    if getattr(sym, "dim", 2) == 3:
-        return _build_pose_function_3d(model)
     out = [c for g in m.ground_points for c in sym.points[g]]
     out += [c for p in m.moving_points for c in sym.points[p]]
     for sl in m.slides:
@@ -39,24 +37,6 @@ def _build_pose_function(model):
         tx, ty = (sym.val(v) for v in sl.through)
         out += [ox + ca.cos(th) * tx - ca.sin(th) * ty, oy + ca.sin(th) * tx + ca.cos(th) * ty,
                 th + sym.val(sl.angle)]
-    return ca.Function("pose", [sym.q, sym.u, sym.p], [ca.vertcat(*out)])
-
-
-def _build_pose_function_3d(model):
-    """In space: every point's (x, y, z), then for each slide on a line the point its line
-    goes through and its unit direction, both carried by the body `along` (a slide on a
-    plane has no line to draw). The spatial model says where a point drawn at P0 on a body
-    is (`sym.world(body, P0)`); a body moves rigidly, so its direction d is
-    world(P0 + d) - world(P0), of length 1 wherever the body's rotation is one."""
-    sym, m = model.sym, model.sym.mech
-    out = [c for g in m.ground_points for c in sym.points[g]]
-    out += [c for p in m.moving_points for c in sym.points[p]]
-    for sl in m.slides:
-        if sl.on_line:
-            t0 = [sym.val(v) for v in sl.through]
-            t = sym.world(sl.along, t0)
-            ahead = sym.world(sl.along, [t0[i] + float(sl.direction[i]) for i in range(3)])
-            out += list(t) + [ahead[i] - t[i] for i in range(3)]
     return ca.Function("pose", [sym.q, sym.u, sym.p], [ca.vertcat(*out)])
 
 
@@ -82,8 +62,7 @@ def pose_values(model, Q, U, p) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        N x (2 (ground + moving points) + 3 slides); in space N x (3 points + 6 slides on
-        lines: through, unit direction).
+        N x (2 (ground + moving points) + 3 slides).
 
     Examples
     --------

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..model.mechanism import GROUND, Mechanism
 from ..results import Sweep
-from .poses import _hull, check_paths, default_pose, geometry, links_of
+from .poses import _hull, _on_line, check_paths, default_pose, geometry, links_of
 from .projection import drawn, project_paths, ring_points
 
 COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
@@ -115,7 +115,7 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0, view:
                 ring = [idx[0], idx[int(np.nanargmax(far))]]
         bodies.append(Body(lk.name, ring, colour[lk.name], lk.name in driven))
     guides = []
-    for sl in (sl for sl in m.slides if sl.name in geo.slides):  # a spatial plane slide has no line
+    for sl in (sl for sl in m.slides if _on_line(sl, geo)):
         through, d, s = geo.slides[sl.name]
         sv = s[np.isfinite(s)] if np.isfinite(s).any() else np.zeros(1)
         guides.append(Guide(sl.name, names.index(sl.point), through, d, float(sv.min() - 4 * r),

@@ -25,7 +25,7 @@ import numpy as np
 from ..model.mechanism import GROUND, Mechanism
 from ..results import Sweep
 from .poses import Geometry, _hull, check_paths, default_pose, geometry  # noqa: F401  (their old home)
-from .poses import links_of
+from .poses import _on_line, links_of
 from .projection import drawn, project_paths, ring_points
 
 PLOT_EXTRA = 'pip install "kincas[plot]"'
@@ -168,7 +168,7 @@ class Drawing:
         from matplotlib.collections import LineCollection
         from matplotlib.patches import Polygon
         self.guides = []  # (slide, [(side, rail)], block, hatch or None)
-        for sl in (sl for sl in self.m.slides if sl.name in self.geo.slides):  # a plane slide has no line
+        for sl in (sl for sl in self.m.slides if _on_line(sl, self.geo)):
             sides = (-1.0, 1.0)
             if sl.along == GROUND:
                 sides = self._free_sides(sl)

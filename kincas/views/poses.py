@@ -60,20 +60,16 @@ def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
     p = np.array([v for _, v in m.parameters], float)
     Q = np.where(ok[:, None], sweep.q, 0.0)  # what depends on q is masked below
     raw = pose_values(model, Q, U, p)
-    ng, dim = len(m.ground_points), 3 if is_spatial(m) else 2
-    xy = raw[:, :dim * len(names)].reshape(n, len(names), dim).copy()
+    ng = len(m.ground_points)
+    xy = raw[:, :2 * len(names)].reshape(n, len(names), 2).copy()
     xy[~ok, ng:] = np.nan  # ground points are known at every pose, moving ones when solved
-    slides, c = {}, dim * len(names)
-    for sl in m.slides:
-        if dim == 2:  # the line's point and direction angle
-            through, angle = raw[:, c:c + 2].copy(), raw[:, c + 2]
-            d, c = np.stack([np.cos(angle), np.sin(angle)], axis=1), c + 3
-        elif sl.on_line:  # in space: its point and unit direction (a plane slide has no line)
-            through, d, c = raw[:, c:c + 3].copy(), raw[:, c + 3:c + 6].copy(), c + 6
-        else:
-            continue
+    slides = {}
+    for k, sl in enumerate(m.slides):
+        c = 2 * len(names) + 3 * k
+        through, angle = raw[:, c:c + 2].copy(), raw[:, c + 2].copy()
         if sl.along != GROUND:
-            through[~ok], d[~ok] = np.nan, np.nan
+            through[~ok], angle[~ok] = np.nan, np.nan
+        d = np.stack([np.cos(angle), np.sin(angle)], axis=1)
         s = np.einsum("ij,ij->i", xy[:, names.index(sl.point)] - through, d)  # signed distance
         slides[sl.name] = (through, d, s)
     from .draw_joints import joint_geometry
@@ -113,6 +109,12 @@ def is_spatial(m) -> bool:
     False
     """
     return str(getattr(m, "space", "2d")).lower() == "3d"
+
+
+def _on_line(sl, geo) -> bool:
+    """A slide the pictures draw: one on a line whose line the geometry has (a spatial slide
+    on a plane keeps its point on a plane: no guide, no block)."""
+    return getattr(sl, "on_line", True) and sl.name in geo.slides
 
 
 def links_of(m) -> tuple:
