@@ -68,3 +68,23 @@ def keyword(where: str, old: str, new: str, old_value, new_value, new_default=No
     warnings.warn(f"{where}({old}=...) is deprecated: use {where}({new}=...) (the old keyword "
                   f"goes in the next release)", DeprecationWarning, stacklevel=3)
     return old_value
+
+
+def attribute(cls_name: str, old: str, new: str) -> property:
+    """A read-only property `old` giving the attribute `new`, with a DeprecationWarning: a
+    result's field renamed (one word per meaning), its 0.1 spelling kept one release.
+
+    >>> import warnings
+    >>> class R:
+    ...     draws = 30
+    ...     samples = attribute("R", "samples", "draws")
+    >>> with warnings.catch_warnings(record=True) as w:
+    ...     warnings.simplefilter("always")
+    ...     R().samples, str(w[0].message)
+    (30, 'R.samples is deprecated: use R.draws (the old name goes in the next release)')
+    """
+    def get(self):
+        warnings.warn(f"{cls_name}.{old} is deprecated: use {cls_name}.{new} (the old name goes in "
+                      f"the next release)", DeprecationWarning, stacklevel=2)
+        return getattr(self, new)
+    return property(get, doc=f"Deprecated name of `{new}`.")

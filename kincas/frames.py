@@ -132,7 +132,7 @@ def tolerance_to_pandas(r, length: str = ""):
     cols["status"] = np.asarray(r.status).astype(str)
     cols["failed"] = np.asarray(r.failed, int)
     df = pd.DataFrame(cols, index=_index(pd, r.inputs, len(r.status)))
-    df.attrs.update(samples=r.samples, seed=r.seed, std=dict(r.std),
+    df.attrs.update(draws=r.draws, samples=r.draws, seed=r.seed, std=dict(r.std),
                     units={n: unit_of(n, length) for n in [*r.inputs, *r.names]})
     return df
 
@@ -150,7 +150,7 @@ def tolerance_to_xarray(r, length: str = ""):
                             {"description": "Monte-Carlo std"}),
             "status": ("pose", np.asarray(r.status).astype(str)),
             "failed": ("pose", np.asarray(r.failed, int))}
-    attrs = {"samples": int(r.samples), **{f"std {p}": float(s) for p, s in r.std.items()}}
+    attrs = {"draws": int(r.draws), "samples": int(r.draws), **{f"std {p}": float(s) for p, s in r.std.items()}}
     if r.seed is not None:
         attrs["seed"] = int(r.seed)
     return xr.Dataset(data, coords=coords, attrs=attrs)
@@ -192,20 +192,20 @@ def modes_to_xarray(modes, length: str = ""):
 
 def optimize_to_pandas(r, length: str = ""):
     pd = require("pandas")
-    n = len(next(iter(r.samples.values()))) if r.samples else 0
+    n = len(next(iter(r.inputs.values()))) if r.inputs else 0
     df = pd.DataFrame({k: np.asarray(v, float) for k, v in r.values.items()},
-                      index=_index(pd, r.samples, n))
+                      index=_index(pd, r.inputs, n))
     df.attrs.update(parameters=dict(r.parameters), varied=dict(r.varied), objective=r.objective,
                     ok=r.ok, status=r.status, message=r.message,
-                    units={k: unit_of(k, length) for k in [*r.samples, *r.values]})
+                    units={k: unit_of(k, length) for k in [*r.inputs, *r.values]})
     return df
 
 
 def optimize_to_xarray(r, length: str = ""):
     xr = require("xarray")
-    coords = {k: ("sample", np.asarray(v, float), {"units": unit_of(k, length)}) for k, v in r.samples.items()}
+    coords = {k: ("sample", np.asarray(v, float), {"units": unit_of(k, length)}) for k, v in r.inputs.items()}
     data = {k: ("sample", np.asarray(v, float), {"units": unit_of(k, length)})
-            for k, v in r.values.items() if k not in r.samples}
+            for k, v in r.values.items() if k not in r.inputs}
     attrs = {"objective": float(r.objective), "ok": int(r.ok), "status": r.status,
              "message": r.message, "iterations": int(r.iterations),
              **{f"parameter {p}": float(v) for p, v in r.parameters.items()},

@@ -187,3 +187,25 @@ def test_clear_all_forgets_models():
     finally:  # the rest of the suite finds its models and libraries again
         for memo, d in kept.items():
             memo._d.update(d)
+
+
+def test_the_sweeps_tables_are_memos():
+    """The mechanisms prepared for sweeps (per model) and each one's first-pose placements
+    are Memos too, within their bounds: RECENT + 3 mechanisms of one structure leave RECENT,
+    PLACEMENTS + 3 starting inputs leave PLACEMENTS, and the same inputs are placed once."""
+    import numpy as np
+    from kincas.analysis.prepared import PLACEMENTS, RECENT, prepared
+    ms = [kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+                           links=[kincas.Link.bar("crank", "A", "B", 1 + 0.01 * i), kincas.Link.bar("coupler", "B", "C", 3.5),
+                                  kincas.Link.bar("rocker", "D", "C", 3)],
+                           inputs=[kincas.Input.angle("crank")], guess={"C": (3.6, 2.9)}) for i in range(RECENT + 3)]
+    model = kincas.model_of(ms[0])
+    for m in ms:
+        prepared(model, m)
+    table = model.memo("sweep.prepared", Memo)
+    assert isinstance(table, Memo) and len(table) == RECENT
+    pm = prepared(model, ms[-1])
+    assert isinstance(pm._places, Memo)
+    first = [pm.placement(model, np.array([0.1 * k]), pm.guess) for k in range(PLACEMENTS + 3)]
+    assert len(pm._places) == PLACEMENTS and all(f is not None for f in first)
+    assert pm.placement(model, np.array([0.1 * (PLACEMENTS + 2)]), pm.guess) is first[-1]

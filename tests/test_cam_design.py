@@ -38,7 +38,7 @@ def test_pressure_and_curvature_against_the_pitch_curve():
     """The pitch curve from its definition (the roller centre at (e, s0 + s) seen from the
     cam), its normal and radius of curvature by central differences in theta."""
     e, rb, rho = 8.0, 40.0, 10.0
-    d = design_cam(SEGMENTS, rb, rho, e, samples=720)
+    d = design_cam(SEGMENTS, rb, rho, e, points=720)
     s0 = math.sqrt((rb + rho) ** 2 - e * e)
     h = 1e-4
 
@@ -51,7 +51,7 @@ def test_pressure_and_curvature_against_the_pitch_curve():
     P = [pitch(t + k * h) for k in (-1, 0, 1)]
     d1, d2 = (P[2] - P[0]) / (2 * h), (P[2] - 2 * P[1] + P[0]) / h ** 2
     kappa = (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]) / np.hypot(*d1.T) ** 3
-    ref = design_cam(SEGMENTS, rb, rho, e, samples=720)
+    ref = design_cam(SEGMENTS, rb, rho, e, points=720)
     # evaluate the design's formulas at the same angles through a design sampled there
     s, ds, dds = motion(SEGMENTS, t)
     # world normal of the pitch curve at the follower: the cam-frame normal turned by theta

@@ -380,7 +380,7 @@ def test_curve_targets_without_timing_are_reached_exactly():
     r = optimize(start, Curve("P", np.c_[tx, ty]), vary=PATH_VARY)
     assert r.ok and r.converged and r.problems == []
     assert r.objective < 1e-14 and r.initial_objective > 1000
-    u = r.samples["crank.angle"]
+    u = r.inputs["crank.angle"]
     assert np.all(np.diff(u) >= 0) and u[-1] - u[0] <= 2 * np.pi  # in order, within a turn
     # through every target: the closed form at the fitted inputs and the fitted dimensions
     x, y = coupler_point(u, **r.varied)
@@ -402,7 +402,7 @@ def test_curve_in_the_other_direction_is_fitted_decreasing():
     tx, ty = coupler_point(hidden, **ref)
     r = optimize(coupler_fourbar(), Curve("P", np.c_[tx, ty]), vary=PATH_VARY)
     assert r.ok and r.objective < 1e-14
-    u = r.samples["crank.angle"]
+    u = r.inputs["crank.angle"]
     assert np.all(np.diff(u) <= 0)
     x, y = coupler_point(u, **r.varied)
     assert np.hypot(x - tx, y - ty).max() < 1e-7
@@ -420,7 +420,7 @@ def test_unreachable_curve_leaves_a_positive_objective():
     bound = np.sum((np.hypot(T[:, 0], T[:, 1]) - (40 + math.hypot(60, 60))) ** 2)
     assert r.objective > bound > 1000
     # the objective is what the closed form gives at the fitted inputs ...
-    u = r.samples["crank.angle"]
+    u = r.inputs["crank.angle"]
     x, y = coupler_point(u, **r.varied)
     d = np.hypot(x - T[:, 0], y - T[:, 1])
     assert np.sum(d * d) == pytest.approx(r.objective, rel=1e-10)

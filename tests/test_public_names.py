@@ -88,7 +88,7 @@ def test_analyse_counts_draws_and_the_old_samples_keyword_warns():
     with pytest.warns(DeprecationWarning, match=r"analyse\(samples=...\) is deprecated: use analyse\(draws=...\)"):
         old = kincas.analyse(_crank(), {"crank.angle": [0.3]}, {"a": 0.01}, ["A.x"], samples=30, seed=2)
     assert abs(new.first_order["A.x"][0] - 0.01 * math.cos(0.3)) < 1e-15
-    assert new.samples == old.samples == 30 and new.monte_carlo["A.x"][0] == old.monte_carlo["A.x"][0]
+    assert new.draws == old.draws == 30 and new.monte_carlo["A.x"][0] == old.monte_carlo["A.x"][0]
     with pytest.raises(kincas.ModelError, match="draws: given twice"):
         kincas.analyse(_crank(), {"crank.angle": [0.3]}, {"a": 0.01}, ["A.x"], draws=30, samples=40)
 

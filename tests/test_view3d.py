@@ -232,6 +232,43 @@ def test_dxf_of_a_spatial_mechanism_is_in_space(spatial, tmp_path):
     assert zs == sorted(round(at(p)[2], 9) for p in "".join("".join(b) for b in LINKS.values()) + "AD")
 
 
+def test_spatial_pictures_keep_the_true_scale_and_names_and_refuse_the_planar_overlay(spatial, tmp_path):
+    """The pictures branch's features on a spatial picture: the SVG's true-scale size beside
+    its view, every point named; DXF names at the points in space; forces and instant centres
+    (planar quantities) refused by the library and, in one line, by the command line."""
+    ezdxf = pytest.importorskip("ezdxf")
+    from kincas.cli.outputs import check_outputs
+    from kincas.errors import OutputError
+    from kincas.views.dxf import write_dxf
+    from kincas.views.svg import svg_text
+    m, sw = spatial
+    pose = 4
+    names, xyz, _ = world()
+    root = ET.fromstring(svg_text(m, sw, pose, view="zx", dense=world_paths(), units="mm"))
+    vb = [float(v) for v in root.get("viewBox").split()]
+    assert root.get("data-view") == "zx"
+    for attr, size in (("width", vb[2]), ("height", vb[3])):  # 1 mm of the scene is 1 mm of the file
+        assert root.get(attr).endswith("mm") and float(root.get(attr)[:-2]) == pytest.approx(size, rel=1e-5)
+    labels = next(g for g in root.iter(SVG + "g") if g.get("id") == "labels")
+    assert sorted(t.text for t in labels) == sorted(names)
+    for t in labels:  # each name near its drawn point (within a few point radii of the picture)
+        u, v = drawn_in(xyz[pose, names.index(t.text)], "zx")
+        assert math.hypot(float(t.get("x")) - u, -float(t.get("y")) - v) < 0.2 * 150
+    write_dxf(tmp_path / "s.dxf", m, sw, pose, dense=world_paths(), units="mm")
+    texts = {e.dxf.text: tuple(e.dxf.insert) for e in ezdxf.readfile(tmp_path / "s.dxf").modelspace()
+             .query('TEXT[layer=="labels"]')}
+    assert set(texts) == set(names)
+    for p in names:
+        assert texts[p] == pytest.approx(xyz[pose, names.index(p)], abs=1e-9)
+    for flag in ("forces", "centres"):
+        with pytest.raises(ValueError, match="spatial"):
+            svg_text(m, sw, pose, dense=world_paths(), **{flag: True})
+        args = SimpleNamespace(svg=str(tmp_path / "a.svg"), view=None, evolute=None, centrodes=None, **{flag: True})
+        with pytest.raises(OutputError, match="--forces, --centres.*spatial") as e:
+            check_outputs(args, m, N)
+        assert len(str(e.value).splitlines()) == 1
+
+
 def test_dxf_text_carries_the_z_group_codes(spatial, tmp_path):
     """Independently of ezdxf's reader: the file's POLYLINE vertices have z (group 30)."""
     pytest.importorskip("ezdxf")
@@ -279,7 +316,8 @@ STUB_DOM = r"""
 const handlers = {}, elements = {};
 function element(id) {
   if (!elements[id]) elements[id] = {
-    id, width: 640, height: 480, style: {}, dataset: {}, textContent: "", value: "0", max: "0",
+    id, width: 640, height: 480, clientWidth: 640, clientHeight: 480, style: {}, dataset: {}, textContent: "",
+    value: "0", max: "0", getBoundingClientRect: () => ({ left: 0, top: 0 }),
     getContext: () => new Proxy({}, { get: (t, k) => (k in t ? t[k] : () => {}), set: (t, k, v) => { t[k] = v; return true; } }),
     addEventListener: (ev, f) => { handlers[ev] = f; }, setPointerCapture: () => {},
     insertBefore: () => {}, appendChild: () => {}, set onclick(f) { handlers["click:" + id] = f; }, set oninput(f) {},
@@ -288,7 +326,8 @@ function element(id) {
 }
 global.document = { getElementById: element, body: element("body"), title: "",
                     createElement: () => element("b" + Object.keys(elements).length) };
-global.window = {}; global.location = { hash: "#pose=3&view=yz" };
+global.window = { addEventListener: () => {}, innerWidth: 1000, innerHeight: 700, scrollX: 0, scrollY: 0 };
+global.location = { hash: "#pose=3&view=yz" };
 """
 
 DRIVE = r"""
@@ -332,22 +371,19 @@ BROWSER = next((shutil.which(b) for b in ("chromium", "chromium-browser", "googl
 
 @pytest.mark.skipif(BROWSER is None, reason="no headless Chromium on this machine")
 def test_the_page_draws_in_a_browser_where_the_camera_says(page, tmp_path, view="zx"):
-    from PIL import Image
-    from test_html import FLAGS
+    from test_html import _driver, _shot
     path = tmp_path / "s.html"
     path.write_text(page, encoding="utf-8")
-    url = path.as_uri() + f"#pose=4&view={view}"
-    run = lambda *extra: subprocess.run([BROWSER, *FLAGS, f"--user-data-dir={tmp_path / 'p'}", *extra, url],
-                                        capture_output=True, text=True, timeout=120).stdout
-    dom = run("--dump-dom")
-    errors = re.search(r'<pre id="errors">(.*?)</pre>', dom, re.S)
-    assert errors is not None and errors.group(1).strip() == "", dom[-2000:]
-    assert 'data-pose="4"' in dom
-    cam = np.array(json.loads(re.search(r'data-camera="([^"]+)"', dom).group(1).replace("&quot;", '"')))
+    driver = _driver()  # one window for the transform and the screenshot (the page fills the window)
+    try:
+        errors, shown, (s, ox, oy), shot = _shot(driver, path.as_uri() + f"#pose=4&view={view}")
+        camera = driver.find_element("tag name", "body").get_attribute("data-camera")
+    finally:
+        driver.quit()
+    assert errors.strip() == "" and shown == "4"
+    cam = np.array(json.loads(camera))
     assert cam == pytest.approx(axes(view), abs=1e-12)
-    s, ox, oy = map(float, re.search(r'data-transform="([^"]+)"', dom).group(1).split())
-    run(f"--screenshot={tmp_path / 'shot.png'}")
-    img = np.asarray(Image.open(tmp_path / "shot.png").convert("RGB")).astype(int)
+    img = np.asarray(shot).astype(int)
     names, xyz, _ = world()
     # the middle of the crank A-B at pose 4, where the projection puts it: the crank's colour
     mid = 0.5 * (xyz[4, 0] + xyz[4, 2])

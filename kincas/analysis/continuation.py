@@ -1,5 +1,6 @@
 """The careful path of a sweep: continuation with step cutting, recovery after a failure,
-and the branch a sweep resumes on after poses with no assembly.
+and the branch a sweep resumes on after poses with no assembly; and the designs' first poses,
+continued in the parameters. Both walks are the one continuation (kincas/analysis/path.py).
 
 A pose the fast pass does not accept is solved here from the last solved pose: predicted along
 the exact tangent dq/du = -g_q^-1 g_u (or the secant through the pose before, next to a
@@ -8,17 +9,31 @@ changes the sign of det g_q.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..core.assembly import assemble, modes
+from ..core.batch import BatchEvaluator, batched_solve as _solve
+from ..core.blocks import numeric_signs
+from ..core.designs_kernel import MAX_STEPS, NEWTON, STEP
+from ..core.newton import stop_rule
 # the first pose of a sweep (its home is the core: `kincas modes` and `range` start there too)
 from ..core.assembly import ambiguous as _ambiguous, first_pose as _first, no_assembly as _no_assembly  # noqa: F401
 from ..core import branch
 from ..core.numeric import Model, Solution
 from ..core.limits import on_step, polish_singular
-from ..core.tolerances import BRANCH, NEAR_SINGULAR, STRAIGHT, WATCH
+from ..core.tolerances import ACCEPT, BRANCH, CAREFUL_DEPTH, ILL, NEAR_SINGULAR, SLOW, STRAIGHT, WATCH
 from ..model.mechanism import Mechanism
+from .path import Bisect, Steps, Walk, follow, follow_all, wandered
 from .resume import carry_groups, larger_groups, resume_label
+
+
+@dataclass
+class _Pose:
+    """The pose a walk starts from (a Solution's `q`, without its Newton)."""
+
+    q: np.ndarray
 
 
 MAX_GROUPS = 8  # groups searched for a limit where continuation of a step failed (the worst conditioned first)
@@ -51,7 +66,7 @@ def careful_pose(model: Model, m: Mechanism, U, p, L, guess, k: int, j: int | No
     reach = []  # how far continuation got from pose j (the furthest pose it solved)
     if sol is None:
         prev = (run.Q[j - 1], U[j - 1]) if fresh and j >= 1 and run.solved[j - 1] else None
-        sol = _continue(model, run.Q[j], U[j], u, p, L, depth=8 if fresh else 0, prev=prev, reach=reach)
+        sol = _continue(model, run.Q[j], U[j], u, p, L, depth=CAREFUL_DEPTH if fresh else 0, prev=prev, reach=reach)
     recovered = sol is None
     if sol is None:
         sol = _recover(model, m, (run.Q[j], U[j]), u, p, L)
@@ -129,45 +144,61 @@ def _recover(model: Model, m: Mechanism, last, u, p, L) -> Solution:
     return _no_assembly(model, last[0])
 
 
-def _scaled_norm(model: Model, dq, L) -> float:
-    return float(np.abs(dq / np.where(model.is_length, L, 1.0)).max(initial=0.0))
+def walk_inputs(model: Model, q0, u0, u1, p, L, depth: int, prev=None) -> Walk:
+    """The careful path's walk from the solved pose (q0, u0) to the inputs u1 (the one
+    continuation, kincas/analysis/path.py: a step to u1 halved `depth` times at most).
+
+    Each step is predicted along the exact tangent dq/du, except where g_q is nearly
+    singular: there the tangent is undefined (at a change point two branches cross), and
+    the secant through the pose before (`prev` = (q, u) before q0) carries the branch
+    straight through. Newton corrects it. A step is cut when the corrector fails ("not
+    converged") or needs many iterations ("slow"), lands far from the prediction
+    ("wandered"), a group's mode (sign of its block of det g_q) changes ("branch
+    changed"), or a singular position lies inside it ("singular crossed"). The shortest
+    step is kept where every group kept its mode or changed it by crossing a singular
+    position of its own that lies in the step (else it jumped branch).
+
+    Returns the Walk: `at` the Solution at u1 where `reason` is "reached"; `reach` the
+    (Solution, u) of every intermediate pose solved, in order (where it failed, the last
+    entry is as far as the branch was followed).
+    """
+    def step(w):
+        qa, ua, ub = w.at.q, w.where, w.target
+        J0 = model.jac(qa, ua, p)
+        before = w.before
+        pred = _secant(qa, ua, ub, (before[0].q, before[1])) \
+            if before is not None and _ill(model, J0, L) else None
+        if pred is None:
+            pred = qa + model.tangent(qa, ua, p) @ (ub - ua)
+        sol = model.newton(pred, ub, p, L)
+        if not sol.ok:
+            return sol, "not converged"
+        if w.last:  # the shortest step: a group may change mode only by crossing
+            # a singular position of its own that lies in this step (else it jumped branch)
+            kept = _same_branch(model, J0, sol, L) or _crossed(model, qa, ua, ub, J0, sol, p, L)
+            return sol, None if kept else "branch changed"
+        if sol.iterations > SLOW:
+            return sol, "slow"
+        if wandered(qa, pred, sol.q, np.where(model.is_length, L, 1.0)):
+            return sol, "wandered"
+        if not _same_branch(model, J0, sol, L):
+            return sol, "branch changed"
+        if _passes_singular(model, qa, ua, ub, J0, sol, p, L):
+            return sol, "singular crossed"
+        return sol, None
+    start = _Pose(np.asarray(q0))
+    before = None if prev is None else (_Pose(np.asarray(prev[0])), prev[1])
+    return follow(start, u0, Bisect(u1, depth, before), step)
 
 
 def _continue(model: Model, q0, u0, u1, p, L, depth: int, prev=None, reach=None) -> Solution | None:
-    """Predict, correct with Newton. The step is halved when the corrector fails or needs
-    many iterations, lands far from the prediction, or the sign of det(g_q) flips (the sign
-    tells the assembly branch apart).
-
-    The predictor is the exact tangent dq/du, except where g_q is nearly singular: there the
-    tangent is undefined (at a change point two branches cross), and the secant through
-    the previous pose `prev` = (q, u) carries the branch straight through.
-
-    `reach`, a list, receives (q, u) of every intermediate pose solved, in order: where
-    the step fails, its last entry is as far as the branch was followed.
-    """
-    J0 = model.jac(q0, u0, p)
-    pred = _secant(q0, u0, u1, prev) if prev is not None and _ill(model, J0, L) else None
-    if pred is None:
-        pred = q0 + model.tangent(q0, u0, p) @ (u1 - u0)
-    sol = model.newton(pred, u1, p, L)
-    if sol.ok and depth == 0:  # the shortest step: a group may change mode only by crossing
-        # a singular position of its own that lies in this step (else it jumped branch)
-        return sol if _same_branch(model, J0, sol, L) or _crossed(model, q0, u0, u1, J0, sol, p, L) else None
-    if sol.ok:
-        moved = _scaled_norm(model, pred - q0, L)
-        far = _scaled_norm(model, sol.q - pred, L) > max(0.02, 0.5 * moved)
-        if sol.iterations <= 8 and not far and _same_branch(model, J0, sol, L) \
-                and not _passes_singular(model, q0, u0, u1, J0, sol, p, L):
-            return sol
-    if depth == 0:
-        return None
-    um = 0.5 * (u0 + u1)
-    mid = _continue(model, q0, u0, um, p, L, depth - 1, prev, reach)
-    if mid is None:
-        return None
+    """The Solution at u1 continued from (q0, u0) by `walk_inputs`, or None where the walk
+    stopped short. `reach`, a list, receives (q, u) of every intermediate pose solved, in
+    order: where the walk failed, its last entry is as far as the branch was followed."""
+    w = walk_inputs(model, q0, u0, u1, p, L, depth, prev)
     if reach is not None:
-        reach.append((mid.q, um))
-    return _continue(model, mid.q, um, u1, p, L, depth - 1, (q0, u0), reach)
+        reach.extend((sol.q, u) for sol, u in w.reach)
+    return w.at if w.ok else None
 
 
 def _gap_inside(model: Model, run, U, p, L, j, k, sol: Solution, reach) -> bool:
@@ -189,7 +220,7 @@ def _gap_inside(model: Model, run, U, p, L, j, k, sol: Solution, reach) -> bool:
         found = locate_singular(model, *near_j, p, L, d, group=int(i), window=(-0.5, 1.5))
         if on_step(found):
             back = []  # and from pose k back towards pose j: the other end of the gap
-            _continue(model, sol.q, U[k], U[j], p, L, depth=8, reach=back)
+            _continue(model, sol.q, U[k], U[j], p, L, depth=CAREFUL_DEPTH, reach=back)
             near_k = back[-1] if back else (sol.q, U[k])
             run.__dict__.setdefault("crossed", []).append((int(j), int(k), near_j, near_k))
             return True
@@ -238,7 +269,7 @@ def _ill(model: Model, J, L) -> bool:
     with np.errstate(all="ignore"):
         # (2-norm, from singular values, for a tall g_q: redundant joints)
         c = np.linalg.cond(J * model.column_scale(L), 1 if model.square else None)
-    return not c < 1e2 * max(1.0, np.sqrt(J.shape[0]))
+    return not c < ILL * max(1.0, np.sqrt(J.shape[0]))
 
 
 def _secant(q0, u0, u1, prev):
@@ -278,3 +309,51 @@ def _same_branch(model: Model, J0, sol: Solution, L) -> bool:
     Q0, R0 = np.linalg.qr(J0 * c)
     d0, d1 = float(np.prod(np.diag(R0))), float(np.linalg.det(Q0.T @ (sol.J * c)))
     return np.sign(d0) == np.sign(d1) or min(abs(d0), abs(d1)) < BRANCH
+
+
+def walk_parameters(model, u, q0, p0, P, Ls, sign0, blocks=None) -> list:
+    """The designs' first poses, continued from the nominal's (q0 at the parameters p0, the
+    inputs u) to each design's parameters (rows of P, sizes Ls): the one continuation
+    (kincas/analysis/path.py), every design one walk of fixed steps, all in lockstep with one
+    batched step. A step of at most STEP times the size in every parameter (counted per
+    design, so that a design's numbers do not depend on the others computed with it: chunks
+    on a cluster), predicted along dq = -g_q^-1 g_p dp, corrected by Newton (undamped: the
+    predictor starts it close; each design stopping by the one rule of kincas/core/newton.py)
+    and kept where its residual is accepted ("not converged" else) and every Assur group kept
+    the nominal's mode `sign0` ("branch changed" else: kincas/core/branch.py). Returns the
+    walks: `at` the design's unknowns where `ok`, `reason` the stop as every walk gives it."""
+    nd = P.shape[0]
+    dP = P - p0
+    steps = np.clip(np.ceil(np.abs(dP).max(axis=1, initial=0.0) / (STEP * Ls)), 1, MAX_STEPS).astype(int)
+    walks = [Walk(np.asarray(q0, float), p0, Steps([p0 + dP[d] * (i / steps[d]) for i in range(1, steps[d] + 1)]))
+             for d in range(nd)]
+    pos = {id(w): d for d, w in enumerate(walks)}
+    ev = BatchEvaluator(model)
+    length = model.is_length[None, :]
+    blocks = list(model.blocks) if blocks is None else blocks
+
+    def step(live):
+        a = np.array([pos[id(w)] for w in live])
+        qa, pc, pt = np.stack([w.at for w in live]), np.stack([w.where for w in live]), np.stack([w.target for w in live])
+        ua, La = np.repeat(u[None, :], len(a), axis=0), Ls[a]
+        _, J, _, Gp = ev.derivatives(qa, ua, pc)
+        qa = qa - _solve(J, np.einsum("dij,dj->di", Gp, pt - pc))
+        D, go, last = np.where(length, La[:, None], 1.0), np.ones(len(a), bool), np.inf
+        for _ in range(NEWTON):
+            gv, J, _, _ = ev.derivatives(qa, ua, pt)
+            dq = _solve(J, gv)
+            size = np.abs(dq / D).max(axis=1, initial=0.0)
+            converged, stalled = stop_rule(np.abs(gv).max(axis=1) / La, size, last)
+            qa = np.where((go & ~stalled)[:, None], qa - dq, qa)
+            go, last = go & ~(converged | stalled), size
+            if not go.any():
+                break
+        gv, J, _, _ = ev.derivatives(qa, ua, pt)
+        r = np.abs(gv).max(axis=1) / La
+        with np.errstate(all="ignore"):
+            s = numeric_signs(J * np.where(length, 1.0, 1.0 / La[:, None])[:, None, :], blocks)
+        solved = (r <= ACCEPT) & np.isfinite(qa).all(axis=1)
+        kept = branch.kept(sign0, s)
+        return [(qa[j], None if solved[j] and kept[j] else "not converged" if not solved[j] else "branch changed")
+                for j in range(len(a))]
+    return follow_all(walks, step)

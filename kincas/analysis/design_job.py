@@ -15,14 +15,13 @@ import numpy as np
 from ..core import branch
 from ..core.assembly import modes
 from ..core.batch import BatchEvaluator, batched_solve as _solve, model_lock as _lock
-from ..core.blocks import numeric_signs
 from ..core.cancel import checkpoint
 from ..core.compiled import ptr, rows
-from ..core.designs_kernel import MAX_STEPS, NEWTON, STEP, designs_loop_for
+from ..core.designs_kernel import designs_loop_for
 from ..core.fast import FastRun
 from ..core.newton import stop_rule
-from ..core.numeric import ACCEPT
-from .continuation import _continue
+from ..core.tolerances import CAREFUL_DEPTH
+from .continuation import _continue, walk_parameters
 from .executor import map_threads
 
 OK, NO_ASSEMBLY, NOT_SOLVED, BRANCH_LOST, NO_MESH = 0, 1, 2, 3, 4
@@ -149,42 +148,13 @@ class _Job:
             self.S[idx] = np.concatenate([self.Q[idx, 0], Jd, cm(T), u, cm(T), u], axis=1)
 
     def _continue_in_parameters(self, idx, q0, p0, sign0) -> np.ndarray:
-        model, P, Ls = self.model, self.P[idx], self.Ls[idx]
-        nd, u = P.shape[0], np.repeat(self.U[:1], P.shape[0], axis=0)
-        ev = BatchEvaluator(model)
-        scale = np.where(model.is_length[None, :], 1.0, 1.0 / Ls[:, None])
-        dP = P - p0
-        # Steps of at most STEP * size in every parameter, counted per design, so that a
-        # design's numbers do not depend on the others computed with it (chunks on a cluster).
-        steps = np.clip(np.ceil(np.abs(dP).max(axis=1, initial=0.0) / (STEP * Ls)), 1, MAX_STEPS).astype(int)
-        q, pc = np.repeat(q0[None, :], nd, axis=0), np.repeat(p0[None, :], nd, axis=0)
-        ok = np.ones(nd, dtype=bool)
-        for i in range(1, int(steps.max(initial=1)) + 1):
-            a = np.flatnonzero(i <= steps)
-            qa, ua, La = q[a], u[a], Ls[a]
-            pt = p0 + dP[a] * (i / steps[a])[:, None]
-            _, J, _, Gp = ev.derivatives(qa, ua, pc[a])
-            qa = qa - _solve(J, np.einsum("dij,dj->di", Gp, pt - pc[a]))
-            # Newton (undamped: the predictor starts it close), each design stopping by the
-            # one rule of kincas/core/newton.py
-            D, live, last = np.where(model.is_length[None, :], La[:, None], 1.0), np.ones(len(a), bool), np.inf
-            for _ in range(NEWTON):
-                gv, J, _, _ = ev.derivatives(qa, ua, pt)
-                dq = _solve(J, gv)
-                size = np.abs(dq / D).max(axis=1, initial=0.0)
-                converged, stalled = stop_rule(np.abs(gv).max(axis=1) / La, size, last)
-                qa = np.where((live & ~stalled)[:, None], qa - dq, qa)
-                live, last = live & ~(converged | stalled), size
-                if not live.any():
-                    break
-            gv, J, _, _ = ev.derivatives(qa, ua, pt)
-            r = np.abs(gv).max(axis=1) / La
-            with np.errstate(all="ignore"):
-                s = numeric_signs(J * scale[a][:, None, :], self.kernel.sweeper.blocks if self.kernel
-                                  else list(model.blocks))
-            ok[a] &= (r <= ACCEPT) & np.isfinite(qa).all(axis=1) & branch.kept(sign0, s)
-            q[a], pc[a] = qa, pt
-        self.Q[idx[ok], 0] = q[ok]
+        """Whether each design of `idx` was continued from the nominal's first pose (q0 at
+        the parameters p0) to its own parameters (its first pose then in self.Q)."""
+        walks = walk_parameters(self.model, self.U[0], q0, p0, self.P[idx], self.Ls[idx], sign0,
+                                self.kernel.sweeper.blocks if self.kernel else None)
+        ok = np.array([w.ok for w in walks], dtype=bool)
+        if ok.any():
+            self.Q[idx[ok], 0] = np.stack([w.at for w, good in zip(walks, ok) if good])
         return ok
 
     # --- 2. the poses: compiled blocks of designs on threads, careful where rejected ---
@@ -296,7 +266,7 @@ class _Job:
             checkpoint()
             with _lock(model):
                 prev = (self.Q[d, k - 2], U[k - 2]) if k >= 2 else None
-                sol = _continue(model, self.Q[d, k - 1], U[k - 1], U[k], p, L, depth=8, prev=prev)
+                sol = _continue(model, self.Q[d, k - 1], U[k - 1], U[k], p, L, depth=CAREFUL_DEPTH, prev=prev)
                 if sol is None or not sol.ok:
                     lost = model.newton(self.Q[d, k - 1], U[k], p, L).ok
                     self.code[d, k] = BRANCH_LOST if lost else NO_ASSEMBLY
@@ -390,3 +360,4 @@ def _thresholds() -> np.ndarray:
     """The fast pass's acceptance thresholds, as `FastRun` sets them."""
     from ..core import fast
     return np.array([fast.RESIDUAL, fast.STEP, fast.JAC_CHANGE, fast.CORRECTION, fast.KERNEL_NEAR])
+

@@ -6,8 +6,9 @@ points never change, and neither does the first pose's *placement*: the unknowns
 pose assembled group by group in the default modes). Repeated sweeps of one mechanism (the
 usual case: a user, a benchmark or an optimiser calling `kincas.sweep` again) read them here
 instead of recomputing them. The table belongs to the structure's `Model` (`Model.memo`),
-holds the RECENT mechanisms used last (each kept by a reference, so its `id` stays its own)
-and is guarded by a lock: nothing here is global, and threads share only immutable arrays.
+holds the RECENT mechanisms prepared last (each kept by a reference, so its `id` stays its
+own) and is a `Memo` (kincas/core/caches.py, the one kind of cache), as is each mechanism's
+table of placements: nothing here is global, and threads share only immutable arrays.
 
 >>> import numpy as np, kincas
 >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
@@ -23,9 +24,6 @@ and is guarded by a lock: nothing here is global, and threads share only immutab
 True
 """
 from __future__ import annotations
-
-import threading
-from collections import OrderedDict
 
 import numpy as np
 
@@ -56,8 +54,7 @@ class Prepared:
         # gears and racks: the first pose's free angles are taken into (-pi, pi] after Newton
         # (core/turns.settle): that pose stays on the careful path
         self.plain = not (m.gears or m.racks)
-        self._places: OrderedDict = OrderedDict()
-        self._lock = threading.Lock()
+        self._places = Memo(bound=PLACEMENTS)  # (inputs, guess) -> Placement or None
         self._sweepers: dict = {}  # (report, compile) -> FastSweeper
         self._names: set = set()  # reports whose names were checked
 
@@ -85,10 +82,10 @@ class Prepared:
             return None
         key = (np.asarray(u, float).tobytes(),
                None if guess is self.guess else tuple(sorted(guess.items())))  # (the usual case)
-        with self._lock:
-            if key in self._places:
-                self._places.move_to_end(key)
-                return self._places[key]
+        out = self._places.get(key, self)  # (self: not kept; a placement may be None)
+        return self._places.get_or_build(key, lambda: self._place(model, u, guess)) if out is self else out
+
+    def _place(self, model, u, guess):
         u = np.array(u, float)
         if guess:
             q0 = guessed_start(model, u, self.p, self.size, guess)
@@ -97,42 +94,15 @@ class Prepared:
             q0 = None if sol is None else sol.q
         else:
             q0 = None
-        out = None
         if q0 is not None and np.all(np.isfinite(q0)):
-            out = Placement(q0, model.scales(u, self.p)[1])
-        with self._lock:
-            self._places[key] = out
-            while len(self._places) > PLACEMENTS:
-                self._places.popitem(last=False)
-        return out
-
-
-class _Recent:
-    """The RECENT mechanisms last prepared, by identity (each entry keeps its mechanism, so
-    an id is never reused while it is here)."""
-
-    def __init__(self):
-        self._d: OrderedDict = OrderedDict()
-        self._lock = threading.Lock()
-
-    def get(self, m: Mechanism) -> Prepared:
-        with self._lock:
-            hit = self._d.get(id(m))
-            if hit is not None and hit.m is m:
-                self._d.move_to_end(id(m))
-                return hit
-        made = Prepared(m)
-        with self._lock:
-            self._d[id(m)] = made
-            self._d.move_to_end(id(m))
-            while len(self._d) > RECENT:
-                self._d.popitem(last=False)
-        return made
+            return Placement(q0, model.scales(u, self.p)[1])
+        return None
 
 
 def prepared(model, m: Mechanism) -> Prepared:
     """The `Prepared` data of mechanism m, whose structure's model is `model`."""
-    return model.memo("sweep.prepared", _Recent).get(m)
+    # id(m) -> Prepared, which keeps m: an id is never reused while it is kept
+    return model.memo("sweep.prepared", lambda: Memo(bound=RECENT)).get_or_build(id(m), lambda: Prepared(m))
 
 
 # --- the mechanisms last swept, by identity: their model and prepared data in one look-up ---

@@ -8,8 +8,9 @@ reported as unknown, with the reason, and never as "same":
 
 - **carried**: where the group and the groups it is built on assemble at every input of the
   gap (a later group is the one that has no assembly), they alone are continued through the
-  gap's inputs (predictor along the exact tangent, Newton corrector group by group, the step
-  halved where it fails, wanders from the prediction or changes a block's sign). The
+  gap's inputs by the one continuation (kincas/analysis/path.py: predictor along the exact
+  tangent, Newton corrector group by group, the step halved where it fails, wanders from the
+  prediction or changes a block's sign). The
   assembly they arrive at is the mode left; the resumed one is it, or another.
 - **the same limit**: where the mode left ended at a limit of the group and the resumed
   assembly begins at one, and both are the same point (the inputs came back the way they
@@ -30,12 +31,12 @@ import numpy as np
 from ..core import branch
 from ..core.assembly import _block_newton, blocks, group_links, modes
 from ..core.limits import locate_singular, on_step
-from ..core.tolerances import ACCEPT, SAME_ASSEMBLY as SAME, SAME_INPUT
+from ..core.tolerances import ACCEPT, CARRY_BUDGET, CARRY_DEPTH, CARRY_ITER, SAME_ASSEMBLY as SAME, SAME_INPUT
+from .path import Bisect, follow, wandered
 
 WIDE = 2  # a group with more unknowns than this has more assemblies than block signs
 # SAME: two assemblies are one when every unknown agrees to this (lengths over L)
-DEPTH = 10  # halvings of one input step while carrying groups through a gap
-BUDGET = 200  # Newton solves spent carrying groups across one input step of a gap
+DEPTH, BUDGET = CARRY_DEPTH, CARRY_BUDGET  # halvings of, and solves spent on, one input step of a gap
 
 REASON = ("its assemblies of one sign are told apart neither by continuation (it has no "
           "assembly in the gap) nor by a limit it left and came back through")
@@ -229,19 +230,9 @@ def _carry(model, U, p, L, j, qj, k, i, memo):
     signs = modes(model, model.jac(qj, U[j], p), L)[0][:i + 1]
     if np.any(signs == 0):
         return None
-    spent = [0]
 
-    def solve(q, u):  # groups 0..i, each by its own Newton, the later ones left as they are
-        for b in range(i + 1):
-            q, r = _block_newton(model, q, u, p, L, b, max_iter=12)
-            if not r <= ACCEPT:
-                return None
-        return q
-
-    def step(q, u0, u1, depth):
-        spent[0] += 1
-        if spent[0] > BUDGET:
-            return None
+    def step(w):  # groups 0..i predicted along their tangent, each corrected by its own Newton
+        q, u0, u1 = w.at, w.where, w.target
         _, J, Ju = model._tangent(q, u0, p)
         with np.errstate(all="ignore"):
             try:
@@ -250,21 +241,21 @@ def _carry(model, U, p, L, j, qj, k, i, memo):
                 t = np.zeros((len(C), len(u0)))
         pred = q.copy()
         pred[C] = q[C] + (t @ (u1 - u0) if np.all(np.isfinite(t)) else 0.0)
-        x = solve(pred.copy(), u1)
-        if x is not None:
-            moved = np.abs((pred - q)[C] / scale).max(initial=0.0)
-            far = np.abs((x - pred)[C] / scale).max(initial=0.0) > max(0.02, 0.5 * moved)
-            if not far and np.array_equal(modes(model, model.jac(x, u1, p), L)[0][:i + 1], signs):
-                return x
-        if depth == 0:
-            return None
-        um = 0.5 * (u0 + u1)
-        mid = step(q, u0, um, depth - 1)
-        return None if mid is None else step(mid, um, u1, depth - 1)
+        x = pred.copy()
+        for b in range(i + 1):  # the later groups left as they are
+            x, r = _block_newton(model, x, u1, p, L, b, max_iter=CARRY_ITER)
+            if not r <= ACCEPT:
+                return None, "not converged"
+        if wandered(q[C], pred[C], x[C], scale):
+            return None, "wandered"
+        got = modes(model, model.jac(x, u1, p), L)[0][:i + 1]
+        if not (got.all() and branch.kept(signs, got)):  # every group defined, in its mode
+            return None, "branch changed"
+        return x, None
 
-    for kk in range(start + 1, k + 1):
-        q = step(q, U[kk - 1], U[kk], DEPTH)
-        spent[0] = 0  # a budget per input step
+    for kk in range(start + 1, k + 1):  # one walk per input step, with its own budget
+        w = follow(q, U[kk - 1], Bisect(U[kk], DEPTH), step, budget=BUDGET)
+        q = w.at if w.ok else None
         memo[(j, i)] = (kk, q)
         if q is None:
             return None

@@ -11,8 +11,9 @@ A limit is located exactly by Newton on the extended system
     g(q, u) = 0,   g_q(q, u) v = 0,   v0 . v = 1
 in (q, u, v), whose Jacobian (second derivatives of g, exact from CasADi) is regular at a
 simple turning point. The range of motion follows the branch by pseudo-arclength
-continuation (through the turns that natural-parameter continuation cannot pass) until the
-input turns back (a limit) or an angle input has made a full turn.
+continuation (the one continuation, kincas/analysis/path.py, in arclength: through the turns
+that natural-parameter continuation cannot pass) until the input turns back (a limit) or an
+angle input has made a full turn.
 
 >>> import math, kincas
 >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
@@ -33,9 +34,11 @@ import numpy as np
 
 from ..core.limits import _scales, locate_singular, scaled_jacobians  # noqa: F401  (their old home)
 from ..core.newton import newton
-from ..core.tolerances import FLAG_SIGMA, MIN_ARC_STEP, ROUNDING_REL
+from ..core.tolerances import (ARC_FIRST, ARC_GROW, ARC_ITER, ARC_LONGEST, ARC_WANDER, FLAG_SIGMA, MAX_STEP,
+                               MIN_ARC_STEP, ROUNDING_REL)
 from ..model.mechanism import Mechanism
 from ..result_base import Result
+from .path import Arclength, follow
 
 
 # --- scaled Jacobians and classification ---
@@ -160,37 +163,41 @@ def input_range(m: Mechanism, inputs: dict, key: str | None = None, *, max_steps
 
 
 def _follow(model, q, u, p, L, i, direction, scale, is_angle, max_steps):
-    """Walk the branch from (q, u) while input i moves in `direction` at first.
+    """Walk the branch from (q, u) while input i moves in `direction` at first: the one
+    continuation (kincas/analysis/path.py) in arclength, in z = (q, u_i) / scale.
 
     Returns (the input value where the walk ended, the located limit or None)."""
     nq = model.nq
     z = np.concatenate([q, [u[i]]]) / scale
     t = _curve_tangent(model, q, u, p, i, scale)
     t = t if t[-1] * direction > 0 or abs(t[-1]) < ROUNDING_REL else -t
-    h, u_start = 0.02, u[i]
-    for _ in range(max_steps):
-        zp = z + h * t
-        zn = _correct(model, zp, t, u, p, L, i, scale)
+    u_start = u[i]
+
+    def step(w):  # predict along the curve's tangent, correct across it; the new tangent
+        (z, t), h = w.at, w.target
+        zn = _correct(model, z + h * t, t, u, p, L, i, scale)
         if zn is None:
-            h /= 2
-            if h < MIN_ARC_STEP:
-                return z[-1] * scale[-1], None
-            continue
-        qn = zn[:nq] * scale[:nq]
-        un = u.copy()
-        un[i] = zn[-1] * scale[-1]
-        tn = _curve_tangent(model, qn, un, p, i, scale)
-        tn = tn if tn @ t >= 0 else -tn
+            return None, "not converged"
+        tn = _curve_tangent(model, zn[:nq] * scale[:nq], _with(u, i, zn[-1] * scale[-1]), p, i, scale)
+        return (zn, tn if tn @ t >= 0 else -tn), None
+
+    def stop(w):
+        (_, t), (zn, tn) = w.prev, w.at
         if np.sign(tn[-1]) != np.sign(t[-1]) and t[-1] != 0:
-            # the input turned back between z and zn: a limit; locate it exactly
-            start = (qn, un) if abs(tn[-1]) < abs(t[-1]) else (z[:nq] * scale[:nq], _with(u, i, z[-1] * scale[-1]))
-            found = locate_singular(model, start[0], start[1], p, L, np.eye(len(u))[i])
-            ul = found[1][i] if found is not None else 0.5 * (z[-1] + zn[-1]) * scale[-1]
-            return ul, ul
-        z, t = zn, tn
-        if is_angle and abs(un[i] - u_start) >= 2 * np.pi:
-            return un[i], None
-        h = min(0.2, h * 1.5)
+            return "limit"  # the input turned back between z and zn
+        if is_angle and abs(zn[-1] * scale[-1] - u_start) >= 2 * np.pi:
+            return "full turn"
+        return None
+    w = follow((z, t), None, Arclength(ARC_FIRST, ARC_LONGEST, ARC_GROW, MIN_ARC_STEP), step,
+               stop=stop, budget=max_steps, reach=False)
+    if w.reason == "limit":  # locate it exactly, from the end nearer it
+        (z, t), (zn, tn) = w.prev, w.at
+        qn, un = zn[:nq] * scale[:nq], _with(u, i, zn[-1] * scale[-1])
+        start = (qn, un) if abs(tn[-1]) < abs(t[-1]) else (z[:nq] * scale[:nq], _with(u, i, z[-1] * scale[-1]))
+        found = locate_singular(model, start[0], start[1], p, L, np.eye(len(u))[i])
+        ul = found[1][i] if found is not None else 0.5 * (z[-1] + zn[-1]) * scale[-1]
+        return ul, ul
+    z = w.at[0]
     return z[-1] * scale[-1], None
 
 
@@ -207,7 +214,7 @@ def _curve_tangent(model, q, u, p, i, scale):
     return np.linalg.svd(G)[2][-1]
 
 
-def _correct(model, zp, t, u, p, L, i, scale, max_iter=12):
+def _correct(model, zp, t, u, p, L, i, scale, max_iter=ARC_ITER):
     """Newton on [g(z) = 0; t.(z - zp) = 0] (pseudo-arclength corrector): the one Newton
     (kincas/core/newton.py) in z (angles as they are, lengths over L), g against each
     group's length. None where it does not converge within `max_iter` or lands more than
@@ -219,7 +226,7 @@ def _correct(model, zp, t, u, p, L, i, scale, max_iter=12):
         g, J, Ju = model._tangent(z[:nq] * scale[:nq], _with(u, i, z[-1] * scale[-1]), p)
         return np.r_[g.ravel(), t @ (z - zp)], np.vstack([np.hstack([J, Ju[:, [i]]]) * scale, t])
 
-    res = newton(F, zp, np.ones(len(zp)), np.r_[eq, 1.0], max_iter=max_iter, max_step=0.5)
-    if not res.ok or res.iterations >= max_iter or not np.abs(res.x - zp).max() <= 0.5:
+    res = newton(F, zp, np.ones(len(zp)), np.r_[eq, 1.0], max_iter=max_iter, max_step=MAX_STEP)
+    if not res.ok or res.iterations >= max_iter or not np.abs(res.x - zp).max() <= ARC_WANDER:
         return None
     return res.x

@@ -39,7 +39,7 @@ import numpy as np
 from ..errors import ModelError
 from ..core.tolerances import ROUNDING_REL, TINY
 from ..model.mechanism import Mechanism
-from .._deprecated import keyword, renamed
+from .._deprecated import attribute, keyword, renamed
 from ..result_base import Result
 
 FEW_POSES = 16  # up to this many poses, each is solved from the nominal's (not swept to)
@@ -58,7 +58,7 @@ class ToleranceAnalysis(Result):
 
     names: list[str]
     std: dict[str, float]
-    samples: int
+    draws: int  # Monte-Carlo draws (0.1: `samples`)
     seed: int | None
     inputs: dict[str, np.ndarray]
     status: list[str]
@@ -69,6 +69,8 @@ class ToleranceAnalysis(Result):
     failed: np.ndarray
     info: dict = field(default_factory=dict)
 
+    samples = attribute("ToleranceAnalysis", "samples", "draws")
+
     @property
     def ok(self) -> np.ndarray:
         """Boolean mask of the poses whose nominal design was solved."""
@@ -76,7 +78,7 @@ class ToleranceAnalysis(Result):
 
     def summary(self) -> str:
         """Poses, Monte-Carlo samples, parameters and outputs (the `repr`'s body)."""
-        return (f"{len(self.status)} poses, {int(self.ok.sum())} solved; {self.samples} samples; "
+        return (f"{len(self.status)} poses, {int(self.ok.sum())} solved; {self.draws} draws; "
                 f"std of {', '.join(self.std)}; outputs {', '.join(self.names)}")
 
     @property
@@ -94,7 +96,7 @@ class ToleranceAnalysis(Result):
     @property
     def standard_error(self) -> float:
         """Relative sampling error of a Monte-Carlo standard deviation, 1 / sqrt(2 (n - 1))."""
-        return 1.0 / math.sqrt(2.0 * max(self.samples - 1, 1))
+        return 1.0 / math.sqrt(2.0 * max(self.draws - 1, 1))
 
     def to_pandas(self, length: str = "", angle: str = "rad"):
         """A DataFrame per pose: each output's nominal value, `std Q` and `mc Q`, status, failed."""
@@ -195,7 +197,7 @@ def analyse(m: Mechanism, inputs, std: dict[str, float], report: list[str] | Non
     mc, shift, failed, retried = _monte_carlo(m, sw, report, to, dp, workers)
     nominal = {n: sw[n] for n in report}
     return ToleranceAnalysis(
-        names=report, std={p: float(std[p]) for p in to}, samples=draws, seed=seed,
+        names=report, std={p: float(std[p]) for p in to}, draws=draws, seed=seed,
         inputs=sw.inputs, status=sw.status, nominal=nominal,
         first_order={n: fo[:, j] for j, n in enumerate(report)},
         monte_carlo={n: mc[:, j] for j, n in enumerate(report)},

@@ -26,25 +26,61 @@ from .solve import cli_arguments as _solve_arguments, cli_run as _solve, rate_li
 # Further commands live in their own modules: each defines `cli_arguments(parser)` and
 # `cli_run(args) -> exit status`, and is imported only when it exists.
 COMMANDS = {
-    "range": ("kincas.cli.range", "range of motion of the input, its limits and singular positions"),
-    "modes": ("kincas.cli.modes", "the distinct assembly modes at the scene's input, as [guess] blocks"),
-    "optimize": ("kincas.cli.optimize", "optimise parameters as the scene's [optimize] section says"),
-    "tolerance": ("kincas.cli.tolerance", "first-order and Monte-Carlo spread of outputs from parameter tolerances"),
-    "study": ("kincas.cli.study", "many designs at once: the scene's [study] section, one row per design"),
-    "cam": ("kincas.cli.cam", "design a disc cam from the scene's [cam_design] section (profile, pressure angle, curvature)"),
+    "range": ("kincas.cli.range", "the input's range of motion, limits, singular poses"),
+    "modes": ("kincas.cli.modes", "the assembly modes at the input, as [guess] blocks"),
+    "optimize": ("kincas.cli.optimize", "optimise parameters as [optimize] says"),
+    "tolerance": ("kincas.cli.tolerance", "spread of the outputs from parameter tolerances"),
+    "study": ("kincas.cli.study", "many designs at once, one row each, as [study] says"),
+    "cam": ("kincas.cli.cam", "design a disc cam as [cam_design] says"),
+}
+SOLVE_HELP = "positions, speeds, forces over the scene's inputs"
+
+# An example for each command's help (its last lines); a command without one shows the plain call.
+EXAMPLES = {
+    "solve": ["kincas solve examples/fourbar_coupler.toml",
+              "kincas solve examples/forces_toggle.toml --plot toggle.png --forces --centres",
+              "kincas solve examples/slider_crank.toml --html slider.html --svg slider.svg"],
+    "range": ["kincas range examples/fourbar_coupler.toml"],
+    "modes": ["kincas modes examples/sixbar.toml"],
+    "optimize": ["kincas optimize examples/forces_vtwin.toml"],
+    "tolerance": ["kincas tolerance examples/fairbairn.toml"],
+    "study": ["kincas study examples/study_fourbar.toml --csv designs.csv"],
+    "cam": ["kincas cam my_cam.toml --out profile.toml   (a scene with [cam_design]: docs/scene-format.md)"],
 }
 
 
+class _Help(argparse.RawDescriptionHelpFormatter):
+    """Descriptions and examples as written, and each command's one line beside its name
+    (argparse measures the commands' names without the indent it prints them with)."""
+
+    def add_argument(self, action):
+        super().add_argument(action)
+        if isinstance(action, argparse._SubParsersAction) and action.choices:
+            longest = max(len(n) for n in action.choices) + self._current_indent + 2 * self._indent_increment
+            self._action_max_length = max(self._action_max_length, longest)
+
+
+def _example(name: str) -> str:
+    lines = EXAMPLES.get(name) or [f"kincas {name} SCENE.toml"]
+    return "example:\n" + "\n".join("  " + ln for ln in lines)
+
+
 def _parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog="kincas", description="Kinematics of planar closed-chain mechanisms.")
+    def raw(prog):  # descriptions and examples as written; a command's help beside its name
+        return _Help(prog, max_help_position=28)
+    ap = argparse.ArgumentParser(prog="kincas", description="Kinematics of planar closed-chain mechanisms.",
+                                 formatter_class=raw,
+                                 epilog="examples:\n  kincas solve examples/fourbar_coupler.toml --plot fourbar.png\n"
+                                        "  kincas solve --help       (each command's options)")
     ap.add_argument("--version", action="store_true", help="print the version and exit")
-    sub = ap.add_subparsers(dest="command")
-    s = sub.add_parser("solve", help="solve a scene: positions, velocities, accelerations over its inputs")
+    sub = ap.add_subparsers(dest="command", metavar="COMMAND")
+    s = sub.add_parser("solve", help=SOLVE_HELP, description=SOLVE_HELP, epilog=_example("solve"),
+                       formatter_class=raw)
     _solve_arguments(s)
     s.set_defaults(run=lambda args: _solve(args))  # looked up when run (tests replace it)
     chosen = next((a for a in (argv or []) if not a.startswith("-")), None)
     for name, (module, text) in COMMANDS.items():
-        c = sub.add_parser(name, help=text)
+        c = sub.add_parser(name, help=text, description=text, epilog=_example(name), formatter_class=raw)
         if name != chosen:  # only the command being run is imported
             continue
         mod = importlib.import_module(module)
@@ -117,7 +153,7 @@ def _check_args(args) -> None:
     write = getattr(args, "write", None)
     if write and Path(write).exists() and not Path(write).is_dir():
         raise OutputError(f"--write: {write} exists and is not a directory (--write names a directory)")
-    starts, samples = getattr(args, "starts", None), getattr(args, "samples", None)
+    starts = getattr(args, "starts", None)
     if not (starts or args.command in ("tolerance", "range")):
         return
     from ..model.mechanism import solved_unknowns
@@ -133,7 +169,9 @@ def _check_args(args) -> None:
             bounds.check("--starts", starts, bounds.per_sample(nq, 0, 0))
         if args.command == "tolerance":
             t = sc.study.raw.get("tolerance", {})
-            field, n = ("--samples", samples) if samples else ("[tolerance] samples", t.get("samples"))
+            from .tolerance import draws_option
+            flag, n = draws_option(args, note=False)
+            field, n = (flag, n) if n else ("[tolerance] samples", t.get("samples"))
             if isinstance(n, int) and not isinstance(n, bool) and n > 0:
                 std = t.get("std", {})
                 poses = max((len(v) for v in sc.study.inputs.values()), default=1)

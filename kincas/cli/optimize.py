@@ -49,7 +49,7 @@ def report(sc, r: Optimization) -> dict:
     curve = {}
     if "curve" in r.info:  # the fitted input at each target and the distance left there
         c = r.info["curve"]
-        fitted = user(key, r.samples[key])
+        fitted = user(key, r.inputs[key])
         if key.endswith(".angle"):  # within one turn from the sweep's start, not 677 deg
             turn, lo = (360.0 if deg else 2 * math.pi), float(np.min(sc.study.written[key]))
             fitted = lo + np.mod(fitted - lo, turn)
@@ -65,8 +65,8 @@ def report(sc, r: Optimization) -> dict:
         "initial": {p: sc.mechanism.parameter(p) for p in r.varied},
         "bounds": {p: list(bounds[p]) for p in r.varied},
         "at_bound": {p: side for p in r.varied if (side := _at_bound(r.varied[p], *bounds[p]))},
-        "parameter_units": {p: _param_unit(sc, p) for p in r.varied},
-        "samples": {k: _list(user(k, v)) for k, v in r.samples.items()},
+        "parameter_units": {p: _optimized_unit(sc, p) for p in r.varied},
+        "samples": {k: _list(user(k, v)) for k, v in r.inputs.items()},  # the scene's word
         "values": {n: _list(user(n, v)) for n, v in r.values.items()},
         "constraints": [{**{k: c[k] for k in ("expr", "min", "max", "satisfied")},
                          "value": _list(np.atleast_1d(c["value"]))} for c in r.constraints],
@@ -90,7 +90,7 @@ def _objective_unit(sc) -> str | None:
     def label(name):
         if name == "__angle__":
             return angle
-        return _param_unit(sc, name) if name in params else _unit(sc, name)
+        return _optimized_unit(sc, name) if name in params else _unit(sc, name)
 
     units = []
     if "curve" in t:  # the sum of squared distances to the targets
@@ -102,6 +102,41 @@ def _objective_unit(sc) -> str | None:
         except ModelError:
             return None
     return units[0] if len(set(units)) == 1 else None
+
+
+def _optimized_unit(sc, name: str) -> str:
+    """A parameter's unit; for one that only [optimize] uses (a bound such as `peak` in
+    `hypot(shaking.x, shaking.y) - peak`), the unit of what its constraints compare it with."""
+    if not _only_optimized(sc.study.raw, name):
+        return _param_unit(sc, name)
+    from ..errors import ModelError
+    from ..synthesis.dimensions import term_unit
+    from ..synthesis.expressions import parse
+    t = sc.study.raw.get("optimize", {})
+    data = list(t.get("data") or {}) if isinstance(t.get("data"), dict) else []
+    params = sc.mechanism.param_values
+    label = lambda n: (sc.study.units.get("angle", "deg") if n == "__angle__" else  # noqa: E731
+                       _param_unit(sc, n) if n in params else _unit(sc, n))
+    found = set()
+    for c in t.get("constraints") or []:
+        try:
+            u = term_unit(parse(c.get("expr"), "constraint", data=data), name, label)
+        except (ModelError, AttributeError, KeyError):
+            continue
+        if u is not None:
+            found.add(u)
+    return found.pop() if len(found) == 1 else _param_unit(sc, name)
+
+
+def _only_optimized(doc: dict, name: str) -> bool:
+    """Whether the scene names parameter `name` nowhere but in [parameters] and [optimize]."""
+    def uses(v) -> bool:
+        if isinstance(v, str):
+            return v.lstrip("-") == name
+        if isinstance(v, dict):
+            return any(uses(x) for x in v.values())
+        return isinstance(v, list) and any(uses(x) for x in v)
+    return not any(uses(v) for k, v in doc.items() if k not in ("parameters", "optimize", "title", "units"))
 
 
 def _at_bound(v: float, lo: float, hi: float) -> str | None:

@@ -61,6 +61,9 @@ def check_outputs(args, mechanism=None, poses: int | None = None) -> None:
         if bad:
             _fail(f"--paths: unknown point(s) {', '.join(bad)} (points: {', '.join(sorted(known))})")
     _check_view(args, mechanism)
+    if (getattr(args, "forces", False) or getattr(args, "centres", False)) and not any(
+            getattr(args, a, None) for a in ("plot", "animate", "html", "svg", "dxf")):
+        _fail("--forces, --centres: they draw on the pictures; give --plot, --animate, --html, --svg or --dxf")
     geo = {k: _names(getattr(args, k, None) or "") for k in ("evolute", "centrodes")}
     if any(geo.values()):
         if not getattr(args, "plot", None):
@@ -97,6 +100,8 @@ def _check_view(args, mechanism) -> None:
                 _fail(str(e))
     if spatial and (getattr(args, "evolute", None) or getattr(args, "centrodes", None)):
         _fail("--evolute, --centrodes: the kinematic geometry of planar motion; this scene is spatial")
+    if spatial and (getattr(args, "forces", False) or getattr(args, "centres", False)):
+        _fail("--forces, --centres: the arrows and instant centres are drawn on planar pictures; this scene is spatial")
 
 
 def check_path(flag: str, path, formats=None) -> None:
@@ -151,16 +156,17 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
     captions = [_caption(scene, sweep, inputs, i) for i in range(len(sweep))]
     solved = _SharedPaths(m, sweep, paths, [a for a in ("plot", "animate", "html", "svg", "dxf")
                                             if getattr(args, a, None)])
+    over = {"forces": bool(getattr(args, "forces", False)), "centres": bool(getattr(args, "centres", False))}
     jobs = [("csv", lambda p: write_csv(p, sweep, scene)),
             ("plot", lambda p: _save_drawing(p, m, sweep, pose, paths, captions, length,
                                              _names(getattr(args, "evolute", None) or ""),
-                                             _names(getattr(args, "centrodes", None) or ""), solved(), view)),
+                                             _names(getattr(args, "centrodes", None) or ""), solved(), view, **over)),
             ("animate", lambda p: _animate(p, m, sweep, paths, captions, length, _rendering(args), solved(),
-                                           view)),
+                                           view, **over)),
             ("plot_quantities", lambda p: savefig(plot_quantities(sweep, scene=scene), p, dpi=100)),
-            ("html", lambda p: _html(p, m, sweep, scene, paths, solved.dense(), view)),
-            ("svg", lambda p: _svg(p, m, sweep, scene, pose, paths, solved.dense(), view)),
-            ("dxf", lambda p: _dxf(p, m, sweep, scene, pose, paths, solved.dense()))]
+            ("html", lambda p: _html(p, m, sweep, scene, paths, solved.dense(), view, **over)),
+            ("svg", lambda p: _svg(p, m, sweep, scene, pose, paths, solved.dense(), view, **over)),
+            ("dxf", lambda p: _dxf(p, m, sweep, scene, pose, paths, solved.dense(), **over))]
     for attr, job in jobs:
         path = getattr(args, attr, None)
         if path:
@@ -204,20 +210,20 @@ class _SharedPaths:
         return 0 if xy is None else xy
 
 
-def _html(path, m, sweep, scene, paths, dense=0, view=None):
+def _html(path, m, sweep, scene, paths, dense=0, view=None, **over):
     from ..views.html import write_html
-    write_html(path, m, sweep, scene, paths, dense=dense, view=view)
+    write_html(path, m, sweep, scene, paths, dense=dense, view=view, **over)
 
 
-def _svg(path, m, sweep, scene, pose, paths, dense=0, view=None):
+def _svg(path, m, sweep, scene, pose, paths, dense=0, view=None, **over):
     from ..views.svg import write_svg
-    write_svg(path, m, sweep, pose, paths=paths, scene=scene, dense=dense, view=view)
+    write_svg(path, m, sweep, pose, paths=paths, scene=scene, dense=dense, view=view, **over)
 
 
-def _dxf(path, m, sweep, scene, pose, paths, dense=0):
+def _dxf(path, m, sweep, scene, pose, paths, dense=0, **over):
     from ..views.dxf import write_dxf
     write_dxf(path, m, sweep, pose, paths=paths, dense=dense,
-              units=scene.study.units.get("length", "") if scene is not None else "")
+              units=scene.study.units.get("length", "") if scene is not None else "", **over)
 
 
 def _caption(scene, sweep, inputs, i) -> str:
@@ -231,12 +237,12 @@ def _caption(scene, sweep, inputs, i) -> str:
 
 
 def _save_drawing(path, m, sweep, pose, paths, captions, length, evolute=(), centrodes=(), path_xy=None,
-                  view=None):
+                  view=None, forces=False, centres=False):
     from ..views.plot import default_pose, draw, new_figure
     fig = new_figure()
     i = default_pose(sweep) if pose is None else pose % len(sweep)
     ax = draw(m, sweep, i, ax=fig.subplots(), paths=paths, title=captions[i], units=length, path_xy=path_xy,
-              view=view)
+              view=view, forces=forces, centres=centres)
     if evolute or centrodes:  # kinematic geometry over the drawing (kincas/views/draw_geometry.py)
         from ..views.draw_geometry import draw_geometry
         draw_geometry(ax, m, sweep, i, evolute, centrodes)
@@ -252,6 +258,7 @@ def _rendering(args):
     return bar
 
 
-def _animate(path, m, sweep, paths, captions, length, progress=None, path_xy=None, view=None):
+def _animate(path, m, sweep, paths, captions, length, progress=None, path_xy=None, view=None, forces=False,
+             centres=False):
     animate(m, sweep, path, paths=paths, captions=captions, units=length, progress=progress, path_xy=path_xy,
-            view=view)
+            view=view, forces=forces, centres=centres)

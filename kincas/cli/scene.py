@@ -80,8 +80,19 @@ class Scene:
         st = self.study
         if any(st.jerks.values()):
             kw.setdefault("jerks", st.jerks)
-        return sweep(self.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
-                     report=self.quantities, **kw)
+        sw = sweep(self.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
+                   report=self.quantities, **kw)
+        sw.info["display"] = self.display(sw)  # Jupyter shows it in the scene's units
+        return sw
+
+    def display(self, sw: Sweep) -> dict:
+        """How a display shows the sweep in the scene's units (plain data, kept in
+        `Sweep.info["display"]`): each name's unit label, and the names in degrees."""
+        from ..model.names import is_angular
+        from ..views.columns import quantity_unit
+        deg = [k for k in sw.inputs if k.endswith(".angle")] + [k for k in sw.values if is_angular(k, self.mechanism)]
+        return {"units": dict(self.study.units), "degrees": deg if self.study.deg else [],
+                "labels": {k: quantity_unit(self, k) for k in [*sw.inputs, *sw.values]}}
 
     def refuse_jerks(self, texts, where: str) -> None:
         """Only `kincas solve` passes the inputs' `jerk` on; elsewhere they would be taken as 0,

@@ -80,13 +80,28 @@ class StudyReader:
             inputs.append(inp)
             written[inp.key] = vals
             values[inp.key] = vals * k
-            rates[inp.key] = self.value(f"{where}: rate", t.get("rate", 1.0), ang)
-            accs[inp.key] = self.value(f"{where}: acceleration", t.get("acceleration", 0.0), ang)
-            self.jerks[inp.key] = self.value(f"{where}: jerk", t.get("jerk", 0.0), ang)
+            rates[inp.key] = self.rate(f"{where}: rate", t.get("rate", 1.0), ang, 1)
+            accs[inp.key] = self.rate(f"{where}: acceleration", t.get("acceleration", 0.0), ang, 2)
+            self.jerks[inp.key] = self.rate(f"{where}: jerk", t.get("jerk", 0.0), ang, 3)
         if len(steps) > 1:
             self.err(f"[[inputs]] sweep.steps: inputs that sweep advance together, but their "
                      f"steps differ ({sorted(steps)})")
         return inputs, values, rates, accs, written
+
+    def rate(self, where: str, v, angular: bool, order: int) -> float:
+        """A rate (order 1), acceleration (2) or jerk (3): a number or a parameter in the
+        scene's units, or a number with its own unit ("3000 rpm", "0.2 m/s"), converted
+        (kincas.units.parse_rate); radians inside for an angle."""
+        from ..units import is_quantity_text, parse_rate
+        if is_quantity_text(v):
+            u = self.units
+            try:
+                v = parse_rate(v, u.get("angle", "deg"), u.get("time", "s"), order=order,
+                               length_unit=u.get("length", ""), angular=angular, where=where)
+            except ValueError as e:
+                self.err(str(e))
+                return 0.0
+        return self.value(where, v, angular)
 
     def affordable(self, where: str, steps: int) -> bool:
         """Whether a sweep of `steps` poses fits in memory (refused up front, before any array

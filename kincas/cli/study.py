@@ -141,9 +141,28 @@ def cli_run(args) -> int:
         write(r, args.out)
     if args.plot:
         from ..views.mapplot import plot_map
-        plot_map(r, args.plot, title=st.title)
+        plot_map(r, args.plot, title=st.title, units=_map_units(sc, r))
     _summary(st.title, r, args.out, args.plot)
     return 0 if all(s == "ok" for s in r.status) else 3
+
+
+def _map_units(sc, r) -> dict:
+    """The unit of each varied parameter and report expression, for the map's axes and colour
+    bars (kincas.synthesis.dimensions; left out where it cannot be decided)."""
+    from ..errors import ModelError
+    from ..synthesis.dimensions import expression_unit
+    from ..synthesis.expressions import parse
+    from .common import _param_unit, _unit
+    params = sc.mechanism.param_values
+    label = lambda n: (sc.study.units.get("angle", "deg") if n == "__angle__" else  # noqa: E731
+                       _param_unit(sc, n) if n in params else _unit(sc, n))
+    out = {p: _param_unit(sc, p) for p in r.names}
+    for text in r.report:
+        try:
+            out[text] = expression_unit(parse(text, "report"), label)
+        except ModelError:
+            out[text] = None
+    return out
 
 
 def _check_size(sc, kw, workers) -> None:

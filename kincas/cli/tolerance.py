@@ -20,7 +20,8 @@ def cli_arguments(parser) -> None:
     """Arguments of `kincas tolerance`."""
     parser.add_argument("scene", help="the scene file (TOML) with a [tolerance] section")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--samples", type=int, help="Monte-Carlo samples (overrides the scene)")
+    parser.add_argument("--draws", type=int, help="Monte-Carlo draws (overrides the scene's [tolerance] samples)")
+    parser.add_argument("--samples", type=int, help="old name of --draws (deprecated)")
     parser.add_argument("--seed", type=int, help="random seed (overrides the scene)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
@@ -29,11 +30,13 @@ def cli_run(args) -> int:
     """Run `kincas tolerance`: 0 when every pose and sample was solved, 3 otherwise."""
     sc = load(args.scene)
     kw = read_section(sc)
-    for k in ("samples", "seed"):
-        if getattr(args, k) is not None:
-            kw[k] = getattr(args, k)
+    flag, n = draws_option(args)
+    if flag is not None:
+        kw["samples"] = n
+    if args.seed is not None:
+        kw["seed"] = args.seed
     if kw["samples"] < 2:
-        raise SceneError(f"--samples: expected a whole number >= 2, got {kw['samples']}")
+        raise SceneError(f"{flag or '[tolerance] samples'}: expected a whole number >= 2, got {kw['samples']}")
     st = sc.study
     sc.refuse_jerks(sc.quantities, "[tolerance]")
     kw["draws"] = kw.pop("samples")  # the scene's `[tolerance] samples`: analyse's draws
@@ -45,7 +48,7 @@ def cli_run(args) -> int:
     fo = {n: snap(user(n, r.first_order[n]), 0.0) for n in r.names}
     mc = {n: snap(user(n, r.monte_carlo[n]), 0.0) for n in r.names}
     if args.json:
-        doc = {"title": st.title, "units": st.units, "samples": r.samples, "seed": r.seed,
+        doc = {"title": st.title, "units": st.units, "samples": r.draws, "seed": r.seed,
                "std": r.std, "inputs": {k: _list(v) for k, v in inputs.items()},
                "status": [str(s) for s in r.status], "failed": r.failed.tolist(),
                "nominal": {n: _list(user(n, r.nominal[n])) for n in r.names},
@@ -61,9 +64,24 @@ def cli_run(args) -> int:
     return 3 if unsolved else 0
 
 
+def draws_option(args, note: bool = True):
+    """(the option given, its value) for the count of Monte-Carlo draws: `--draws`, or its
+    old name `--samples` (with a note on stderr that it goes in the next release); (None,
+    None) where neither was given. Both given: SceneError."""
+    draws, samples = getattr(args, "draws", None), getattr(args, "samples", None)
+    if draws is not None and samples is not None:
+        raise SceneError("--draws, --samples: give one (--samples is the old name of --draws)")
+    if samples is not None and note:
+        print("kincas: --samples is deprecated: use --draws (the old option goes in the next release)",
+              file=sys.stderr)
+    if samples is not None:
+        return "--samples", samples
+    return ("--draws", draws) if draws is not None else (None, None)
+
+
 def _print(sc, r: ToleranceAnalysis, inputs, fo, mc, unit):
     stds = ", ".join(f"{p} {s:g}" for p, s in r.std.items())
-    print(f"{sc.study.title or 'kincas'}: tolerance analysis, {r.samples} samples (seed {r.seed})")
+    print(f"{sc.study.title or 'kincas'}: tolerance analysis, {r.draws} samples (seed {r.seed})")
     print(f"standard deviations: {stds}")
     print("first-order std (exact sensitivities) and Monte-Carlo std, per pose:")
     cols = [(k, v, unit(k)) for k, v in inputs.items()]

@@ -47,6 +47,20 @@ STEP_SLACK = 1e-9  # a position located at s in [-STEP_SLACK, 1 + STEP_SLACK] of
 MIN_ARC_STEP = 1e-12  # following a branch gives up when its step (scaled) halves below this
 WATCH = 0.5  # a group conditioned below this at either end of a step is checked for a crossing
 
+# --- continuation (kincas/analysis/path.py: every walk along a path of poses) ---
+# A corrected pose farther than WANDER_SHARE of the predicted move (or WANDER_FLOOR, scaled)
+# from its prediction went elsewhere on the branch: the step is cut
+WANDER_FLOOR, WANDER_SHARE = 0.02, 0.5
+ILL = 1e2  # g_q's condition number (scaled, per sqrt of its rows) above which a step is predicted by the secant
+SLOW = 8  # Newton iterations a step that is not the shortest may take (more: cut it)
+CAREFUL_DEPTH = 8  # halvings of one step of a sweep's careful path
+CARRY_DEPTH, CARRY_BUDGET = 10, 200  # halvings of, and solves spent on, one input step of a gap
+CARRY_ITER = 12  # Newton iterations per group while carrying groups through a gap
+# the range of an input, in arclength (scaled unknowns): first step, longest, growth on success
+ARC_FIRST, ARC_LONGEST, ARC_GROW = 0.02, 0.2, 1.5
+ARC_ITER = 12  # corrector iterations per arclength step
+ARC_WANDER = 0.5  # an arclength corrector landing farther than this from its prediction: rejected
+
 # --- the compiled kernel (kincas/core/kernel.py) ---
 JAC_CHANGE = 0.9  # per group, sum |entries of D^-1 (A_prev^-1 A - I) D| (below 1 keeps det's sign)
 CORRECTION = 0.25  # max per group of ||D^-1 (q - q_pred)||_1: Newton may not wander far from the prediction

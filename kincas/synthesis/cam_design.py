@@ -24,7 +24,7 @@ motion law (tests/test_cam_design.py).
 
 >>> d = design_cam([Segment("rise", 90, 20, "cycloidal"), Segment("dwell", 90),
 ...                 Segment("return", 90, 20, "polynomial345"), Segment("dwell", 90)],
-...                base_radius=40, roller_radius=10, samples=360)
+...                base_radius=40, roller_radius=10, points=360)
 >>> round(float(d.s.max()), 12), round(float(d.pressure.max()), 4)
 (20.0, 0.4055)
 """
@@ -34,6 +34,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from .._deprecated import keyword
 
 TURN = 2 * math.pi
 LAWS = ("cycloidal", "harmonic", "polynomial345")
@@ -180,16 +182,20 @@ def motion(segments, theta, jerk: bool = False):
 
 
 def design_cam(segments, base_radius: float, roller_radius: float = 0.0, offset: float = 0.0,
-               samples: int = 3600) -> CamDesign:
-    """The cam for a translating follower moving by `segments` (see the module's text).
+               points: int = 3600, *, samples: int | None = None) -> CamDesign:
+    """The cam for a translating follower moving by `segments` (see the module's text), its
+    profile computed at `points` equally spaced cam angles (the scene's `[cam_design]
+    samples`; `samples=` is 0.1's name of `points`, kept one release with a
+    DeprecationWarning).
 
     Raises ValueError naming the `[cam_design]` field when the data are wrong.
     """
+    points = keyword("design_cam", "samples", "points", samples, points, 3600)
     segments = list(segments)
-    bad = problems(segments, base_radius, roller_radius, offset, samples)
+    bad = problems(segments, base_radius, roller_radius, offset, points)
     if bad:
         raise ValueError("\n".join(bad))
-    theta = np.arange(samples) * (TURN / samples)
+    theta = np.arange(points) * (TURN / points)
     s, ds, dds, ddds = motion(segments, theta, jerk=True)
     e, rho = offset, roller_radius
     s0 = math.sqrt((base_radius + rho) ** 2 - e * e)

@@ -96,6 +96,31 @@ def expression_unit(e: Expr, label_of) -> str | None:
     return "" if u == _FREE else format_unit(u)
 
 
+def term_unit(e: Expr, name: str, label_of) -> str | None:
+    """The unit of bare name `name` where it is a term of the expression's outer sum
+    (`hypot(shaking.x, shaking.y) - peak`: peak has the unit of the force), read as the unit
+    of the rest; None where it is not such a term or the rest's unit is undecided.
+
+    >>> from kincas.synthesis.expressions import parse
+    >>> labels = {"shaking.x": "N", "shaking.y": "N"}.get
+    >>> term_unit(parse("hypot(shaking.x, shaking.y) - peak", "c"), "peak", labels)
+    'N'
+    >>> term_unit(parse("2 * peak - shaking.x", "c"), "peak", labels) is None
+    True
+    """
+    def terms(node):
+        if isinstance(node, ast.BinOp) and isinstance(node.op, (ast.Add, ast.Sub)):
+            return terms(node.left) + terms(node.right)
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
+            return terms(node.operand)
+        return [node]
+    if not any(isinstance(t, ast.Name) and t.id == name for t in terms(e.tree)):
+        return None
+    free = Expr(e.text, e.tree, e.where, e.quantities, e.names, [*e.data, name], e.extremes)
+    u = _unit(e.tree, free, label_of)
+    return None if u is None or u == _FREE else format_unit(u)
+
+
 def _combine(a, b, sign):
     if a is None or b is None:
         return None

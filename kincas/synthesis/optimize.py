@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.mechanism import Mechanism
-from .._deprecated import keyword, renamed
+from .._deprecated import attribute, keyword, renamed
 from ..result_base import Result
 from ..errors import ModelError
 from ..results import Sweep
@@ -82,7 +82,7 @@ class Optimization:
     parameters: dict[str, float]
     varied: dict[str, float]
     mechanism: Mechanism
-    samples: dict[str, np.ndarray]
+    inputs: dict[str, np.ndarray]  # the input values posed (0.1: `samples`)
     q: np.ndarray
     values: dict[str, np.ndarray]
     constraints: list[dict]
@@ -91,6 +91,8 @@ class Optimization:
     problems: list[str] = field(default_factory=list)
     sweep: Sweep | None = None
     info: dict = field(default_factory=dict)
+
+    samples = attribute("Optimization", "samples", "inputs")
 
     def __repr__(self) -> str:
         return f"<Optimization: {self.summary()}>"

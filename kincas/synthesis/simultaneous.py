@@ -222,7 +222,7 @@ class Problem(Checks, SampledNLP):
         return dict(
             ok=ok, converged=success, status=status, message=msg, objective=float(fval[0]),
             initial_objective=f0, parameters=mech.param_values, varied=varied, mechanism=mech,
-            samples={k: self.U[:, j].copy() for j, k in enumerate(self.keys)}, q=Q,
+            inputs={k: self.U[:, j].copy() for j, k in enumerate(self.keys)}, q=Q,
             values=values, constraints=cons, extremes=extremes,
             iterations=int(stats.get("iter_count", 0)), problems=problems, sweep=sw)
 

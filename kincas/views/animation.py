@@ -11,12 +11,13 @@ from ..results import Sweep
 
 def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, fps: int = 20,
             captions=None, units: str = "", dpi: int = 80, size=(6.4, 4.8), progress=None,
-            path_xy=None, view: str | None = None) -> int:
+            path_xy=None, view: str | None = None, forces: bool = False, centres: bool = False) -> int:
     """Write an animated GIF of the sweep's solved poses (at most `frames` of them, evenly
     spread); returns the number of frames written. `captions[i]` titles pose i;
     `progress(done, total)` is called after each frame (a progress bar, say); `path_xy`: the
     paths already solved (point -> M x 2, `kincas.views.plot.smooth_paths`), else solved here;
-    `view`: a spatial mechanism's ("iso", the default, "xy", "yz", "zx").
+    `view`: a spatial mechanism's ("iso", the default, "xy", "yz", "zx");
+    `forces`, `centres`: arrows and instant centres on every frame (kincas/views/forces.py), planar only.
 
     >>> import os, tempfile, numpy as np, kincas
     >>> m = kincas.Mechanism(ground={"O": (0, 0)},
@@ -36,7 +37,10 @@ def animate(m: Mechanism, sweep: Sweep, path, *, paths=None, frames: int = 120, 
     fig = new_figure(size)
     chosen = check_paths(m, paths)
     smooth = smooth_paths(m, sweep, chosen) if path_xy is None else {p: path_xy[p] for p in chosen}
-    d = Drawing(fig.subplots(), m, drawn(m, sweep, view), chosen, True, units, smooth)
+    from .forces import planar_overlay
+    geo = drawn(m, sweep, view)
+    d = Drawing(fig.subplots(), m, geo, chosen, True, units, smooth,
+                planar_overlay(m, sweep, geo, forces, centres, extent=None))
     cap = captions if captions is not None else [caption(sweep, i) for i in range(len(sweep))]
     d.update(int(pick[0]), cap[pick[0]])
     fig.canvas.draw()  # lay the figure out once; every frame keeps that layout

@@ -18,21 +18,23 @@ from ..units import unit_label
 
 def quantity_unit(sc, name: str) -> str:
     """The unit of quantity `name` in the scene's units (kincas/units.py)."""
-    return unit_label(sc.study.units, sc.mechanism, name, _force_unit)
+    force = sc.study.units.get("force") or "force"
+    return unit_label(sc.study.units, sc.mechanism, name, lambda n, L: _force_unit(n, L, force))
 
 
-def _force_unit(name: str, L: str) -> str | None:
-    """Units of force quantities and curvature (None for others). The scene names no mass
-    unit, so a force is written `force` (N with masses in kg and SI lengths, or in t and mm)."""
+def _force_unit(name: str, L: str, force: str = "force") -> str | None:
+    """Units of force quantities and curvature (None for others). A force is written with the
+    scene's `units.force` label ("N"), else the word `force` (N with masses in kg and SI
+    lengths, or in t and mm); a torque is force·length."""
     from ..core.dynamics import _EFFORT
     m = _EFFORT.match(name)
     if m:
         angular = m["key"].endswith(".angle")
-        return f"force·{L}" if angular and L else "force"
+        return f"{force}·{L}" if angular and L else force
     if name.startswith("reaction(") or name in ("shaking.x", "shaking.y"):
-        return "force"
+        return force
     if name == "shaking.moment":
-        return f"force·{L}" if L else "force"
+        return f"{force}·{L}" if L else force
     if name.endswith(".curvature"):
         return f"1/{L}" if L else ""
     return None

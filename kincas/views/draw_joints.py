@@ -140,6 +140,15 @@ def curves(m, geo, i: int, unit: float, fine: int = 121) -> list[tuple[str, str,
     return out
 
 
+def as_circle(label: str, a: np.ndarray):
+    """(cx, cy, radius) of a curve that is a circle (a pitch circle, a roller), else None:
+    the formats that can draw a true circle draw it round, not as a polygon."""
+    if not (label.endswith("pitch circle") or label.endswith("roller")) or not np.isfinite(a).all():
+        return None
+    c = a[:-1].mean(axis=0)  # the points are evenly spread, the last repeating the first
+    return np.array([c[0], c[1], float(np.hypot(*(a[0] - c)))])
+
+
 _STYLE = {"pitch circle": ("-.", 1.0, 3.2), "mark": ("-", 1.2, 3.2), "pitch line": ("-", 1.4, 3.3),
           "teeth": ("-", 0.8, 3.3), "profile": ("-", 1.6, 3.4), "contact": ("o", 0, 6.5),
           "roller": ("-", 1.2, 5.5), "face": ("-", 3.0, 5.5)}

@@ -45,11 +45,14 @@ def _require():
 
 
 def dxf_document(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None,
-                 dense: int = 0, units: str = ""):
-    """An ezdxf document of the drawing at `pose` (default: the first solved) with the paths."""
+                 dense: int = 0, units: str = "", forces: bool = False, centres: bool = False,
+                 labels: bool = True):
+    """An ezdxf document of the drawing at `pose` (default: the first solved) with the paths;
+    `forces`, `centres`: arrows and instant centres (layers `forces`, `centres`); `labels`:
+    each point's name as a TEXT on layer `labels`."""
     ezdxf = _require()
     from ezdxf import colors
-    pic = picture(m, sweep, paths, dense, world=True)
+    pic = picture(m, sweep, paths, dense, world=True, forces=forces, centres=centres)
     i = pic.first if pose is None else int(pose) % max(len(sweep), 1)
     xy = pic.xy[i]
     space = xy.shape[-1] == 3  # a spatial mechanism: 3D polylines
@@ -94,11 +97,17 @@ def dxf_document(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=N
     curves = pic.joint_curves(i)  # gears, racks, cams (views/draw_joints.py): layer "joints"
     if curves:
         doc.layers.add("joints")
+    from .draw_joints import as_circle
     for label, body, a in curves:
         if len(a) == 1 and np.isfinite(a).all():
             msp.add_circle(tuple(a[0]), 0.5 * pic.r, dxfattribs={"layer": "joints"})
+        circle = as_circle(label, a)
+        if circle is not None:  # a pitch circle, a roller: a true CIRCLE
+            msp.add_circle(tuple(circle[:2]), float(circle[2]), dxfattribs={"layer": "joints"})
+            continue
         for run in _runs(a):
             msp.add_lwpolyline([tuple(q) for q in run], dxfattribs={"layer": "joints"})
+    _extras(doc, msp, pic, i, labels)
     return doc
 
 
@@ -118,6 +127,53 @@ def _across(d: np.ndarray) -> np.ndarray:
     e = np.eye(3)[int(np.argmin(np.abs(d)))]
     n = e - (e @ d) * d
     return n / np.linalg.norm(n)
+
+
+def _extras(doc, msp, pic, i: int, labels: bool) -> None:
+    """Springs (layer `springs`), force arrows and instant centres, and the points' names. In
+    space (a spatial mechanism's world positions) springs are straight and each name stands at
+    its point: the zigzags, the overlay and the placement of names are planar."""
+    r = pic.r
+    xy = pic.xy[i]
+    if xy.shape[-1] == 3:
+        ends = [(xy[a], xy[b]) for _, a, b in pic.springs if np.isfinite(xy[[a, b]]).all()]
+        if ends:
+            doc.layers.add("springs")
+        for pa, pb in ends:
+            _polyline(msp, [pa, pb], True, False, {"layer": "springs"})
+        if labels:
+            doc.layers.add("labels")
+            for k, name in enumerate(pic.names):
+                if np.isfinite(xy[k]).all():
+                    msp.add_text(name, height=2.2 * r, dxfattribs={"layer": "labels",
+                                                                  "insert": tuple(map(float, xy[k]))})
+        return
+    springs = pic.spring_lines(i)
+    if springs:
+        doc.layers.add("springs")
+    for _, zz in springs:
+        msp.add_lwpolyline([tuple(q) for q in zz], dxfattribs={"layer": "springs"})
+    ov = pic.overlay
+    if ov is not None:
+        doc.layers.add("forces"), doc.layers.add("centres")
+        for label, kind, line, head in ov.segments(i, r):
+            msp.add_lwpolyline([tuple(q) for q in line], dxfattribs={"layer": "forces"})
+            msp.add_lwpolyline([tuple(q) for q in head], close=True, dxfattribs={"layer": "forces"})
+            msp.add_text(label, height=1.2 * r, dxfattribs={"layer": "forces", "insert": tuple(line[0])})
+        for label, xy in ov.centres:
+            p = xy[i]
+            if np.isfinite(p).all():
+                msp.add_line(tuple(p - r), tuple(p + r), dxfattribs={"layer": "centres"})
+                msp.add_line((p[0] - r, p[1] + r), (p[0] + r, p[1] - r), dxfattribs={"layer": "centres"})
+                msp.add_text(f"I {label}", height=1.2 * r,
+                             dxfattribs={"layer": "centres", "insert": (p[0] + 1.2 * r, p[1] + 1.2 * r)})
+    if labels:
+        doc.layers.add("labels")
+        from .labels import label_offsets
+        for name, p, off in label_offsets(pic, i):
+            msp.add_text(name, height=2.2 * r, dxfattribs={"layer": "labels", "insert": tuple(p + off),
+                                                          "halign": 1, "valign": 2,
+                                                          "align_point": tuple(p + off)})
 
 
 def write_dxf(path, m: Mechanism, sweep: Sweep, pose: int | None = None, **kw) -> None:

@@ -5,8 +5,11 @@ a cursor that follows the slider.
 
 The page opens at pose 0, or at `#pose=I`. It keeps in its DOM what a test (or a curious
 user) may read: `<body data-pose=I data-transform="sx ox oy">` (a world point (x, y) is drawn
-at canvas pixel (ox + sx x, oy - sx y)) and `<pre id="errors">` collecting any JavaScript
-error, which also goes into the title.
+at the page's pixel (ox + sx x, oy - sx y)) and `<pre id="errors">` collecting any JavaScript
+error, which also goes into the title. The page fills the window (the drawing on the left,
+the plots with their axes, ticks and units on the right, both sized again when the window
+is), follows changes of `#pose=I`, plays at a chosen speed, and with `--forces`,
+`--centres` draws the force arrows and instant centres (views/forces.py).
 
 >>> import numpy as np, kincas
 >>> m = kincas.Mechanism(ground={"O": (0, 0)},
@@ -21,37 +24,26 @@ True
 from __future__ import annotations
 
 import json
-import math
 
 import numpy as np
 
 from ..model.mechanism import Mechanism
 from ..results import Sweep
-from .picture import INK, picture
+from .page_parts import _arr, _centres, _forces, _joints, _labels, _wrap
+from .picture import INK, picture  # noqa: F401
 
 MAX_FRAMES = 2000  # poses kept in the page (evenly spread) so that it stays small
 WIDTH, HEIGHT = 640, 480  # the mechanism's canvas, CSS pixels
 
 
-def _num(v, digits=9):
-    """A JSON number (None for NaN), to `digits` significant digits."""
-    v = float(v)
-    return None if not math.isfinite(v) else float(f"{v:.{digits}g}")
-
-
-def _arr(a, digits=9):
-    a = np.asarray(a, float)
-    if a.ndim == 0:
-        return _num(a, digits)
-    return [_arr(x, digits) for x in a]
-
-
 def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0,
-              view: str | None = None) -> dict:
-    """Everything the page draws, as JSON-ready lists (scene units when a scene is given); a
-    spatial mechanism's in space, with the `camera` the page opens with (`html3d.camera`)."""
-    from .columns import heading, user_columns, _abscissa
-    pic = picture(m, sweep, paths, dense, view, world=True)
+              view: str | None = None, *, forces: bool = False, centres: bool = False) -> dict:
+    """Everything the page draws, as JSON-ready lists (scene units when a scene is given);
+    `forces`, `centres`: arrows and instant centres per pose (views/forces.py, planar only);
+    a spatial mechanism's in space, with the `camera` the page opens with (`html3d.camera`)."""
+    from .columns import heading, quantity_unit, user_columns, _abscissa, _units_of
+    pic = picture(m, sweep, paths, dense, view, world=True, forces=forces, centres=centres)
+    spatial = pic.xy.shape[-1] == 3
     n = len(sweep)
     keep = np.unique(np.round(np.linspace(0, n - 1, min(n, MAX_FRAMES))).astype(int)) if n else np.zeros(0, int)
     inputs, values = user_columns(sweep, scene)
@@ -59,10 +51,15 @@ def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0
     xkey, x = _abscissa(sweep, inputs)
     units = scene.study.units.get("length", "") if scene is not None else ""
     box = pic.box()
-    caption = [", ".join(f"{k} = {float(v[i]):.6g}" for k, v in inputs.items())
+    unit = lambda k: quantity_unit(_units_of(scene), k)  # noqa: E731
+    shown = lambda k, v: f"{k} = {v:.6g}" + ("°" if unit(k) == "deg" else f" {unit(k)}" if unit(k) else "")  # noqa: E731
+    caption = [", ".join(shown(k, float(v[i])) for k, v in inputs.items())
                + ("" if sweep.status[i] == "ok" else f" ({sweep.status[i]})") for i in keep]
     out = {
         "title": (getattr(getattr(scene, "study", None), "title", "") or "kincas"),
+        "springs": [{"label": label, "a": a, "b": b} for label, a, b in pic.springs],
+        "forces": _forces(pic, keep), "centres": _centres(pic, keep),
+        "labels": [] if spatial else _labels(pic, keep),  # names in free space: planar pictures
         "units": units, "names": pic.names, "ground": pic.ground, "r": pic.r,
         "box": _arr(box), "ok": [bool(v) for v in sweep.ok[keep]],
         "xy": _arr(pic.xy[keep]), "caption": caption, "poses": [int(i) for i in keep],
@@ -73,29 +70,22 @@ def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0
                     "direction": _arr(g.direction[keep])} for g in pic.guides],
         "paths": {p: _arr(v) for p, v in pic.paths.items()},
         "joints": _joints(pic, keep),
-        "x": {"name": heading(xkey, scene) if xkey else "pose", "values": _arr(x[keep])},
-        "quantities": [{"name": heading(k, scene), "values": _arr(np.asarray(v)[keep])}
+        "x": {"name": xkey or "pose", "unit": unit(xkey) if xkey else "", "values": _arr(x[keep])},
+        "quantities": [{"name": k, "unit": unit(k), "heading": heading(k, scene),
+                        "values": _arr(np.asarray(v, float)[keep]), "wrap": _wrap(k, unit(k))}
                        for k, v in values.items()],
     }
-    if pic.xy.shape[-1] == 3:
+    if spatial:
         from .html3d import camera
         from .projection import check_view
         out.update(camera(check_view(view, True)))
     return out
 
 
-def _joints(pic, keep) -> list:
-    """Per kept pose, the gears', racks' and cams' polylines (views/draw_joints.py), coarser
-    than in the other pictures so that the page stays small: [{colour, pts}]."""
-    colours = {b.name: b.colour for b in pic.bodies}
-    return [[{"colour": "#c0392b" if len(a) == 1 else colours.get(body, INK), "pts": _arr(a, 7)}
-             for _, body, a in pic.joint_curves(int(i), 41)] for i in keep]
-
-
 def html_page(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0,
-              view: str | None = None) -> str:
+              view: str | None = None, *, forces: bool = False, centres: bool = False) -> str:
     """The page as text (a spatial mechanism's turns with the mouse, opening in `view`)."""
-    data = page_data(m, sweep, scene, paths, dense, view)
+    data = page_data(m, sweep, scene, paths, dense, view, forces=forces, centres=centres)
     page = _PAGE
     if "camera" in data:  # a spatial mechanism: the view that turns (views/html3d.py)
         from .html3d import MECHANISM_3D
@@ -107,30 +97,44 @@ def html_page(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0
 
 
 def write_html(path, m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0,
-               view: str | None = None) -> None:
-    """Write the page to `path`."""
+               view: str | None = None, **kw) -> None:
+    """Write the page to `path` (`kw`: forces, centres)."""
     from .atomic import open_replacing
     with open_replacing(path, "w", encoding="utf-8") as f:
-        f.write(html_page(m, sweep, scene, paths, dense, view))
+        f.write(html_page(m, sweep, scene, paths, dense, view, **kw))
 
 
 _HEAD = r"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>kincas</title>
+<html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
+<title>kincas</title>
 <style>
-body { font: 13px sans-serif; margin: 0; color: #222; }
-#mech { position: absolute; left: 0; top: 0; border-bottom: 1px solid #ddd; }
-#controls { position: absolute; left: 0; top: @H@px; width: @W@px; padding: 6px 8px; box-sizing: border-box; }
-#controls input[type=range] { width: 420px; vertical-align: middle; }
+html, body { height: 100%; }
+body { font: 13px sans-serif; margin: 0; color: #222; display: flex; flex-direction: column; overflow: hidden; }
+#head { padding: 4px 10px; border-bottom: 1px solid #ddd; }
+#head h1 { font-size: 16px; margin: 0; display: inline; }
+#head .units { color: #666; margin-left: 10px; }
+#main { flex: 1; display: flex; min-height: 0; }
+#left { display: flex; flex-direction: column; flex: 3 1 0; min-width: 0; }
+#stage { flex: 1; min-height: 0; position: relative; }
+#mech { position: absolute; left: 0; top: 0; }
+#controls { padding: 6px 8px; border-top: 1px solid #ddd; }
+#controls input[type=range] { width: 50%; vertical-align: middle; }
 #caption { margin-top: 4px; }
-#plots { position: absolute; left: @W@px; top: 0; }
-#errors { position: absolute; left: 0; top: 560px; color: #b00; white-space: pre-wrap; }
+#right { flex: 2 1 0; min-width: 0; overflow-y: auto; border-left: 1px solid #ddd; }
+#errors { color: #b00; white-space: pre-wrap; margin: 0; }
 </style></head>
 <body data-pose="-1">
-<canvas id="mech" width="@W@" height="@H@"></canvas>
+<div id="head"><h1 id="title"></h1><span class="units" id="units"></span></div>
+<div id="main">
+<div id="left"><div id="stage"><canvas id="mech" width="@W@" height="@H@"></canvas></div>
 <div id="controls"><button id="play">play</button>
 <input id="slider" type="range" min="0" max="0" value="0" step="1">
-<span id="pose"></span><div id="caption"></div></div>
-<canvas id="plots" width="420" height="@H@"></canvas>
+<span id="pose"></span>
+<label>speed <select id="speed"><option value="0.25">0.25x</option><option value="0.5">0.5x</option>
+<option value="1" selected>1x</option><option value="2">2x</option><option value="4">4x</option></select></label>
+<div id="caption"></div></div></div>
+<div id="right"><canvas id="plots" width="420" height="@H@"></canvas></div>
+</div>
 <pre id="errors"></pre>
 <script>
 "use strict";
@@ -142,18 +146,32 @@ const D = @DATA@;
 const mech = document.getElementById("mech"), ctx = mech.getContext("2d");
 const plots = document.getElementById("plots"), pctx = plots.getContext("2d");
 const slider = document.getElementById("slider"), play = document.getElementById("play");
+const speed = document.getElementById("speed"), stage = document.getElementById("stage");
 const N = D.xy.length;
 slider.max = Math.max(N - 1, 0);
 document.title = D.title;
+document.getElementById("title").textContent = D.title;
+document.getElementById("units").textContent =
+  (D.units ? "lengths in " + D.units : "") + (D.x.unit ? (D.units ? ", " : "") + D.x.name + " in " + D.x.unit : "");
 """
-_MECHANISM = r"""// world -> canvas: equal scales, the whole sweep in view
-const W = mech.width, H = mech.height, bx = D.box;
-const sx = Math.min(W / (bx[1][0] - bx[0][0]), H / (bx[1][1] - bx[0][1]));
-const ox = W / 2 - sx * (bx[0][0] + bx[1][0]) / 2, oy = H / 2 + sx * (bx[0][1] + bx[1][1]) / 2;
-document.body.dataset.transform = sx + " " + ox + " " + oy;
+# a planar mechanism's drawing; a spatial one's is views/html3d.MECHANISM_3D (it defines the same
+# layout(), drawMechanism(i), W, H and R, which _TAIL uses)
+_MECHANISM = r"""// world -> canvas: equal scales, the whole sweep in view; set again when the window changes
+const bx = D.box;
+let W = mech.width, H = mech.height, sx = 1, ox = 0, oy = 0, R = 1;
+function layout() {
+  W = mech.width = Math.max(200, stage.clientWidth);
+  H = mech.height = Math.max(150, stage.clientHeight);
+  sx = Math.min(W / (bx[1][0] - bx[0][0]), H / (bx[1][1] - bx[0][1]));
+  ox = W / 2 - sx * (bx[0][0] + bx[1][0]) / 2; oy = H / 2 + sx * (bx[0][1] + bx[1][1]) / 2;
+  const at = mech.getBoundingClientRect();  // published in the page's pixels
+  document.body.dataset.transform = sx + " " + (ox + at.left + window.scrollX) + " " + (oy + at.top + window.scrollY);
+  R = D.r * sx;
+  document.body.dataset.window = window.innerWidth + "x" + window.innerHeight;
+  plots.width = Math.max(260, document.getElementById("right").clientWidth - 4);
+}
 const X = p => ox + sx * p[0], Y = p => oy - sx * p[1];
 const fin = p => p !== null && p[0] !== null && p[1] !== null;
-const R = D.r * sx;
 
 function line(pts, colour, width, dash) {
   ctx.beginPath(); ctx.setLineDash(dash || []); ctx.strokeStyle = colour; ctx.lineWidth = width;
@@ -164,6 +182,17 @@ function line(pts, colour, width, dash) {
     pen = true;
   }
   ctx.stroke(); ctx.setLineDash([]);
+}
+function zigzag(a, b) {  // a spring from a to b, as the other pictures draw it
+  const dx = b[0] - a[0], dy = b[1] - a[1], n = Math.hypot(dx, dy);
+  if (!(n > 0)) return [a, b];
+  const ux = dx / n, uy = dy / n, wx = -uy, wy = ux, out = [a, [a[0] + 0.15 * dx, a[1] + 0.15 * dy]];
+  for (let k = 0; k < 12; k++) {
+    const t = 0.15 + 0.7 * (k + 0.5) / 12, s = 0.75 * D.r * (k % 2 ? -1 : 1);
+    out.push([a[0] + t * dx + s * wx, a[1] + t * dy + s * wy]);
+  }
+  out.push([a[0] + 0.85 * dx, a[1] + 0.85 * dy], b);
+  return out;
 }
 
 function drawMechanism(i) {
@@ -193,11 +222,18 @@ function drawMechanism(i) {
       ctx.restore();
     }
   }
-  for (const c of D.joints[i] || []) {  // gears, racks, cams
-    if (c.pts.length === 1) {
+  for (const c of D.joints[i] || []) {  // gears, racks, cams; circles drawn round
+    if (c.circle) {
+      const [cx, cy, r] = c.circle; if (cx === null || cy === null) continue;
+      ctx.beginPath(); ctx.arc(X([cx, cy]), Y([cx, cy]), r * sx, 0, 2 * Math.PI);
+      ctx.strokeStyle = c.colour; ctx.lineWidth = 1.2; ctx.stroke();
+    } else if (c.pts.length === 1) {
       const p = c.pts[0]; if (!fin(p)) continue;
       ctx.beginPath(); ctx.arc(X(p), Y(p), 3, 0, 2 * Math.PI); ctx.fillStyle = c.colour; ctx.fill();
     } else line(c.pts, c.colour, 1.2);
+  }
+  for (const s of D.springs) {
+    if (fin(xy[s.a]) && fin(xy[s.b])) line(zigzag(xy[s.a], xy[s.b]), "#9467bd", 1.2);
   }
   const order = D.bodies.filter(b => !b.driven).concat(D.bodies.filter(b => b.driven));
   for (const b of order) {
@@ -211,79 +247,130 @@ function drawMechanism(i) {
       ctx.lineCap = "round"; line(pts, b.colour, 7); ctx.lineCap = "butt";
     }
   }
-  for (let k = 0; k < D.names.length; k++) {  // joints and points, with their names
+  for (const f of D.forces[i] || []) {  // arrows: loads, springs, efforts, reactions
+    line(f.pts, f.colour, 1.8);
+    ctx.beginPath(); f.head.forEach((p, j) => j ? ctx.lineTo(X(p), Y(p)) : ctx.moveTo(X(p), Y(p)));
+    ctx.closePath(); ctx.fillStyle = f.colour; ctx.fill();
+  }
+  for (const c of D.centres[i] || []) {  // instant centres: a cross and the link's name
+    const x = X(c.p), y = Y(c.p);
+    ctx.beginPath(); ctx.moveTo(x - 5, y - 5); ctx.lineTo(x + 5, y + 5); ctx.moveTo(x - 5, y + 5); ctx.lineTo(x + 5, y - 5);
+    ctx.strokeStyle = "#111"; ctx.lineWidth = 2; ctx.stroke();
+    ctx.fillStyle = "#111"; ctx.font = "10px sans-serif"; ctx.fillText("I " + c.label, x + 6, y + 12);
+  }
+  ctx.textAlign = "center"; ctx.textBaseline = "middle";
+  for (let k = 0; k < D.names.length; k++) {  // joints and points, with their names in free space
     const p = xy[k]; if (!fin(p)) continue;
     ctx.beginPath(); ctx.arc(X(p), Y(p), 4, 0, 2 * Math.PI);
     ctx.fillStyle = "white"; ctx.fill(); ctx.strokeStyle = "@INK@"; ctx.lineWidth = 1.3; ctx.stroke();
-    ctx.fillStyle = "@INK@"; ctx.font = "11px sans-serif"; ctx.fillText(D.names[k], X(p) + 7, Y(p) - 7);
+    const off = (D.labels[i] || [])[k];
+    const at = fin(off) ? [p[0] + off[0], p[1] + off[1]] : [p[0] + 2 * D.r, p[1] + 2 * D.r];
+    ctx.fillStyle = "@INK@"; ctx.font = "11px sans-serif"; ctx.fillText(D.names[k], X(at), Y(at));
   }
+  ctx.textAlign = "start"; ctx.textBaseline = "alphabetic";
 }
 
 """
 # the quantities against the input, the slider and play button: both pages (views/html3d.py)
-_TAIL = r"""// the quantities against the input, one panel each, a cursor at the slider's pose
-const QH = Math.max(60, Math.min(120, Math.floor((plots.height - 20) / Math.max(D.quantities.length, 1))));
-plots.height = Math.max(plots.height, 20 + QH * D.quantities.length);
+_TAIL = r"""// the quantities against the input, one panel each with its axes, a cursor at the slider's pose
 function extent(v) {
   let lo = Infinity, hi = -Infinity;
   for (const a of v) if (a !== null) { lo = Math.min(lo, a); hi = Math.max(hi, a); }
   if (!isFinite(lo)) return [0, 1];
-  if (hi - lo <= 1e-12 * Math.max(Math.abs(lo), Math.abs(hi), 1e-300)) { const c = lo; lo = c - 1; hi = c + 1; }
+  if (hi - lo <= 1e-9 * Math.max(Math.abs(lo), Math.abs(hi), 1e-300)) {
+    const c = lo, pad = c !== 0 ? 0.05 * Math.abs(c) : 1; lo = c - pad; hi = c + pad;
+  }
   return [lo, hi];
 }
+function ticks(lo, hi, most) {  // round values 1, 2 or 5 x 10^k apart, at most `most`
+  const raw = (hi - lo) / Math.max(most, 1), mag = Math.pow(10, Math.floor(Math.log10(raw)));
+  const step = [1, 2, 5, 10].map(k => k * mag).find(s => s >= raw) || raw;
+  const out = [];
+  for (let t = Math.ceil(lo / step) * step; t <= hi + 1e-9 * step; t += step) out.push(Math.abs(t) < 1e-12 * step ? 0 : t);
+  return out;
+}
+const fmt = v => Number(v.toPrecision(6)).toString();
+const QH = 130, TOP = 8, LEFT = 62;
 function drawPlots(i) {
+  const need = TOP + QH * D.quantities.length + 40;
+  if (plots.height !== need) plots.height = need;
   pctx.fillStyle = "white"; pctx.fillRect(0, 0, plots.width, plots.height);
   const xs = D.x.values, [x0, x1] = extent(xs);
-  const L = 10, Rr = plots.width - 10;
+  const L = LEFT, Rr = plots.width - 12;
   const PX = v => L + (Rr - L) * (v - x0) / (x1 - x0);
+  const xt = ticks(x0, x1, Math.max(2, Math.floor((Rr - L) / 70)));
+  pctx.font = "10px sans-serif";
   D.quantities.forEach((q, j) => {
-    const top = 10 + j * QH, bot = top + QH - 22, [y0, y1] = extent(q.values);
+    const top = TOP + j * QH + 16, bot = TOP + (j + 1) * QH - 18, [y0, y1] = extent(q.values);
     const PY = v => bot - (bot - top) * (v - y0) / (y1 - y0);
-    pctx.strokeStyle = "#ddd"; pctx.lineWidth = 1; pctx.strokeRect(L, top, Rr - L, bot - top);
+    pctx.fillStyle = "#222"; pctx.font = "11px sans-serif"; pctx.textAlign = "left";
+    const v = q.values[i];
+    pctx.fillText(q.name + (q.unit ? " [" + q.unit + "]" : "") + " = " + (v === null ? "-" : fmt(v)), L, top - 4);
+    pctx.font = "10px sans-serif";
+    pctx.strokeStyle = "#eee"; pctx.lineWidth = 1; pctx.textAlign = "right"; pctx.textBaseline = "middle";
+    for (const t of ticks(y0, y1, 4)) {  // y ticks with their values, a light grid
+      const y = PY(t); pctx.beginPath(); pctx.moveTo(L, y); pctx.lineTo(Rr, y); pctx.stroke();
+      pctx.fillStyle = "#444"; pctx.fillText(fmt(t), L - 4, y);
+    }
+    pctx.textAlign = "center"; pctx.textBaseline = "top";
+    for (const t of xt) {  // x ticks
+      const x = PX(t); pctx.beginPath(); pctx.moveTo(x, top); pctx.lineTo(x, bot); pctx.stroke();
+      pctx.fillStyle = "#444"; pctx.fillText(fmt(t), x, bot + 2);
+    }
+    pctx.textAlign = "left"; pctx.textBaseline = "alphabetic";
+    pctx.strokeStyle = "#888"; pctx.strokeRect(L, top, Rr - L, bot - top);
     pctx.beginPath(); pctx.strokeStyle = "#1f77b4"; pctx.lineWidth = 1.4;
-    let pen = false;
+    let pen = false, last = null;
     q.values.forEach((v, k) => {
       if (v === null || xs[k] === null) { pen = false; return; }
+      if (pen && q.wrap !== null && Math.abs(v - last) > q.wrap) pen = false;  // an angle wrapping round
       if (pen) pctx.lineTo(PX(xs[k]), PY(v)); else pctx.moveTo(PX(xs[k]), PY(v));
-      pen = true;
+      pen = true; last = v;
     });
     pctx.stroke();
-    pctx.fillStyle = "#222"; pctx.font = "11px sans-serif";
-    const v = q.values[i];
-    pctx.fillText(q.name + " = " + (v === null ? "-" : Number(v.toPrecision(6))), L + 4, bot + 13);
     if (xs[i] !== null) {  // the cursor
       pctx.beginPath(); pctx.strokeStyle = "#d62728"; pctx.lineWidth = 1;
       pctx.moveTo(PX(xs[i]), top); pctx.lineTo(PX(xs[i]), bot); pctx.stroke();
       if (v !== null) { pctx.beginPath(); pctx.arc(PX(xs[i]), PY(v), 3, 0, 2 * Math.PI); pctx.fillStyle = "#d62728"; pctx.fill(); }
     }
   });
-  pctx.fillStyle = "#222"; pctx.fillText("against " + D.x.name, L, plots.height - 4);
+  pctx.fillStyle = "#222"; pctx.font = "11px sans-serif"; pctx.textAlign = "center";
+  pctx.fillText(D.x.name + (D.x.unit ? " [" + D.x.unit + "]" : ""), (L + Rr) / 2, plots.height - 12);
+  pctx.textAlign = "left";
 }
 
+let current = 0;
 function show(i) {
   i = Math.max(0, Math.min(N - 1, i | 0));
-  slider.value = i;
+  current = i; slider.value = i;
   drawMechanism(i); drawPlots(i);
   document.getElementById("pose").textContent = "pose " + D.poses[i] + " of " + (D.poses[N - 1] + 1);
   document.getElementById("caption").textContent = D.caption[i];
   document.body.dataset.pose = D.poses[i];
 }
-let timer = null;
+let timer = null, clock = 0;
+function step(now) {  // about 20 poses a second at 1x
+  if (!timer) return;
+  if (now - clock >= 50 / (+speed.value)) { clock = now; show((current + 1) % N); }
+  timer = requestAnimationFrame(step);
+}
 play.onclick = function () {
-  if (timer) { clearInterval(timer); timer = null; play.textContent = "play"; return; }
-  play.textContent = "pause";
-  timer = setInterval(() => show((+slider.value + 1) % N), 50);
+  if (timer) { cancelAnimationFrame(timer); timer = null; play.textContent = "play"; return; }
+  play.textContent = "pause"; clock = 0; timer = requestAnimationFrame(step);
 };
 slider.oninput = () => show(+slider.value);
-const wanted = /pose=(-?\d+)/.exec(location.hash);
-let start = 0;
-if (wanted) {  // the sweep's pose index; the nearest kept frame
+function fromHash() {  // #pose=I: the sweep's pose index; the nearest kept frame
+  const wanted = /pose=(-?\d+)/.exec(location.hash);
+  if (!wanted) return 0;
   const w = +wanted[1], target = w < 0 ? D.poses[N - 1] + 1 + w : w;
   let best = 0;
   D.poses.forEach((p, k) => { if (Math.abs(p - target) < Math.abs(D.poses[best] - target)) best = k; });
-  start = best;
+  return best;
 }
-if (N) show(start);
+window.addEventListener("hashchange", () => { if (N) show(fromHash()); });
+window.addEventListener("resize", () => { layout(); if (N) show(current); });
+layout();
+if (N) show(fromHash());
 </script></body></html>
 """
 _PAGE = _HEAD + _MECHANISM + _TAIL

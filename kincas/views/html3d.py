@@ -10,7 +10,7 @@ page (no network, no library: it works from file://).
 The projection is orthographic, as in `kincas.views.projection`: the camera's rows are the
 drawing's right and up directions and the direction towards the viewer; bodies are drawn
 farthest first. For a test, the page keeps in its DOM `data-camera` (the rows, JSON) and
-`data-transform="s ox oy"`: a world point p is drawn at canvas pixel
+`data-transform="s ox oy"`: a world point p is drawn at the page's pixel
 (ox + s (right . p), oy - s (up . p)).
 
 >>> c = camera("iso")
@@ -32,7 +32,8 @@ def camera(view: str) -> dict:
 
 # Replaces the planar page's `drawMechanism` (views/html.py: _HEAD + this + _TAIL).
 MECHANISM_3D = r"""// a spatial mechanism, orthographic, turned with the mouse
-const W = mech.width, H = mech.height, bx = D.box;
+const bx = D.box;
+let W = mech.width, H = mech.height;
 const C0 = [0, 1, 2].map(j => (bx[0][j] + bx[1][j]) / 2);
 const fin = p => p !== null && p[0] !== null && p[1] !== null && p[2] !== null;
 // the sphere about the box's centre holding every point and path, with the picture's margin:
@@ -52,8 +53,16 @@ let S = 0, OX = 0, OY = 0, R = 0;  // scale, origin, the picture's unit of size 
 function frame() {  // world -> canvas of the current camera, published for tests
   S = zoom * 0.5 * Math.min(W, H) / RAD; R = D.r * S;
   OX = W / 2 + panX - S * dot(cam[0], C0); OY = H / 2 + panY + S * dot(cam[1], C0);
-  document.body.dataset.transform = S + " " + OX + " " + OY;
+  const at = mech.getBoundingClientRect();  // published in the page's pixels
+  document.body.dataset.transform = S + " " + (OX + at.left + window.scrollX) + " " + (OY + at.top + window.scrollY);
   document.body.dataset.camera = JSON.stringify(cam);
+}
+function layout() {  // the canvas fills its stage; set again when the window changes
+  W = mech.width = Math.max(200, stage.clientWidth);
+  H = mech.height = Math.max(150, stage.clientHeight);
+  document.body.dataset.window = window.innerWidth + "x" + window.innerHeight;
+  plots.width = Math.max(260, document.getElementById("right").clientWidth - 4);
+  frame();
 }
 // a world point: canvas x, canvas y, depth (larger: farther from the viewer)
 const P = p => [OX + S * dot(cam[0], p), OY - S * dot(cam[1], p), -dot(cam[2], p)];
@@ -131,6 +140,9 @@ function drawMechanism(i) {
       ctx.fillRect(-2 * R, -1.4 * R, 4 * R, 2.8 * R); ctx.strokeRect(-2 * R, -1.4 * R, 4 * R, 2.8 * R);
       ctx.restore();
     }
+  }
+  for (const s of D.springs) {  // springs, straight
+    if (fin(xy[s.a]) && fin(xy[s.b])) line([xy[s.a], xy[s.b]], "#9467bd", 1.2);
   }
   // the bodies, farthest first (by the mean depth of their points)
   const order = [];

@@ -24,8 +24,16 @@ def check_plot(path, vary) -> None:
         raise OutputError(f"--plot: {str(path)!r}: expected a .png, .svg or .pdf file")
 
 
-def plot_map(r, path, title: str = "") -> None:
-    """Draw the map of the `Study` r into the file `path`."""
+def _label(name: str, units: dict) -> str:
+    """`name [unit]`, or the name alone when its unit is not known (or a pure number)."""
+    u = units.get(name)
+    return f"{name} [{u}]" if u else name
+
+
+def plot_map(r, path, title: str = "", units: dict | None = None) -> None:
+    """Draw the map of the `Study` r into the file `path`; `units` gives the unit label of
+    each varied parameter and report expression (the axes' and colour bars' labels)."""
+    units = units or {}
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -38,8 +46,8 @@ def plot_map(r, path, title: str = "") -> None:
         v = np.where(r.ok, r.values[text], np.nan)
         if len(r.names) >= 2:
             y = r.params[:, 1]
-            _panel(ax, x, y, v)
-            ax.set_ylabel(r.names[1])
+            _panel(ax, x, y, v, _label(text, units))
+            ax.set_ylabel(_label(r.names[1], units))
             if bad.any():
                 ax.plot(x[bad], y[bad], "x", color="tab:red", ms=4, mew=1,
                         label="not solved at every pose")
@@ -51,8 +59,8 @@ def plot_map(r, path, title: str = "") -> None:
                 ax.plot(x[bad], np.zeros(bad.sum()) + np.nanmin(v, initial=0.0), "x",
                         color="tab:red", label="not solved at every pose")
                 ax.legend(fontsize="small")
-            ax.set_ylabel(text)
-        ax.set_xlabel(r.names[0])
+            ax.set_ylabel(_label(text, units))
+        ax.set_xlabel(_label(r.names[0], units))
         ax.set_title(text, fontsize="medium")
     if title:
         fig.suptitle(title)
@@ -66,7 +74,7 @@ def plot_map(r, path, title: str = "") -> None:
         plt.close(fig)
 
 
-def _panel(ax, x, y, v):
+def _panel(ax, x, y, v, label: str = ""):
     xs, ys = np.unique(x), np.unique(y)
     if len(xs) * len(ys) == len(x) and len(xs) > 1 and len(ys) > 1:  # a full grid: its cells
         Z = np.full((len(ys), len(xs)), np.nan)
@@ -80,7 +88,7 @@ def _panel(ax, x, y, v):
             im = ax.tricontourf(x[good], y[good], v[good], levels=14)
         else:
             im = ax.scatter(x[good], y[good], c=v[good])
-    ax.figure.colorbar(im, ax=ax)
+    ax.figure.colorbar(im, ax=ax, label=label)
 
 
 def _edges(c):

@@ -58,11 +58,29 @@ def first_inputs(m) -> dict[str, float]:
 
 
 def mechanism_svg(m, width: float = 420) -> str:
-    """The mechanism drawn at its first pose (see the module), as SVG text."""
+    """The mechanism drawn at its first pose (see the module), as SVG text; where it does not
+    assemble there, a short picture saying so (not a drawing of the ground alone)."""
     from ..analysis.sweeps import sweep
     from .svg import svg_text
     sw = sweep(m, {k: np.array([v]) for k, v in first_inputs(m).items()}, report=[])
+    if not sw.ok[0]:
+        return message_svg(f"{type(m).__name__} does not assemble at its first pose ({sw.status[0]})",
+                           "check the dimensions and the guess; kincas.solve says more", width)
     return svg_text(m, sw, 0, width=width)
+
+
+def message_svg(text: str, hint: str = "", width: float = 420) -> str:
+    """A small SVG that says `text` (and `hint` under it).
+
+    >>> message_svg("no assembly").count("<text")
+    1
+    """
+    lines = [f'<text x="10" y="24" font-size="13" fill="#b00">{escape(text)}</text>']
+    if hint:
+        lines.append(f'<text x="10" y="44" font-size="11" fill="#555">{escape(hint)}</text>')
+    h = 56 if hint else 36
+    return (f'<svg xmlns="http://www.w3.org/2000/svg" width="{width:g}" height="{h}" viewBox="0 0 {width:g} {h}">'
+            f'<rect width="{width:g}" height="{h}" fill="#fff6f6" stroke="#e0b0b0"/>{"".join(lines)}</svg>')
 
 
 def _spark(x, v, w=150, h=40) -> str:
@@ -84,19 +102,30 @@ def _spark(x, v, w=150, h=40) -> str:
 
 
 def sweep_html(sw, most: int = 6) -> str:
-    """The sweep's summary and a small plot of each of its first `most` quantities."""
+    """The sweep's summary and a small plot of each of its first `most` quantities; in the
+    scene's units (degrees, with each quantity's unit) when the sweep came from a scene
+    (`Sweep.info["display"]`, set by `Scene.run`)."""
+    shown = sw.info.get("display") if isinstance(sw.info, dict) else None
+    deg = set(shown["degrees"]) if shown else set()
+    labels = shown["labels"] if shown else {}
+    user = lambda k, v: np.degrees(np.asarray(v, float)) if k in deg else np.asarray(v, float)  # noqa: E731
     lines = sw.summary_lines()
     key = next((k for k, v in sw.inputs.items() if np.ptp(np.asarray(v, float)) > 0), None)
-    x = np.asarray(sw.inputs[key], float) if key else np.arange(len(sw), dtype=float)
+    x = user(key, sw.inputs[key]) if key else np.arange(len(sw), dtype=float)
     cells = []
     for name in list(sw.values)[:most]:
-        v = np.asarray(sw.values[name], float)
+        v = user(name, sw.values[name])
         fin = v[np.isfinite(v)]
-        rng = f"{fin.min():.4g} to {fin.max():.4g}" if fin.size else "not solved"
+        unit = f" {labels[name]}" if labels.get(name) else ""
+        rng = f"{fin.min():.4g} to {fin.max():.4g}{unit}" if fin.size else "not solved"
         cells.append(f"<td style='padding:2px 8px'><code>{escape(name)}</code><br>{_spark(x, v)}"
-                     f"<br><small>{rng}</small></td>")
+                     f"<br><small>{escape(rng)}</small></td>")
     more = len(sw.values) - most
     tail = f"<p><small>and {more} more quantities</small></p>" if more > 0 else ""
-    against = f"<small>against {escape(key)}</small>" if key else "<small>against the pose</small>"
+    if key:
+        span = f" ({x[0]:.4g} to {x[-1]:.4g} {labels.get(key, '')})".replace(" )", ")") if shown else ""
+        against = f"<small>against {escape(key)}{escape(span)}</small>"
+    else:
+        against = "<small>against the pose</small>"
     return (f"<div><pre style='margin:0'>{escape(chr(10).join(lines))}</pre>"
             f"<table><tr>{''.join(cells)}</tr></table>{against}{tail}</div>")

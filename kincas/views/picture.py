@@ -69,6 +69,19 @@ class Picture:
     joint_curves: object = field(default=lambda i, fine=121: [], repr=False)
     depth: np.ndarray | None = field(default=None, repr=False)  # N x P, larger farther (in a view)
     view: str | None = None  # a spatial picture's view (views/projection.py), None in space or planar
+    springs: list = field(default_factory=list)  # (label, index a, index b): views/forces.py
+    overlay: object = None  # force arrows and instant centres when asked (views/forces.Overlay)
+
+    def spring_lines(self, i: int) -> list[tuple[str, np.ndarray]]:
+        """(label, zigzag K x 2) of each spring at pose i whose ends are known (in space, with
+        `world=True`: the straight line K x 3 between them)."""
+        from .forces import zigzag
+        out = []
+        for label, a, b in self.springs:
+            pa, pb = self.xy[i, a], self.xy[i, b]
+            if np.isfinite(pa).all() and np.isfinite(pb).all():
+                out.append((label, zigzag(pa, pb, self.r) if len(pa) == 2 else np.array([pa, pb])))
+        return out
 
     def box(self) -> np.ndarray:
         """[[xmin, ymin], [xmax, ymax]] of everything drawn over the sweep, with a margin."""
@@ -85,12 +98,14 @@ class Picture:
 
 
 def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0, view: str | None = None,
-            world: bool = False) -> Picture:
+            world: bool = False, *, forces: bool = False, centres: bool = False) -> Picture:
     """The Picture of `sweep`; `paths` names the points whose paths are drawn (default: every
     moving point); `dense` > 0 solves that many extra poses between each two of the sweep's
     for smooth paths, or is those paths already solved (point -> M x 2, from `dense_paths`:
     several pictures of one sweep share one solve). A spatial sweep is drawn in `view`
-    (default isometric, `kincas.views.projection`), or kept in space with `world=True`."""
+    (default isometric, `kincas.views.projection`), or kept in space with `world=True`.
+    `forces`, `centres`: the arrows of the loads, efforts and reactions, the instant centres
+    (views/forces.py; planar mechanisms only, ValueError for a spatial one)."""
     geo = drawn(m, sweep, view, world)
     names, xy = geo.names, geo.xy
     i0 = default_pose(geo.ok)
@@ -126,8 +141,11 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0, view:
         path_xy = {p: dense[p] for p in chosen}
     else:
         path_xy = dense_paths(m, sweep, chosen, dense) if dense > 0 else {p: geo.point(p) for p in chosen}
+    from .forces import planar_overlay, springs
+    over = planar_overlay(m, sweep, geo, forces, centres, extent=span)
     return Picture(names, xy, geo.ok, [names.index(g) for g in m.ground_points], bodies, guides,
-                   project_paths(path_xy, geo.view), r, i0, _joint_curves(m, geo, r), geo.depth, geo.view)
+                   project_paths(path_xy, geo.view), r, i0, _joint_curves(m, geo, r), geo.depth, geo.view,
+                   [(label, names.index(a), names.index(b)) for label, a, b in springs(m)], over)
 
 
 def _joint_curves(m: Mechanism, geo, r: float):

@@ -66,7 +66,7 @@ class Drawing:
     """Every artist of a mechanism drawing; `update(i)` moves them to pose i."""
 
     def __init__(self, ax, m: Mechanism, geo: Geometry, paths, labels: bool, units: str = "",
-                 path_xy: dict | None = None):
+                 path_xy: dict | None = None, overlay=None):
         self.ax, self.m, self.geo = ax, m, geo
         self.i0 = default_pose(geo.ok)
         pts = geo.xy[np.isfinite(geo.xy).all(axis=2)]
@@ -98,14 +98,15 @@ class Drawing:
             xy = path_xy[p] if path_xy and p in path_xy else geo.point(p)
             if np.isfinite(xy).all(axis=1).sum() >= 2:
                 ax.plot(*xy.T, "--", lw=1.0, color=self.colour.get(owner.get(p), INK), alpha=0.7, zorder=2)
-        names = geo.names  # what surrounds each point: the other points of its bodies
-        self.near = {k: sorted({names.index(q) for lk in self.links if p in lk.point_names
-                                for q in lk.point_names if q != p}) for k, p in enumerate(names)}
         self._ground_symbols()
         self._make_bodies()
         self._make_slides()
         from .draw_joints import JointArtists
         self.joint_artists = JointArtists(self, geo.joints) if geo.joints is not None else None
+        from .draw_forces import OverlayArtists, SpringArtists  # views/draw_forces.py
+        from .forces import springs
+        self.springs = SpringArtists(self, springs(m))
+        self.overlay = OverlayArtists(self, overlay) if overlay is not None else None
         self._make_points(labels)
         self.caption = ax.set_title("", fontsize=9)
         # The limits follow this box, widened to equal scales by matplotlib when drawn (the
@@ -222,25 +223,6 @@ class Drawing:
                                     bbox=dict(fc=PAPER, ec="none", alpha=0.75, pad=0.3))
                        for p in names] if labels else []
 
-    def _free_side(self, k: int, xy: np.ndarray, i: int) -> np.ndarray:
-        """A unit vector from point k into free space: minus the sum of the unit vectors
-        towards what is drawn around it (its neighbours, a ground symbol, a slide's guide)."""
-        v = sum((_unit(xy[j] - xy[k]) for j in self.near[k]), np.zeros(2))
-        name = self.geo.names[k]
-        if name in self.m.ground_points:
-            v = v + np.array([0.0, -1.0])
-        along = None
-        for sl, rails, *_ in self.guides:
-            if sl.point == name:  # a ground guide's surface is on one side
-                along = self.geo.slides[sl.name][1][i]
-                v = v + (rails[0][0] * np.array([-along[1], along[0]]) if len(rails) == 1 else 0.0)
-        v = -v
-        if along is not None and np.isfinite(along).all():  # the guide runs both ways: go across
-            n = np.array([-along[1], along[0]])
-            v = n * (1.0 if n @ v >= 0 else -1.0)
-        v = _unit(v)
-        return v if v.any() else np.array([0.6, 0.8])
-
     def _view_axes(self, units: str):
         """A spatial mechanism's view: the drawing's axes named after the world's where the view
         looks along one of them, and a cross of the world axes x, y, z in a corner."""
@@ -299,12 +281,35 @@ class Drawing:
             line.set_data(*xy[idx].T)
         if self.joint_artists is not None:
             self.joint_artists.update(i)
+        self.springs.update(xy)
+        if self.overlay is not None:
+            self.overlay.update(i)
+        spots = self._label_spots(xy, i) if self.labels else ()
         for k, t in enumerate(self.labels):
-            ok = bool(np.isfinite(xy[k]).all())
+            ok = bool(np.isfinite(spots[k]).all())
             t.set_visible(ok)
             if ok:
-                t.set_position(xy[k] + 3.0 * r * self._free_side(k, xy, i))
+                t.set_position(spots[k])
         self.caption.set_text(caption)
+
+    def _label_spots(self, xy: np.ndarray, i: int) -> np.ndarray:
+        """Where the names go at this pose: the freest spots (views/labels.py), off the bars,
+        bodies, guides, blocks, ground symbols and springs."""
+        from .labels import block, ground_symbol, label_spots
+        segments, polygons = [], []
+        for kind, _, idx in self.bodies:
+            (segments if kind == "bar" else polygons).append(xy[idx])
+        for sl, *_ in self.guides:
+            through, d, s = (a[i] for a in self.geo.slides[sl.name])
+            if np.isfinite(through).all() and np.isfinite(d).all():
+                lo, hi = self.sref[sl.name]
+                segments.append(np.array([through + lo * d, through + hi * d]))
+                p = xy[self.geo.names.index(sl.point)]
+                if np.isfinite(p).all():
+                    polygons.append(block(p, d, self.r))
+        polygons += [ground_symbol(xy[self.geo.names.index(g)], self.r) for g in self.m.ground_points]
+        segments += self.springs.lines(xy)
+        return label_spots(xy, self.r, segments=segments, polygons=polygons)
 
 
 # --- public drawing functions ---
@@ -318,12 +323,14 @@ def caption(sweep: Sweep, i: int) -> str:
 
 def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=None,
          labels: bool = True, title: str | None = None, units: str = "", path_xy=None,
-         view: str | None = None):
+         view: str | None = None, forces: bool = False, centres: bool = False):
     """Draw `m` at pose `pose` of `sweep` (default: the first solved) with the paths of
     `paths` (default: every moving point) over the sweep; returns the matplotlib Axes.
     `path_xy`: those paths already solved (point -> M x 2, `smooth_paths`), else solved here.
     A spatial mechanism is drawn in `view` ("iso", the default, "xy", "yz" or "zx";
     `kincas.views.projection`), a planar one in its plane.
+    `forces`: arrows for the loads, springs' pulls, efforts and joint reactions; `centres`:
+    each link's instant centre (kincas/views/forces.py), planar only. Springs are always drawn.
 
     Links with two points are bars, links with three or more are filled polygons, ground
     pivots stand on hatched bases, slides show their guide and block; axes have equal scales.
@@ -335,7 +342,9 @@ def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=
     paths = check_paths(m, paths)
     i = default_pose(sweep) if pose is None else int(pose) % max(len(sweep), 1)  # -1: the last
     smooth = smooth_paths(m, sweep, paths) if path_xy is None else {p: path_xy[p] for p in paths}
-    d = Drawing(ax, m, drawn(m, sweep, view), paths, labels, units, smooth)
+    from .forces import planar_overlay
+    geo = drawn(m, sweep, view)
+    d = Drawing(ax, m, geo, paths, labels, units, smooth, planar_overlay(m, sweep, geo, forces, centres))
     d.update(i, caption(sweep, i) if title is None else title)
     return ax
 

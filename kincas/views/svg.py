@@ -49,21 +49,46 @@ def _runs(a: np.ndarray):
             yield a[lo:hi]
 
 
+# a scene's length unit -> (SVG's absolute unit, how many of them make one): the file's
+# width and height in these, so that an import draws the mechanism at true scale
+TRUE_SCALE = {"mm": ("mm", 1.0), "cm": ("cm", 1.0), "in": ("in", 1.0), "m": ("mm", 1000.0),
+              "dm": ("mm", 100.0), "km": ("mm", 1e6), "um": ("mm", 1e-3), "µm": ("mm", 1e-3),
+              "ft": ("in", 12.0), "pt": ("pt", 1.0), "pc": ("pc", 1.0), "px": ("px", 1.0)}
+
+
+def svg_size(w: float, h: float, units: str, width: float = 800) -> tuple[str, str]:
+    """The width and height attributes of a drawing w x h in the scene's length `units`:
+    at true scale where the unit is one SVG measures (mm, cm, in, and m, ft converted),
+    else `width` pixels wide.
+
+    >>> svg_size(120, 80, "mm"), svg_size(0.12, 0.08, "m")
+    (('120mm', '80mm'), ('120mm', '80mm'))
+    """
+    if units in TRUE_SCALE:
+        u, k = TRUE_SCALE[units]
+        return f"{_f(w * k)}{u}", f"{_f(h * k)}{u}"
+    return _f(width), _f(width * h / w if w > 0 else width)
+
+
 def svg_text(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None, scene=None,
-             dense: int = 0, width: float = 800, view: str | None = None) -> str:
+             dense: int = 0, width: float = 800, view: str | None = None, forces: bool = False,
+             centres: bool = False, units: str | None = None) -> str:
     """The SVG document: the drawing at `pose` (default: the first solved) and the paths
-    (a spatial mechanism in `view`)."""
-    pic = picture(m, sweep, paths, dense, view)
+    (a spatial mechanism in `view`); `forces`, `centres`: arrows and instant centres
+    (views/forces.py, planar only). Sized at true scale in the scene's length unit (`units`,
+    default the scene's; see `svg_size`)."""
+    pic = picture(m, sweep, paths, dense, view, forces=forces, centres=centres)
     i = pic.first if pose is None else int(pose) % max(len(sweep), 1)
     xy = pic.xy[i]
     (x0, y0), (x1, y1) = pic.box()
     w, h = x1 - x0, y1 - y0
-    height = width * h / w if w > 0 else width
     r, sw_ = pic.r, pic.r * 0.35  # point radius, bar width's unit
-    units = scene.study.units.get("length", "") if scene is not None else ""
+    if units is None:
+        units = scene.study.units.get("length", "") if scene is not None else ""
+    wide, high = svg_size(w, h, units, width)
     title = getattr(getattr(scene, "study", None), "title", "") or "kincas"
     out = ['<?xml version="1.0" encoding="UTF-8"?>',
-           f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(width)}" height="{_f(height)}" '
+           f'<svg xmlns="http://www.w3.org/2000/svg" width="{wide}" height="{high}" '
            f'viewBox="{_f(x0)} {_f(-y1)} {_f(w)} {_f(h)}" data-units={quoteattr(units)}'
            + (f' data-view="{pic.view}">' if pic.view else ">"),
            f"<title>{escape(title)}</title>",
@@ -117,6 +142,7 @@ def svg_text(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None,
     out.append("</g>")
     out.append('<g id="joints" fill="none">')  # gears, racks, cams: views/draw_joints.py
     colours = {b.name: b.colour for b in pic.bodies}
+    from .draw_joints import as_circle
     for label, body, a in pic.joint_curves(i):
         c = colours.get(body, INK)
         if len(a) == 1:  # a cam's contact point
@@ -124,10 +150,21 @@ def svg_text(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None,
                 out.append(f'<circle data-joint={quoteattr(label)} cx="{_f(a[0, 0])}" cy="{_f(a[0, 1])}" '
                            f'r="{_f(0.5 * r)}" fill="#c0392b"/>')
             continue
+        circle = as_circle(label, a)
+        if circle is not None:  # a pitch circle or a roller: a true circle, round at any zoom
+            out.append(f'<circle data-joint={quoteattr(label)} cx="{_f(circle[0])}" cy="{_f(circle[1])}" '
+                       f'r="{_f(circle[2])}" stroke="{c}" stroke-width="{_f(0.4 * sw_)}"/>')
+            continue
         for run in _runs(a):
             out.append(f'<polyline data-joint={quoteattr(label)} points="{_pts(run)}" stroke="{c}" '
                        f'stroke-width="{_f(0.4 * sw_)}"/>')
     out.append("</g>")
+    out.append('<g id="springs" fill="none">')
+    for label, zz in pic.spring_lines(i):
+        out.append(f'<polyline data-spring={quoteattr(label)} points="{_pts(zz)}" stroke="#9467bd" '
+                   f'stroke-width="{_f(0.4 * sw_)}"/>')
+    out.append("</g>")
+    out += _overlay(pic, i, r, sw_)
     out.append('<g id="points">')
     for k, name in enumerate(pic.names):
         x, y = xy[k]
@@ -137,11 +174,12 @@ def svg_text(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None,
     out.append("</g></g>")
     if pic.view:
         out += _triad(pic.view, x0, -y0, r, sw_)
-    out.append(f'<g id="labels" font-family="sans-serif" font-size="{_f(2.2 * r)}" fill="{INK}">')
-    for k, name in enumerate(pic.names):  # outside the flip, so the text reads upright
-        x, y = xy[k]
-        if np.isfinite([x, y]).all():
-            out.append(f'<text x="{_f(x + 1.2 * r)}" y="{_f(-y - 1.2 * r)}">{escape(name)}</text>')
+    out.append(f'<g id="labels" font-family="sans-serif" font-size="{_f(2.2 * r)}" fill="{INK}" '
+               f'text-anchor="middle" dominant-baseline="central">')
+    from .labels import picture_labels
+    for name, p, off in picture_labels(pic, i):  # outside the flip, so the text reads upright
+        x, y = p + off
+        out.append(f'<text x="{_f(x)}" y="{_f(-y)}">{escape(name)}</text>')
     out.append("</g></svg>")
     return "\n".join(out) + "\n"
 
@@ -167,6 +205,35 @@ def _triad(view: str, x: float, y: float, r: float, sw_: float) -> list[str]:
         out.append(f'<line data-axis="{k}" x1="{_f(o[0])}" y1="{_f(o[1])}" x2="{_f(e[0])}" y2="{_f(e[1])}"/>')
         out.append(f'<text x="{_f(t[0])}" y="{_f(t[1])}" stroke="none" text-anchor="middle" '
                    f'dominant-baseline="middle">{k}</text>')
+    out.append("</g>")
+    return out
+
+
+def _overlay(pic, i: int, r: float, sw_: float) -> list[str]:
+    """The force arrows (`data-force`, with the force's components or the torque as
+    `data-value-*`) and the instant centres (`data-centre`), when asked."""
+    ov = pic.overlay
+    if ov is None:
+        return []
+    from .forces import COLOURS
+    values = {a.label: ("x", a.vec[i]) for a in ov.arrows} | {t.label: ("t", t.value[i]) for t in ov.torques}
+    out = ['<g id="forces" fill="none">']
+    for label, kind, line, head in ov.segments(i, r):
+        c = COLOURS[kind]
+        tag, v = values[label]
+        val = (f'data-value-x="{_f(v[0])}" data-value-y="{_f(v[1])}"' if tag == "x" else f'data-value="{_f(v)}"')
+        out.append(f'<polyline data-force={quoteattr(label)} data-kind="{kind}" {val} points="{_pts(line)}" '
+                   f'stroke="{c}" stroke-width="{_f(0.5 * sw_)}"/>')
+        out.append(f'<polygon data-head={quoteattr(label)} points="{_pts(head)}" fill="{c}"/>')
+    out.append("</g>")
+    out.append('<g id="centres">')
+    for label, xy in ov.centres:
+        p = xy[i]
+        if np.isfinite(p).all():
+            a, b = p - r, p + r
+            out.append(f'<path data-centre={quoteattr(label)} d="M{_f(a[0])},{_f(a[1])} L{_f(b[0])},{_f(b[1])} '
+                       f'M{_f(a[0])},{_f(b[1])} L{_f(b[0])},{_f(a[1])}" stroke="{COLOURS["centre"]}" '
+                       f'stroke-width="{_f(0.4 * sw_)}" data-x="{_f(p[0])}" data-y="{_f(p[1])}"/>')
     out.append("</g>")
     return out
 
