@@ -60,6 +60,7 @@ def check_outputs(args, mechanism=None, poses: int | None = None) -> None:
         bad = [p for p in _names(args.paths) if p not in known]
         if bad:
             _fail(f"--paths: unknown point(s) {', '.join(bad)} (points: {', '.join(sorted(known))})")
+    _check_view(args, mechanism)
     if (getattr(args, "forces", False) or getattr(args, "centres", False)) and not any(
             getattr(args, a, None) for a in ("plot", "animate", "html", "svg", "dxf")):
         _fail("--forces, --centres: they draw on the pictures; give --plot, --animate, --html, --svg or --dxf")
@@ -73,6 +74,34 @@ def check_outputs(args, mechanism=None, poses: int | None = None) -> None:
                 check_geometry(mechanism, geo["evolute"], geo["centrodes"])
             except ValueError as e:
                 _fail(str(e))
+
+
+def add_view_argument(parser) -> None:
+    """`--view iso|xy|yz|zx` for a command that draws pictures through `write_outputs`."""
+    from ..views.projection import VIEWS
+    parser.add_argument("--view", choices=list(VIEWS), metavar="|".join(VIEWS),
+                        help="a spatial scene's projection in --plot, --animate, --svg and the view --html opens "
+                             "with (default iso); a planar scene is drawn in its plane (xy only)")
+
+
+def _check_view(args, mechanism) -> None:
+    """--view: a spatial scene's projection (kincas/views/projection.py), for the pictures that
+    draw one; a planar scene accepts only its own plane, xy. Evolutes and centrodes are planar."""
+    from ..views.projection import check_view, is_spatial
+    spatial = mechanism is not None and is_spatial(mechanism)
+    view = getattr(args, "view", None)
+    if view is not None:
+        if not any(getattr(args, a, None) for a in ("plot", "animate", "svg", "html")):
+            _fail("--view: it chooses the projection of --plot, --animate, --svg and --html; give one of them")
+        if mechanism is not None:
+            try:
+                check_view(view, spatial)
+            except ValueError as e:
+                _fail(str(e))
+    if spatial and (getattr(args, "evolute", None) or getattr(args, "centrodes", None)):
+        _fail("--evolute, --centrodes: the kinematic geometry of planar motion; this scene is spatial")
+    if spatial and (getattr(args, "forces", False) or getattr(args, "centres", False)):
+        _fail("--forces, --centres: the arrows and instant centres are drawn on planar pictures; this scene is spatial")
 
 
 def check_path(flag: str, path, formats=None) -> None:
@@ -121,6 +150,7 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
     check_outputs(args, m, len(sweep))
     paths = _names(args.paths) if getattr(args, "paths", None) else None
     pose = getattr(args, "pose", None)
+    view = getattr(args, "view", None)  # a spatial scene's projection (None: iso; planar: its plane)
     length = scene.study.units.get("length", "")
     inputs = scene.user_inputs(sweep)
     captions = [_caption(scene, sweep, inputs, i) for i in range(len(sweep))]
@@ -130,12 +160,12 @@ def write_outputs(scene, sweep: Sweep, args) -> None:
     jobs = [("csv", lambda p: write_csv(p, sweep, scene)),
             ("plot", lambda p: _save_drawing(p, m, sweep, pose, paths, captions, length,
                                              _names(getattr(args, "evolute", None) or ""),
-                                             _names(getattr(args, "centrodes", None) or ""), solved(), **over)),
+                                             _names(getattr(args, "centrodes", None) or ""), solved(), view, **over)),
             ("animate", lambda p: _animate(p, m, sweep, paths, captions, length, _rendering(args), solved(),
-                                           **over)),
+                                           view, **over)),
             ("plot_quantities", lambda p: savefig(plot_quantities(sweep, scene=scene), p, dpi=100)),
-            ("html", lambda p: _html(p, m, sweep, scene, paths, solved.dense(), **over)),
-            ("svg", lambda p: _svg(p, m, sweep, scene, pose, paths, solved.dense(), **over)),
+            ("html", lambda p: _html(p, m, sweep, scene, paths, solved.dense(), view, **over)),
+            ("svg", lambda p: _svg(p, m, sweep, scene, pose, paths, solved.dense(), view, **over)),
             ("dxf", lambda p: _dxf(p, m, sweep, scene, pose, paths, solved.dense(), **over))]
     for attr, job in jobs:
         path = getattr(args, attr, None)
@@ -180,14 +210,14 @@ class _SharedPaths:
         return 0 if xy is None else xy
 
 
-def _html(path, m, sweep, scene, paths, dense=0, **over):
+def _html(path, m, sweep, scene, paths, dense=0, view=None, **over):
     from ..views.html import write_html
-    write_html(path, m, sweep, scene, paths, dense=dense, **over)
+    write_html(path, m, sweep, scene, paths, dense=dense, view=view, **over)
 
 
-def _svg(path, m, sweep, scene, pose, paths, dense=0, **over):
+def _svg(path, m, sweep, scene, pose, paths, dense=0, view=None, **over):
     from ..views.svg import write_svg
-    write_svg(path, m, sweep, pose, paths=paths, scene=scene, dense=dense, **over)
+    write_svg(path, m, sweep, pose, paths=paths, scene=scene, dense=dense, view=view, **over)
 
 
 def _dxf(path, m, sweep, scene, pose, paths, dense=0, **over):
@@ -207,12 +237,12 @@ def _caption(scene, sweep, inputs, i) -> str:
 
 
 def _save_drawing(path, m, sweep, pose, paths, captions, length, evolute=(), centrodes=(), path_xy=None,
-                  forces=False, centres=False):
+                  view=None, forces=False, centres=False):
     from ..views.plot import default_pose, draw, new_figure
     fig = new_figure()
     i = default_pose(sweep) if pose is None else pose % len(sweep)
     ax = draw(m, sweep, i, ax=fig.subplots(), paths=paths, title=captions[i], units=length, path_xy=path_xy,
-              forces=forces, centres=centres)
+              view=view, forces=forces, centres=centres)
     if evolute or centrodes:  # kinematic geometry over the drawing (kincas/views/draw_geometry.py)
         from ..views.draw_geometry import draw_geometry
         draw_geometry(ax, m, sweep, i, evolute, centrodes)
@@ -228,6 +258,7 @@ def _rendering(args):
     return bar
 
 
-def _animate(path, m, sweep, paths, captions, length, progress=None, path_xy=None, forces=False, centres=False):
+def _animate(path, m, sweep, paths, captions, length, progress=None, path_xy=None, view=None, forces=False,
+             centres=False):
     animate(m, sweep, path, paths=paths, captions=captions, units=length, progress=progress, path_xy=path_xy,
-            forces=forces, centres=centres)
+            view=view, forces=forces, centres=centres)

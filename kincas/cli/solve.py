@@ -32,6 +32,8 @@ def cli_arguments(parser) -> None:
     parser.add_argument("--centrodes", metavar="L,M", help="with --plot: draw the fixed and moving centrodes of these links")
     parser.add_argument("--forces", action="store_true", help="on every picture: arrows for the loads, springs, efforts and reactions")
     parser.add_argument("--centres", "--centers", action="store_true", help="on every picture: each link's instant centre")
+    from .outputs import add_view_argument
+    add_view_argument(parser)
     parser.add_argument("--pose", type=int, metavar="I", help="the pose --plot draws, by index (default: the first solved; -1: the last)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar, even on a terminal")
 
@@ -43,8 +45,8 @@ def cli_run(args) -> int:
         sc = load(args.scene)
     wants_files = (args.csv or args.plot or args.animate or args.plot_quantities or args.html
                    or args.svg or args.dxf)
-    if wants_files or args.pose is not None or args.evolute or args.centrodes or args.forces or args.centres:
-        # fail before a long solve
+    if (wants_files or args.pose is not None or args.evolute or args.centrodes or args.forces or args.centres
+            or args.view):  # fail before a long solve
         from .outputs import check_outputs
         check_outputs(args, sc.mechanism, len(next(iter(sc.study.inputs.values()))))
     sw = sc.run(progress=progress_for(args))

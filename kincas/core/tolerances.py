@@ -86,3 +86,6 @@ FREE_LINKS = 6  # links left free by a guess that are tried in several turns (co
 NEARER = 1e-9  # another start's assembly is nearer the guessed points when its cost is below (1 - this) times
 CHOICE_STARTS = 128  # scattered starts finding a guessless sweep's other assemblies (analysis/choice.py)
 CHOICE_TRIES = 8  # of which at most this many are swept
+
+# --- pictures ---
+END_ON = 1e-6  # a slide's unit direction drawn shorter than this is seen end on (views/projection.py)

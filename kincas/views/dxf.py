@@ -6,6 +6,12 @@ for the blocks, `paths` for the paths. A bar is a LINE, a body of three or more 
 closed LWPOLYLINE, each point a CIRCLE, each path an LWPOLYLINE per run of solved poses,
 each guide a LINE, each block a closed LWPOLYLINE.
 
+A spatial mechanism is written in space, as it is (no projection): a bar is a LINE between
+3D points, a body of three or more points a closed 3D POLYLINE (its outline in its own
+plane), each path a 3D POLYLINE per run, each guide a LINE, each block a closed 3D POLYLINE
+(a rectangle in the plane of the guide and the world axis most across it), each point a
+CIRCLE at its height (in a plane z = constant).
+
 >>> import os, tempfile, numpy as np, kincas, ezdxf
 >>> m = kincas.Mechanism(ground={"O": (0, 0)},
 ...     links=[kincas.Link.bar("crank", "O", "A", 1), kincas.Link.bar("rod", "A", "B", 3)],
@@ -46,9 +52,10 @@ def dxf_document(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=N
     each point's name as a TEXT on layer `labels`."""
     ezdxf = _require()
     from ezdxf import colors
-    pic = picture(m, sweep, paths, dense, forces=forces, centres=centres)
+    pic = picture(m, sweep, paths, dense, world=True, forces=forces, centres=centres)
     i = pic.first if pose is None else int(pose) % max(len(sweep), 1)
     xy = pic.xy[i]
+    space = xy.shape[-1] == 3  # a spatial mechanism: 3D polylines
     doc = ezdxf.new("R2010")
     if units in _UNITS:
         doc.units = _UNITS[units]
@@ -64,7 +71,7 @@ def dxf_document(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=N
             continue
         at = {"layer": b.name, "true_color": rgb(b.colour)}
         if len(b.ring) >= 3:
-            msp.add_lwpolyline([tuple(p) for p in pts], close=True, dxfattribs=at)
+            _polyline(msp, pts, space, True, at)
         else:
             msp.add_line(tuple(pts[0]), tuple(pts[1]), dxfattribs=at)
         for k in b.ring:
@@ -80,13 +87,13 @@ def dxf_document(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=N
                      dxfattribs={"layer": "ground" if g.ground else "slides"})
         p = xy[g.point]
         if np.isfinite(p).all():
-            n, r = np.array([-d[1], d[0]]), pic.r
+            n, r = _across(d), pic.r
             c = [p - 2 * r * d - 1.4 * r * n, p + 2 * r * d - 1.4 * r * n, p + 2 * r * d + 1.4 * r * n,
                  p - 2 * r * d + 1.4 * r * n]
-            msp.add_lwpolyline([tuple(q) for q in c], close=True, dxfattribs={"layer": "slides"})
+            _polyline(msp, c, space, True, {"layer": "slides"})
     for name, a in pic.paths.items():
         for run in _runs(a):
-            msp.add_lwpolyline([tuple(q) for q in run], dxfattribs={"layer": "paths"})
+            _polyline(msp, run, space, False, {"layer": "paths"})
     curves = pic.joint_curves(i)  # gears, racks, cams (views/draw_joints.py): layer "joints"
     if curves:
         doc.layers.add("joints")
@@ -104,9 +111,43 @@ def dxf_document(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=N
     return doc
 
 
+def _polyline(msp, pts, space: bool, close: bool, attribs: dict) -> None:
+    """A polyline through `pts`: an LWPOLYLINE in the plane, a 3D POLYLINE in space."""
+    if space:
+        msp.add_polyline3d([tuple(map(float, q)) for q in pts], close=close, dxfattribs=attribs)
+    else:
+        msp.add_lwpolyline([tuple(q) for q in pts], close=close, dxfattribs=attribs)
+
+
+def _across(d: np.ndarray) -> np.ndarray:
+    """A unit vector across the unit direction d: its normal in the plane; in space, the world
+    axis least along d with its part along d taken away."""
+    if len(d) == 2:
+        return np.array([-d[1], d[0]])
+    e = np.eye(3)[int(np.argmin(np.abs(d)))]
+    n = e - (e @ d) * d
+    return n / np.linalg.norm(n)
+
+
 def _extras(doc, msp, pic, i: int, labels: bool) -> None:
-    """Springs (layer `springs`), force arrows and instant centres, and the points' names."""
+    """Springs (layer `springs`), force arrows and instant centres, and the points' names. In
+    space (a spatial mechanism's world positions) springs are straight and each name stands at
+    its point: the zigzags, the overlay and the placement of names are planar."""
     r = pic.r
+    xy = pic.xy[i]
+    if xy.shape[-1] == 3:
+        ends = [(xy[a], xy[b]) for _, a, b in pic.springs if np.isfinite(xy[[a, b]]).all()]
+        if ends:
+            doc.layers.add("springs")
+        for pa, pb in ends:
+            _polyline(msp, [pa, pb], True, False, {"layer": "springs"})
+        if labels:
+            doc.layers.add("labels")
+            for k, name in enumerate(pic.names):
+                if np.isfinite(xy[k]).all():
+                    msp.add_text(name, height=2.2 * r, dxfattribs={"layer": "labels",
+                                                                  "insert": tuple(map(float, xy[k]))})
+        return
     springs = pic.spring_lines(i)
     if springs:
         doc.layers.add("springs")

@@ -103,7 +103,21 @@ def _number(m: Mechanism, v) -> float:
 
 def springs(m: Mechanism) -> list[tuple[str, str, str]]:
     """(label, point a, point b) of each spring load."""
-    return [(f"spring {ld.points[0]}-{ld.points[1]}", *ld.points) for ld in m.loads if ld.kind == "spring"]
+    return [(f"spring {ld.points[0]}-{ld.points[1]}", *ld.points) for ld in getattr(m, "loads", ())
+            if ld.kind == "spring"]
+
+
+def planar_overlay(m: Mechanism, sweep: Sweep, geo, forces: bool = False, centres: bool = False,
+                   extent: float | None = None) -> Overlay | None:
+    """The `overlay` a picture asks for (None when neither `forces` nor `centres`); they are
+    planar quantities, so a spatial mechanism's picture refuses them (ValueError)."""
+    if not (forces or centres):
+        return None
+    from .poses import is_spatial
+    if is_spatial(m):
+        raise ValueError("forces, centres: the arrows and instant centres are drawn on planar pictures only; "
+                         "this mechanism is spatial")
+    return overlay(m, sweep, forces=forces, centres=centres, extent=extent, geo=geo)
 
 
 def zigzag(a, b, r: float, turns: int = 6) -> np.ndarray:

@@ -36,12 +36,14 @@ MAX_FRAMES = 2000  # poses kept in the page (evenly spread) so that it stays sma
 WIDTH, HEIGHT = 640, 480  # the mechanism's canvas, CSS pixels
 
 
-def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0, *,
-              forces: bool = False, centres: bool = False) -> dict:
+def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0,
+              view: str | None = None, *, forces: bool = False, centres: bool = False) -> dict:
     """Everything the page draws, as JSON-ready lists (scene units when a scene is given);
-    `forces`, `centres`: arrows and instant centres per pose (views/forces.py)."""
+    `forces`, `centres`: arrows and instant centres per pose (views/forces.py, planar only);
+    a spatial mechanism's in space, with the `camera` the page opens with (`html3d.camera`)."""
     from .columns import heading, quantity_unit, user_columns, _abscissa, _units_of
-    pic = picture(m, sweep, paths, dense, forces=forces, centres=centres)
+    pic = picture(m, sweep, paths, dense, view, world=True, forces=forces, centres=centres)
+    spatial = pic.xy.shape[-1] == 3
     n = len(sweep)
     keep = np.unique(np.round(np.linspace(0, n - 1, min(n, MAX_FRAMES))).astype(int)) if n else np.zeros(0, int)
     inputs, values = user_columns(sweep, scene)
@@ -53,11 +55,11 @@ def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0
     shown = lambda k, v: f"{k} = {v:.6g}" + ("°" if unit(k) == "deg" else f" {unit(k)}" if unit(k) else "")  # noqa: E731
     caption = [", ".join(shown(k, float(v[i])) for k, v in inputs.items())
                + ("" if sweep.status[i] == "ok" else f" ({sweep.status[i]})") for i in keep]
-    return {
+    out = {
         "title": (getattr(getattr(scene, "study", None), "title", "") or "kincas"),
         "springs": [{"label": label, "a": a, "b": b} for label, a, b in pic.springs],
         "forces": _forces(pic, keep), "centres": _centres(pic, keep),
-        "labels": _labels(pic, keep),
+        "labels": [] if spatial else _labels(pic, keep),  # names in free space: planar pictures
         "units": units, "names": pic.names, "ground": pic.ground, "r": pic.r,
         "box": _arr(box), "ok": [bool(v) for v in sweep.ok[keep]],
         "xy": _arr(pic.xy[keep]), "caption": caption, "poses": [int(i) for i in keep],
@@ -73,26 +75,36 @@ def page_data(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0
                         "values": _arr(np.asarray(v, float)[keep]), "wrap": _wrap(k, unit(k))}
                        for k, v in values.items()],
     }
+    if spatial:
+        from .html3d import camera
+        from .projection import check_view
+        out.update(camera(check_view(view, True)))
+    return out
 
 
-def html_page(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0, *,
-              forces: bool = False, centres: bool = False) -> str:
-    """The page as text."""
-    data = json.dumps(page_data(m, sweep, scene, paths, dense, forces=forces, centres=centres),
-                      allow_nan=False, separators=(",", ":"))
+def html_page(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0,
+              view: str | None = None, *, forces: bool = False, centres: bool = False) -> str:
+    """The page as text (a spatial mechanism's turns with the mouse, opening in `view`)."""
+    data = page_data(m, sweep, scene, paths, dense, view, forces=forces, centres=centres)
+    page = _PAGE
+    if "camera" in data:  # a spatial mechanism: the view that turns (views/html3d.py)
+        from .html3d import MECHANISM_3D
+        page = _HEAD + MECHANISM_3D + _TAIL
+    data = json.dumps(data, allow_nan=False, separators=(",", ":"))
     data = data.replace("</", "<\\/")  # nothing in the data may close the script element
-    return (_PAGE.replace("@W@", str(WIDTH)).replace("@H@", str(HEIGHT)).replace("@INK@", INK)
+    return (page.replace("@W@", str(WIDTH)).replace("@H@", str(HEIGHT)).replace("@INK@", INK)
             .replace("@DATA@", data))
 
 
-def write_html(path, m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0, **kw) -> None:
+def write_html(path, m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0,
+               view: str | None = None, **kw) -> None:
     """Write the page to `path` (`kw`: forces, centres)."""
     from .atomic import open_replacing
     with open_replacing(path, "w", encoding="utf-8") as f:
-        f.write(html_page(m, sweep, scene, paths, dense, **kw))
+        f.write(html_page(m, sweep, scene, paths, dense, view, **kw))
 
 
-_PAGE = r"""<!DOCTYPE html>
+_HEAD = r"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
 <title>kincas</title>
 <style>
@@ -141,7 +153,10 @@ document.title = D.title;
 document.getElementById("title").textContent = D.title;
 document.getElementById("units").textContent =
   (D.units ? "lengths in " + D.units : "") + (D.x.unit ? (D.units ? ", " : "") + D.x.name + " in " + D.x.unit : "");
-// world -> canvas: equal scales, the whole sweep in view; set again when the window changes
+"""
+# a planar mechanism's drawing; a spatial one's is views/html3d.MECHANISM_3D (it defines the same
+# layout(), drawMechanism(i), W, H and R, which _TAIL uses)
+_MECHANISM = r"""// world -> canvas: equal scales, the whole sweep in view; set again when the window changes
 const bx = D.box;
 let W = mech.width, H = mech.height, sx = 1, ox = 0, oy = 0, R = 1;
 function layout() {
@@ -255,7 +270,9 @@ function drawMechanism(i) {
   ctx.textAlign = "start"; ctx.textBaseline = "alphabetic";
 }
 
-// the quantities against the input, one panel each with its axes, a cursor at the slider's pose
+"""
+# the quantities against the input, the slider and play button: both pages (views/html3d.py)
+_TAIL = r"""// the quantities against the input, one panel each with its axes, a cursor at the slider's pose
 function extent(v) {
   let lo = Infinity, hi = -Infinity;
   for (const a of v) if (a !== null) { lo = Math.min(lo, a); hi = Math.max(hi, a); }
@@ -356,3 +373,4 @@ layout();
 if (N) show(fromHash());
 </script></body></html>
 """
+_PAGE = _HEAD + _MECHANISM + _TAIL

@@ -24,7 +24,8 @@ import numpy as np
 
 from ..model.mechanism import GROUND, Mechanism
 from ..results import Sweep
-from .poses import _hull, check_paths, default_pose, geometry
+from .poses import _hull, _on_line, check_paths, default_pose, geometry, links_of
+from .projection import drawn, project_paths, ring_points
 
 COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
            "#7f7f7f", "#bcbd22", "#17becf"]  # matplotlib's tab10, as the PNG drawings use
@@ -56,7 +57,7 @@ class Guide:
 @dataclass
 class Picture:
     names: list[str]
-    xy: np.ndarray  # N x P x 2, NaN where a pose was not solved
+    xy: np.ndarray  # N x P x 2 (x 3: a spatial one in space), NaN where a pose was not solved
     ok: np.ndarray
     ground: list[int]
     bodies: list[Body]
@@ -66,17 +67,20 @@ class Picture:
     first: int = 0  # the first solved pose
     # pose -> [(label, body, polyline)] of the gears, racks and cams (views/draw_joints.py)
     joint_curves: object = field(default=lambda i, fine=121: [], repr=False)
+    depth: np.ndarray | None = field(default=None, repr=False)  # N x P, larger farther (in a view)
+    view: str | None = None  # a spatial picture's view (views/projection.py), None in space or planar
     springs: list = field(default_factory=list)  # (label, index a, index b): views/forces.py
     overlay: object = None  # force arrows and instant centres when asked (views/forces.Overlay)
 
     def spring_lines(self, i: int) -> list[tuple[str, np.ndarray]]:
-        """(label, zigzag K x 2) of each spring at pose i whose ends are known."""
+        """(label, zigzag K x 2) of each spring at pose i whose ends are known (in space, with
+        `world=True`: the straight line K x 3 between them)."""
         from .forces import zigzag
         out = []
         for label, a, b in self.springs:
             pa, pb = self.xy[i, a], self.xy[i, b]
             if np.isfinite(pa).all() and np.isfinite(pb).all():
-                out.append((label, zigzag(pa, pb, self.r)))
+                out.append((label, zigzag(pa, pb, self.r) if len(pa) == 2 else np.array([pa, pb])))
         return out
 
     def box(self) -> np.ndarray:
@@ -89,40 +93,44 @@ class Picture:
             for s in (g.lo, g.hi):
                 e = g.through + s * g.direction
                 parts.append(e[np.isfinite(e).all(axis=1)])
-        pts = np.concatenate([p for p in parts if p.size] or [np.zeros((1, 2))])
+        pts = np.concatenate([p for p in parts if p.size] or [np.zeros((1, self.xy.shape[-1]))])
         return np.array([pts.min(axis=0) - 5 * self.r, pts.max(axis=0) + 5 * self.r])
 
 
-def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0, *, forces: bool = False,
-            centres: bool = False) -> Picture:
+def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0, view: str | None = None,
+            world: bool = False, *, forces: bool = False, centres: bool = False) -> Picture:
     """The Picture of `sweep`; `paths` names the points whose paths are drawn (default: every
     moving point); `dense` > 0 solves that many extra poses between each two of the sweep's
     for smooth paths, or is those paths already solved (point -> M x 2, from `dense_paths`:
-    several pictures of one sweep share one solve); `forces`, `centres`: the arrows of the
-    loads, efforts and reactions, the instant centres (views/forces.py)."""
-    geo = geometry(m, sweep)
+    several pictures of one sweep share one solve). A spatial sweep is drawn in `view`
+    (default isometric, `kincas.views.projection`), or kept in space with `world=True`.
+    `forces`, `centres`: the arrows of the loads, efforts and reactions, the instant centres
+    (views/forces.py; planar mechanisms only, ValueError for a spatial one)."""
+    geo = drawn(m, sweep, view, world)
     names, xy = geo.names, geo.xy
     i0 = default_pose(geo.ok)
     pts = xy[np.isfinite(xy).all(axis=2)]
     span = float(np.ptp(pts, axis=0).max()) if pts.size else 0.0
     r = 0.02 * (span if span > 0 else m.size())
     driven = {i.target for i in m.inputs if i.kind == "angle"}
-    colour = {lk.name: COLOURS[k % 10] for k, lk in enumerate(m.links)}
+    links = links_of(m)
+    colour = {lk.name: COLOURS[k % 10] for k, lk in enumerate(links)}
     bodies = []
-    for lk in m.links:
+    for lk in links:
         idx = [names.index(p) for p in lk.point_names]
         ring = idx
-        if len(idx) >= 3:
-            p0 = xy[i0, idx]
-            ring = [idx[k] for k in _hull(p0)] if np.isfinite(p0).all() else idx[:2]
-            x, y = xy[i0, ring].T
+        if len(idx) >= 3:  # the outline in the body's plane (a spatial body: its own plane)
+            p0 = ring_points(geo, i0, idx)
+            hull = _hull(p0) if np.isfinite(p0).all() else [0, 1]
+            ring = [idx[k] for k in hull]
+            x, y = p0[hull].T
             area = 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
             if len(ring) < 3 or not area > (0.5 * r) ** 2:  # collinear: a bar between the farthest
-                far = np.hypot(*(xy[i0, idx] - xy[i0, idx[0]]).T)
+                far = np.hypot(*(p0 - p0[0]).T)
                 ring = [idx[0], idx[int(np.nanargmax(far))]]
         bodies.append(Body(lk.name, ring, colour[lk.name], lk.name in driven))
     guides = []
-    for sl in m.slides:
+    for sl in (sl for sl in m.slides if _on_line(sl, geo)):
         through, d, s = geo.slides[sl.name]
         sv = s[np.isfinite(s)] if np.isfinite(s).any() else np.zeros(1)
         guides.append(Guide(sl.name, names.index(sl.point), through, d, float(sv.min() - 4 * r),
@@ -133,10 +141,10 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0, *, fo
         path_xy = {p: dense[p] for p in chosen}
     else:
         path_xy = dense_paths(m, sweep, chosen, dense) if dense > 0 else {p: geo.point(p) for p in chosen}
-    from .forces import overlay, springs
-    over = overlay(m, sweep, forces=forces, centres=centres, extent=span, geo=geo) if forces or centres else None
+    from .forces import planar_overlay, springs
+    over = planar_overlay(m, sweep, geo, forces, centres, extent=span)
     return Picture(names, xy, geo.ok, [names.index(g) for g in m.ground_points], bodies, guides,
-                   path_xy, r, i0, _joint_curves(m, geo, r),
+                   project_paths(path_xy, geo.view), r, i0, _joint_curves(m, geo, r), geo.depth, geo.view,
                    [(label, names.index(a), names.index(b)) for label, a, b in springs(m)], over)
 
 
@@ -178,7 +186,7 @@ def dense_paths(m: Mechanism, sweep: Sweep, points: list[str], per_step: int) ->
     g = geometry(mm, fsw)
     out = {}
     for p in points:
-        xy = np.full((len(t), 2), np.nan)
+        xy = np.full((len(t), g.xy.shape[2]), np.nan)  # 3 columns in space
         xy[start:] = g.point(p)
         out[p] = xy
     return out

@@ -25,6 +25,8 @@ import numpy as np
 from ..model.mechanism import GROUND, Mechanism
 from ..results import Sweep
 from .poses import Geometry, _hull, check_paths, default_pose, geometry  # noqa: F401  (their old home)
+from .poses import _on_line, links_of
+from .projection import drawn, project_paths, ring_points
 
 PLOT_EXTRA = 'pip install "kincas[plot]"'
 
@@ -84,10 +86,14 @@ class Drawing:
         self.box = np.array([lo, hi])  # the whole sweep fits: an animation keeps its frame
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(True, color="#e6e6e6", lw=0.6, zorder=0)
-        if units:
+        if units and geo.view is None:
             ax.set_xlabel(f"x [{units}]"), ax.set_ylabel(f"y [{units}]")
-        self.colour = {lk.name: f"C{k % 10}" for k, lk in enumerate(m.links)}
-        owner = {p: lk.name for lk in reversed(m.links) for p in lk.point_names}  # the first link
+        elif geo.view is not None:  # a spatial mechanism in a view
+            self._view_axes(units)
+        self.links = links_of(m)  # a spatial mechanism's bodies
+        self.colour = {lk.name: f"C{k % 10}" for k, lk in enumerate(self.links)}
+        owner = {p: lk.name for lk in reversed(self.links) for p in lk.point_names}  # the first link
+        path_xy = project_paths(path_xy, geo.view)  # a spatial sweep's paths, drawn in its view
         for p in paths:  # a path in its link's colour; NaN at unsolved poses breaks the line
             xy = path_xy[p] if path_xy and p in path_xy else geo.point(p)
             if np.isfinite(xy).all(axis=1).sum() >= 2:
@@ -135,20 +141,21 @@ class Drawing:
         from matplotlib.patches import Polygon
         self.bodies = []  # (kind, artist, indices of the points drawn)
         driven = {i.target for i in self.m.inputs if i.kind == "angle"}
-        for lk in self.m.links:
+        for lk in self.links:
             idx = [self.geo.names.index(p) for p in lk.point_names]
             c, ring = self.colour[lk.name], idx
-            if len(idx) >= 3:
-                pts = self.geo.xy[self.i0, idx]
-                ring = [idx[k] for k in _hull(pts)] if np.isfinite(pts).all() else idx[:2]
-                x, y = self.geo.xy[self.i0, ring].T
+            if len(idx) >= 3:  # the outline in the body's plane (a spatial body: its own plane)
+                pts = ring_points(self.geo, self.i0, idx)
+                hull = _hull(pts) if np.isfinite(pts).all() else [0, 1]
+                ring = [idx[k] for k in hull]
+                x, y = pts[hull].T
                 area = 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))  # shoelace
                 if len(ring) >= 3 and area > (0.5 * self.r) ** 2:
                     patch = Polygon(np.zeros((len(ring), 2)), closed=True, fc=c, ec=c, alpha=0.45,
                                     lw=2.5, zorder=3)
                     self.bodies.append(("polygon", self.ax.add_patch(patch), ring))
                     continue
-                far = np.hypot(*(self.geo.xy[self.i0, ring] - self.geo.xy[self.i0, ring[0]]).T)
+                far = np.hypot(*(pts[hull] - pts[hull[0]]).T)
                 ring = [ring[0], ring[int(np.argmax(far))]]
             line, = self.ax.plot([], [], "-", lw=5, color=c, solid_capstyle="round",
                                  zorder=4.5 if lk.name in driven else 4, label=lk.name)
@@ -162,7 +169,7 @@ class Drawing:
         from matplotlib.collections import LineCollection
         from matplotlib.patches import Polygon
         self.guides = []  # (slide, [(side, rail)], block, hatch or None)
-        for sl in self.m.slides:
+        for sl in (sl for sl in self.m.slides if _on_line(sl, self.geo)):
             sides = (-1.0, 1.0)
             if sl.along == GROUND:
                 sides = self._free_sides(sl)
@@ -184,7 +191,7 @@ class Drawing:
         t = np.linspace(0.0, 1.0, 17)[None, :, None]
         samples = [xy[:, [names.index(p)]] for p in self.m.ground_points + self.m.moving_points
                    if p != sl.point]
-        for lk in self.m.links:  # points along every pair of a body's points: its bars and edges
+        for lk in self.links:  # points along every pair of a body's points: its bars and edges
             idx = [names.index(p) for p in lk.point_names]
             for a in range(len(idx)):
                 for b in range(a + 1, len(idx)):
@@ -206,7 +213,7 @@ class Drawing:
         """Joints (on two bodies or more, the ground counting as one) as rings, other points
         as dots, and the name of each."""
         names, m = self.geo.names, self.m
-        count = Counter([p for lk in m.links for p in lk.point_names] + list(m.ground_points))
+        count = Counter([p for lk in self.links for p in lk.point_names] + list(m.ground_points))
         joints = [k for k, p in enumerate(names) if count[p] >= 2]
         self.joints = (joints, self.ax.plot([], [], "o", ms=6, mfc=PAPER, mec=INK, mew=1.3,
                                             ls="none", zorder=6)[0])
@@ -215,6 +222,27 @@ class Drawing:
         self.labels = [self.ax.text(0, 0, p, fontsize=8, zorder=7, ha="center", va="center",
                                     bbox=dict(fc=PAPER, ec="none", alpha=0.75, pad=0.3))
                        for p in names] if labels else []
+
+    def _view_axes(self, units: str):
+        """A spatial mechanism's view: the drawing's axes named after the world's where the view
+        looks along one of them, and a cross of the world axes x, y, z in a corner."""
+        from .projection import triad
+        ax, view = self.ax, self.geo.view
+        u = f" [{units}]" if units else ""
+        if view in ("xy", "yz", "zx"):
+            ax.set_xlabel(view[0] + u), ax.set_ylabel(view[1] + u)
+        else:  # an oblique view has no true scale along its axes: no ticks
+            ax.set_xticklabels([]), ax.set_yticklabels([])
+            ax.set_xlabel(f"{view} view" + u)
+        o = np.array([0.07, 0.09])
+        for k, v in triad(view):
+            if np.hypot(*v) < 1e-9:  # seen end on: a dot
+                ax.plot(*o, "o", ms=3, color=INK, transform=ax.transAxes, zorder=8)
+                continue
+            e = o + 0.06 * v
+            ax.annotate("", xy=e, xytext=o, xycoords="axes fraction",
+                        arrowprops=dict(arrowstyle="->", color=INK, lw=1.0), zorder=8)
+            ax.text(*(o + 0.085 * v), k, transform=ax.transAxes, fontsize=8, ha="center", va="center", zorder=8)
 
     # --- moving to a pose ---
     def update(self, i: int, caption: str = ""):
@@ -227,6 +255,11 @@ class Drawing:
             else:
                 artist.set_visible(bool(np.isfinite(xy[idx]).all()))
                 artist.set_xy(np.nan_to_num(xy[idx]))
+        if geo.depth is not None and 0 <= i < len(geo.ok):  # in space: the nearer bodies over the farther
+            from .projection import depth_order
+            order = depth_order(geo.depth[i], [idx for _, _, idx in self.bodies])
+            for rank, k in enumerate(order):
+                self.bodies[k][1].set_zorder(3 + 1.9 * rank / max(len(order), 1))
         for sl, rails, block, hatch in self.guides:
             through, d, s = (a[i] for a in geo.slides[sl.name])
             fixed = bool(np.isfinite(through).all() and np.isfinite(d).all())  # the guide is there
@@ -290,12 +323,14 @@ def caption(sweep: Sweep, i: int) -> str:
 
 def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=None,
          labels: bool = True, title: str | None = None, units: str = "", path_xy=None,
-         forces: bool = False, centres: bool = False):
+         view: str | None = None, forces: bool = False, centres: bool = False):
     """Draw `m` at pose `pose` of `sweep` (default: the first solved) with the paths of
     `paths` (default: every moving point) over the sweep; returns the matplotlib Axes.
     `path_xy`: those paths already solved (point -> M x 2, `smooth_paths`), else solved here.
+    A spatial mechanism is drawn in `view` ("iso", the default, "xy", "yz" or "zx";
+    `kincas.views.projection`), a planar one in its plane.
     `forces`: arrows for the loads, springs' pulls, efforts and joint reactions; `centres`:
-    each link's instant centre (kincas/views/forces.py). Springs are always drawn.
+    each link's instant centre (kincas/views/forces.py), planar only. Springs are always drawn.
 
     Links with two points are bars, links with three or more are filled polygons, ground
     pivots stand on hatched bases, slides show their guide and block; axes have equal scales.
@@ -307,11 +342,9 @@ def draw(m: Mechanism, sweep: Sweep, pose: int | None = None, *, ax=None, paths=
     paths = check_paths(m, paths)
     i = default_pose(sweep) if pose is None else int(pose) % max(len(sweep), 1)  # -1: the last
     smooth = smooth_paths(m, sweep, paths) if path_xy is None else {p: path_xy[p] for p in paths}
-    geo, ov = geometry(m, sweep), None
-    if forces or centres:
-        from .forces import overlay
-        ov = overlay(m, sweep, forces=forces, centres=centres, geo=geo)
-    d = Drawing(ax, m, geo, paths, labels, units, smooth, ov)
+    from .forces import planar_overlay
+    geo = drawn(m, sweep, view)
+    d = Drawing(ax, m, geo, paths, labels, units, smooth, planar_overlay(m, sweep, geo, forces, centres))
     d.update(i, caption(sweep, i) if title is None else title)
     return ax
 

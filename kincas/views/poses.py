@@ -17,7 +17,10 @@ from ..results import Sweep
 class Geometry:
     """World positions over a sweep: `xy[i, k]` is point `names[k]` at pose i (NaN when the
     pose was not solved); each slide's line at each pose as a point `through` (N x 2), a unit
-    direction `direction` (N x 2) and the slide coordinate `s` (N,) of its point.
+    direction `direction` (N x 2) and the slide coordinate `s` (N,) of its point. A spatial
+    sweep has 3 columns where a planar one has 2; drawn in a view
+    (`kincas.views.projection.project`) it has 2 again, and `depth` (N x K, larger farther from
+    the viewer), `world` (the N x K x 3 positions) and `view` (its name) are set.
 
     >>> import numpy as np, kincas
     >>> m = kincas.Mechanism(ground={"O": (0, 0)},
@@ -34,9 +37,12 @@ class Geometry:
     slides: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]
     ok: np.ndarray
     joints: object = field(default=None, repr=False)  # gears, racks, cams: views/draw_joints.py
+    depth: np.ndarray | None = field(default=None, repr=False)
+    world: np.ndarray | None = field(default=None, repr=False)
+    view: str | None = None
 
     def point(self, name: str) -> np.ndarray:
-        """(N x 2) positions of one point."""
+        """(N x 2) positions of one point (N x 3 in space)."""
         return self.xy[:, self.names.index(name)]
 
 
@@ -91,6 +97,36 @@ def default_pose(sweep: Sweep | np.ndarray) -> int:
     """The pose drawn when none is asked for: the first one solved (0 when none was)."""
     k = np.flatnonzero(sweep.ok if isinstance(sweep, Sweep) else sweep)
     return int(k[0]) if k.size else 0
+
+
+def is_spatial(m) -> bool:
+    """True for a mechanism declared in space (`space = "3d"`): one that has a `space`
+    attribute "3d". Planar mechanisms have none (or "2d").
+
+    >>> import kincas
+    >>> is_spatial(kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("c", "O", "A", 1)],
+    ...                             inputs=[kincas.Input.angle("c")]))
+    False
+    """
+    return str(getattr(m, "space", "2d")).lower() == "3d"
+
+
+def _on_line(sl, geo) -> bool:
+    """A slide the pictures draw: one on a line whose line the geometry has (a spatial slide
+    on a plane keeps its point on a plane: no guide, no block)."""
+    return getattr(sl, "on_line", True) and sl.name in geo.slides
+
+
+def links_of(m) -> tuple:
+    """The bodies a picture draws: a planar mechanism's `links`, a spatial one's `bodies`
+    (each with `name` and `point_names`).
+
+    >>> import kincas
+    >>> [lk.name for lk in links_of(kincas.Mechanism(ground={"O": (0, 0)},
+    ...     links=[kincas.Link.bar("c", "O", "A", 1)], inputs=[kincas.Input.angle("c")]))]
+    ['c']
+    """
+    return tuple(m.links if hasattr(m, "links") else m.bodies)
 
 
 def check_paths(m: Mechanism, paths) -> list[str]:

@@ -5,6 +5,10 @@ vector program measures true lengths: each bar is a `<line data-link=NAME>`, eac
 three or more points a `<polygon data-link=NAME>`, each point a `<circle data-point=NAME>`,
 each path one or more `<polyline data-path=NAME>` (broken where poses were not solved), each
 slide's guide a `<line data-slide=NAME>` and its block a `<polygon data-block=NAME>`.
+A spatial mechanism is drawn in a view (`view`: "iso", the default, "xy", "yz", "zx"; see
+`kincas.views.projection`): coordinates are then the view's (right, up), true lengths only
+parallel to the drawing plane, the root carries `data-view`, bodies are drawn farthest first
+and a cross of the world axes stands in the lower left corner (`<g id="triad">`).
 
 >>> import io, numpy as np, kincas, xml.etree.ElementTree as ET
 >>> m = kincas.Mechanism(ground={"O": (0, 0)},
@@ -67,12 +71,13 @@ def svg_size(w: float, h: float, units: str, width: float = 800) -> tuple[str, s
 
 
 def svg_text(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None, scene=None,
-             dense: int = 0, width: float = 800, forces: bool = False, centres: bool = False,
-             units: str | None = None) -> str:
-    """The SVG document: the drawing at `pose` (default: the first solved) and the paths;
-    `forces`, `centres`: arrows and instant centres (views/forces.py). Sized at true scale
-    in the scene's length unit (`units`, default the scene's; see `svg_size`)."""
-    pic = picture(m, sweep, paths, dense, forces=forces, centres=centres)
+             dense: int = 0, width: float = 800, view: str | None = None, forces: bool = False,
+             centres: bool = False, units: str | None = None) -> str:
+    """The SVG document: the drawing at `pose` (default: the first solved) and the paths
+    (a spatial mechanism in `view`); `forces`, `centres`: arrows and instant centres
+    (views/forces.py, planar only). Sized at true scale in the scene's length unit (`units`,
+    default the scene's; see `svg_size`)."""
+    pic = picture(m, sweep, paths, dense, view, forces=forces, centres=centres)
     i = pic.first if pose is None else int(pose) % max(len(sweep), 1)
     xy = pic.xy[i]
     (x0, y0), (x1, y1) = pic.box()
@@ -84,7 +89,8 @@ def svg_text(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None,
     title = getattr(getattr(scene, "study", None), "title", "") or "kincas"
     out = ['<?xml version="1.0" encoding="UTF-8"?>',
            f'<svg xmlns="http://www.w3.org/2000/svg" width="{wide}" height="{high}" '
-           f'viewBox="{_f(x0)} {_f(-y1)} {_f(w)} {_f(h)}" data-units={quoteattr(units)}>',
+           f'viewBox="{_f(x0)} {_f(-y1)} {_f(w)} {_f(h)}" data-units={quoteattr(units)}'
+           + (f' data-view="{pic.view}">' if pic.view else ">"),
            f"<title>{escape(title)}</title>",
            '<rect x="%s" y="%s" width="%s" height="%s" fill="white"/>' % (_f(x0), _f(-y1), _f(w), _f(h)),
            '<g transform="scale(1,-1)" stroke-linecap="round" stroke-linejoin="round">']
@@ -122,7 +128,7 @@ def svg_text(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None,
                        f'stroke="{INK}" stroke-width="{_f(0.3 * sw_)}"/>')
     out.append("</g>")
     out.append('<g id="bodies">')
-    for b in sorted(pic.bodies, key=lambda b: b.driven):
+    for b in _order(pic, i):
         pts = xy[b.ring]
         if not np.isfinite(pts).all():
             continue
@@ -166,6 +172,8 @@ def svg_text(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None,
             out.append(f'<circle data-point={quoteattr(name)} cx="{_f(x)}" cy="{_f(y)}" r="{_f(0.7 * r)}" '
                        f'fill="white" stroke="{INK}" stroke-width="{_f(0.3 * sw_)}"/>')
     out.append("</g></g>")
+    if pic.view:
+        out += _triad(pic.view, x0, -y0, r, sw_)
     out.append(f'<g id="labels" font-family="sans-serif" font-size="{_f(2.2 * r)}" fill="{INK}" '
                f'text-anchor="middle" dominant-baseline="central">')
     from .labels import picture_labels
@@ -174,6 +182,31 @@ def svg_text(m: Mechanism, sweep: Sweep, pose: int | None = None, *, paths=None,
         out.append(f'<text x="{_f(x)}" y="{_f(-y)}">{escape(name)}</text>')
     out.append("</g></svg>")
     return "\n".join(out) + "\n"
+
+
+def _order(pic, i: int) -> list:
+    """The bodies in drawing order: planar, the driven ones last (on top); in a view, the
+    farthest first."""
+    if pic.depth is None or not 0 <= i < len(pic.depth):
+        return sorted(pic.bodies, key=lambda b: b.driven)
+    from .projection import depth_order
+    return [pic.bodies[k] for k in depth_order(pic.depth[i], [b.ring for b in pic.bodies])]
+
+
+def _triad(view: str, x: float, y: float, r: float, sw_: float) -> list[str]:
+    """The world axes x, y, z as drawn in `view`, from the lower left corner (x, y) of the
+    picture in SVG's own coordinates (y downwards)."""
+    from .projection import triad
+    o = np.array([x + 6 * r, y - 6 * r])
+    out = [f'<g id="triad" stroke="{INK}" stroke-width="{_f(0.3 * sw_)}" font-family="sans-serif" '
+           f'font-size="{_f(2 * r)}" fill="{INK}">']
+    for k, v in triad(view):
+        e, t = o + 4 * r * np.array([v[0], -v[1]]), o + 5.5 * r * np.array([v[0], -v[1]])
+        out.append(f'<line data-axis="{k}" x1="{_f(o[0])}" y1="{_f(o[1])}" x2="{_f(e[0])}" y2="{_f(e[1])}"/>')
+        out.append(f'<text x="{_f(t[0])}" y="{_f(t[1])}" stroke="none" text-anchor="middle" '
+                   f'dominant-baseline="middle">{k}</text>')
+    out.append("</g>")
+    return out
 
 
 def _overlay(pic, i: int, r: float, sw_: float) -> list[str]:
