@@ -237,7 +237,7 @@ def sweep_designs(m: Mechanism, params, inputs=None, *, names=None, rates=None,
     P[:, [pnames.index(k) for k in names]] = X
     P = np.ascontiguousarray(P)
     Ls = np.ascontiguousarray(_sizes(m, P, pnames))
-    g = {k: (m.value(x), m.value(y)) for k, (x, y) in {**dict(m.guess), **dict(guess or {})}.items()}
+    g = {k: tuple(map(m.value, xy)) for k, xy in {**dict(m.guess), **dict(guess or {})}.items()}
     job = _Job(model, m, report, U, Ud, Udd, P, Ls, g, compile, progress)
     job.backend = backend
     workers = workers or os.cpu_count() or 1

@@ -132,7 +132,7 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
     L = m_at.size()
 
     # The mechanism's own guess is start 0, so the mode a sweep would take is always found.
-    guess = {k: (m_at.value(x), m_at.value(y)) for k, (x, y) in m.guess}
+    guess = {k: tuple(map(m_at.value, xy)) for k, xy in m.guess}
     Q = np.vstack([model.initial_q(u, p, guess, L), _scatter(m_at, model, starts - 1, L, seed)])
     if tied(model).any():  # gears, racks: each start at the turns their relations want
         Q = np.array([turns(model, q, u, p) for q in Q])

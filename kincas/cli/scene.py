@@ -38,7 +38,7 @@ from ..results import Sweep
 from .scene_study import StudyReader
 
 LARGEST = 1e100  # beyond it, squared lengths overflow double precision
-SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
+SECTIONS = {"title", "space", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
             "output", "optimize", "tolerance", "gravity", "loads", "study", "gears", "racks",
             "cams", "cam_design"}
 
@@ -244,6 +244,12 @@ class _Reader(StudyReader):
     # --- sections ---
     def scene(self) -> Scene:
         doc = self.doc
+        space = doc.get("space", "2d")
+        if space == "3d":  # a spatial scene: kincas/cli/scene_space.py
+            from .scene_space import SpaceReader
+            return SpaceReader(doc).scene()
+        if space != "2d":
+            self.err(f"space: expected \"2d\" or \"3d\", got {space!r}")
         for k in doc:
             if k not in SECTIONS:
                 self.err(f"scene: unknown section or key {k!r} (expected {sorted(SECTIONS)})")

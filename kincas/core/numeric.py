@@ -81,7 +81,11 @@ def model_of(m: Mechanism, check: bool = True) -> "Model":
     (2, [2], True)
     """
     # built once per structure, however many threads ask (Symbolic never reads parameter values)
-    model = _CACHE.get_or_build(_structure_key(m), lambda: Model(Symbolic(m)))
+    if getattr(m, "space", "2d") == "3d":  # a spatial mechanism: the same interface
+        from .space_model import SpatialModel, structure_key
+        model = _CACHE.get_or_build(structure_key(m), lambda: SpatialModel(m))
+    else:
+        model = _CACHE.get_or_build(_structure_key(m), lambda: Model(Symbolic(m)))
     if check and needs_rank_test(m):
         decide(m, model)
     return model
@@ -150,7 +154,7 @@ class Model(FirstPose):
         self.nq, self.nu, self.ng = sym.nq, sym.nu, sym.ng
         self.square = self.ng == self.nq  # tall: redundant joints (a consistent system)
         m = sym.mech
-        locs = [sym.val(c) for lk in m.links for _, xy in lk.points for c in xy]
+        locs = [c for lk in m.links for xy in sym.local_points(lk) for c in xy]
         self.f_local = ca.Function("local", [sym.u, sym.p], [ca.vertcat(*locs)])
         gxy = [c for g, _ in m.ground for c in sym.points[g]]
         self.f_ground = ca.Function("ground", [sym.u, sym.p], [ca.vertcat(*gxy) if gxy else ca.SX(0, 1)])
@@ -289,7 +293,7 @@ class Model(FirstPose):
         return self._resjac(q, u, p)[1]
 
     def points(self, q, u, p) -> np.ndarray:
-        """World positions of the moving points, 2 x n."""
+        """World positions of the moving points, 2 x n (3 x n in space)."""
         return np.asarray(self.sym.f_points(q, u, p))
 
     def memo(self, key, build):
@@ -354,4 +358,4 @@ class Model(FirstPose):
             return np.zeros((0, 0))
         f = self.sym.f_points.map(n)
         pts = np.asarray(f(Q.T, np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)))
-        return pts.reshape(2, -1, n, order="F").transpose(2, 1, 0).reshape(n, -1)
+        return pts.reshape(self.sym.dim, -1, n, order="F").transpose(2, 1, 0).reshape(n, -1)
