@@ -70,8 +70,12 @@ def axis_rotation(a, angle) -> np.ndarray:
 
 
 def kabsch(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """The rotation R minimising sum |R a_i - b_i|^2 (rows of A and B, already centred)."""
-    U, _, Vt = np.linalg.svd(B.T @ A)
+    """The rotation R minimising sum |R a_i - b_i|^2 (rows of A and B, already centred).
+    Where the points leave it undecided (two points, or points on a line: a turn about
+    their line costs nothing), the one nearest the identity: a faint pull towards it is
+    added to the correlation matrix (the drawing pose's orientation is the identity)."""
+    H = B.T @ A
+    U, _, Vt = np.linalg.svd(H + 1e-9 * (np.trace(A.T @ A) + 1e-300) * np.eye(3))
     D = np.diag([1.0, 1.0, np.sign(np.linalg.det(U @ Vt)) or 1.0])
     return U @ D @ Vt
 

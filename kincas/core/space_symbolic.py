@@ -15,7 +15,10 @@ A joint's angle comes from the relative quaternion conj(e1) (x) e2 = (w, v): a r
 the unit axis a by theta has v = sin(theta/2) a, w = cos(theta/2), so with s = v.a,
 theta = atan2(2 s w, w^2 - s^2), wrapped in (-pi, pi]. An input driving it adds
 s cos(u/2) - w sin(u/2) = sin((theta - u)/2) = 0: e and -e (the same rotation) both satisfy
-it, and theta = u + 2k pi only (no spurious branch).
+it, and theta = u + 2k pi only (no spurious branch). A revolute joint keeps v along a
+(v.b1 = v.b2 = 0 for b1, b2 perpendicular to a): regular at every angle (the Jacobian of
+(v.b1, v.b2) in the rotations about b1, b2 has determinant (w^2 + s^2) / 4 = 1/4), and
+without the flipped assembly R2 a = -R1 a that (R2 a).(R1 b) = 0 would admit.
 
 >>> import kincas
 >>> from kincas import SpatialMechanism, Body, Joint, Input
@@ -232,8 +235,11 @@ class SpatialSymbolic(Symbolic):
         a = list(j.axis)
         b1v, b2v = (list(v) for v in perpendiculars(a))
         if j.type in ("revolute", "cylindrical", "planar"):
-            eqs += [Ls * dot(apply(R2, a), apply(R1, b1v)), Ls * dot(apply(R2, a), apply(R1, b2v))]
+            # a rotation about a alone: the relative quaternion's vector part along a. (Keeping
+            # R2 a perpendicular to R1 b1 and R1 b2 instead would also admit R2 a = -R1 a: a
+            # spurious assembly half a turn away that a sweep can fall into.)
             w, *v = self._relative(b1, b2)
+            eqs += [Ls * dot(v, b1v), Ls * dot(v, b2v)]
             self.joint_q[f"{name}.angle"] = joint_angle(w, dot(v, a))
             self._half[f"{name}.angle"] = (w, dot(v, a))
         if j.type in ON_SECOND:
