@@ -110,6 +110,7 @@ class SpatialModel(Model):
         drawn, gv = self._drawn(u, p)
         index = {name: i for i, (name, _) in enumerate(sym.unknowns)}
         q = np.zeros(self.nq)
+        o = gv[m.ground[0][0]] if m.ground else np.zeros(3)  # the model's origin
         pose = {GROUND: (np.zeros(3), np.eye(3), np.zeros(3))}  # body -> (r, R, c)
         for b in m.bodies:
             if b.two_point:
@@ -133,14 +134,14 @@ class SpatialModel(Model):
         for name, (r, R, c) in pose.items():
             if name == GROUND:
                 continue
-            for a, v in zip("xyz", r):
+            for a, v in zip("xyz", r - o):
                 q[index[f"{name}.r{a}"]] = v
             for a, v in zip("wxyz", quat_of(R)):
                 q[index[f"{name}.q{a}"]] = v
         for pt in m.moving_points:
             if f"{pt}.x" in index:
-                for a, v in zip("xyz", guess[pt]):
-                    q[index[f"{pt}.{a}"]] = float(v)
+                for a, v, oa in zip("xyz", guess[pt], o):
+                    q[index[f"{pt}.{a}"]] = float(v) - oa
         return q
 
     @staticmethod

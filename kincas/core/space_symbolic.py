@@ -4,7 +4,9 @@ that Newton, sweeps, singular flags, sensitivities and the compiled kernels use 
 Formulation (docs/spatial.md): absolute coordinates with unit quaternions. A moving rigid
 body has unknowns r (3, its reference point: at the drawing pose the centroid c of its
 drawn points) and e = (w, x, y, z) (4), with e.e - 1 = 0; its point P (drawn at P0) is
-r + R(e) (P0 - c), R(e) the quadratic rotation matrix of e. A point that only two-point bars
+r + R(e) (P0 - c), R(e) the quadratic rotation matrix of e. Every position inside is taken
+relative to the first ground point (added back to reported positions), so a mechanism far
+from the global origin keeps its residuals' and steps' relative accuracy. A point that only two-point bars
 carry has its 3 coordinates as unknowns; a bar adds (|P - Q|^2 - L^2) / L = 0. Every
 equation is polynomial in (r, e). Equations without a length (a quaternion's norm, axes kept
 perpendicular) are multiplied by the mechanism's size `Ls`, so that every residual is a
@@ -122,13 +124,16 @@ class SpatialSymbolic(Symbolic):
         self.Ls = self._size()
         Ls = self.Ls
         self._half, self._sc = {}, {}  # per joint angle: (w, s) of its half angle; (sin, cos)
-        self.points = {g: self._xyz(xyz) for g, xyz in m.ground}
+        # coordinates relative to the first ground point: far from the global origin, the
+        # residuals (differences of nearby points) and the steps keep their relative accuracy
+        self.origin = self._xyz(m.ground[0][1]) if m.ground else [ca.SX(0)] * 3
+        self.points = {g: self._rel(xyz) for g, xyz in m.ground}
         self.frames = {GROUND: ([ca.SX(0)] * 3, [ca.SX(c) for c in IDENTITY], [ca.SX(0)] * 3)}
         exempt = m.exempt()
         for b in m.bodies:
             if b.two_point:
                 continue
-            loc = {p: self._xyz(xyz) for p, xyz in b.points}
+            loc = {p: self._rel(xyz) for p, xyz in b.points}
             c = [sum(v[i] for v in loc.values()) / len(loc) for i in range(3)]
             r = [new(f"{b.name}.r{a}", "length") for a in "xyz"]
             e = [new(f"{b.name}.q{a}", "quaternion") for a in "wxyz"]
@@ -157,7 +162,7 @@ class SpatialSymbolic(Symbolic):
         for sl in m.slides:
             r1, e1, c1 = self.frames[sl.along]
             R1 = rotation(e1)
-            X1 = self.world(sl.along, self._xyz(sl.through))
+            X1 = self.world(sl.along, self._rel(sl.through))
             d = [self.points[sl.point][i] - X1[i] for i in range(3)]
             if sl.on_line:
                 b1, b2 = perpendiculars(sl.direction)
@@ -172,11 +177,16 @@ class SpatialSymbolic(Symbolic):
             elif i.kind == "joint":
                 eqs.append(self._input_equation(i.target, u))
         self.angles = {}
+        self.points = {k: [v[i] + self.origin[i] for i in range(3)] for k, v in self.points.items()}
         self._finish(qs, eqs)
 
     # --- numbers, frames ---
     def _xyz(self, xyz):
         return [self.val(c) for c in xyz]
+
+    def _rel(self, xyz):
+        """A drawn point relative to the model's origin (the first ground point)."""
+        return [self.val(c) - o for c, o in zip(xyz, self.origin)]
 
     def world(self, body, P0):
         """Where the point drawn at P0 (global, drawing pose) is when `body` has moved."""
@@ -243,7 +253,7 @@ class SpatialSymbolic(Symbolic):
             self.joint_q[f"{name}.angle"] = joint_angle(w, dot(v, a))
             self._half[f"{name}.angle"] = (w, dot(v, a))
         if j.type in ON_SECOND:
-            P0 = self._xyz(next(xyz for b in m.bodies if b.name == b2 for p, xyz in b.points if p == j.point))
+            P0 = self._rel(next(xyz for b in m.bodies if b.name == b2 for p, xyz in b.points if p == j.point))
             X1 = self.world(b1, P0)
             d = [self.points[j.point][i] - X1[i] for i in range(3)]
             if j.type == "planar":
