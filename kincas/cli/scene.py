@@ -246,8 +246,8 @@ class _Reader(StudyReader):
         doc = self.doc
         space = doc.get("space", "2d")
         if space == "3d":  # a spatial scene: kincas/cli/scene_space.py
-            from .scene_space import SpaceReader
-            return SpaceReader(doc).scene()
+            from .scene_space import read_space
+            return read_space(self, Scene, Study)
         if space != "2d":
             self.err(f"space: expected \"2d\" or \"3d\", got {space!r}")
         for k in doc:

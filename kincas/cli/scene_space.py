@@ -30,7 +30,6 @@ from ..errors import KincasError, ModelError, SceneError
 from ..model.mechanism import GROUND, Input
 from ..model.space import SpatialMechanism
 from ..model.space_parts import JOINT_TYPES, Body, Joint, SpatialSlide
-from .scene import Scene, Study, _Reader
 
 SPACE_SECTIONS = {"title", "space", "units", "parameters", "ground", "links", "joints", "slides",
                   "inputs", "guess", "output", "optimize", "tolerance", "study"}
@@ -38,10 +37,27 @@ PLANAR_ONLY = {"gears": "gears", "racks": "racks", "cams": "cams", "cam_design":
 NOT_YET = {"gravity", "loads"}  # efforts in 3D: not built in this version
 
 
-class SpaceReader(_Reader):
-    """The reader of a spatial scene (see the module's text)."""
+INPUT_KINDS = ("joint", "parameter", "slide")
 
-    INPUT_KINDS = ("joint", "parameter", "slide")
+
+def read_space(reader, scene_type, study_type):
+    """The Scene of a spatial document, read by the planar scene reader `reader` (its problems
+    list, numbers and parameters, `[[inputs]]` and `[output]`) with the 3D sections below;
+    `scene_type` and `study_type` are kincas/cli/scene.py's Scene and Study."""
+    return _Space(reader).scene(scene_type, study_type)
+
+
+class _Space:
+    """The 3D sections, read into a planar scene reader's problems (see the module's text)."""
+
+    def __init__(self, r):
+        self.r = r
+        r.INPUT_KINDS = INPUT_KINDS  # the reader's [[inputs]] take joints, named here
+        r.make_input = self.make_input
+        self.joint_list = []
+
+    def __getattr__(self, name):  # err, num, value, fields, table, array, inputs, output, ...
+        return getattr(self.r, name)
 
     def xyz(self, where, v):
         if not isinstance(v, list) or len(v) != 3:
@@ -60,7 +76,7 @@ class SpaceReader(_Reader):
             return None
         return tuple(float(c) for c in v)
 
-    def scene(self) -> Scene:
+    def scene(self, Scene, Study):
         doc = self.doc
         for k in doc:
             if k in PLANAR_ONLY:
@@ -105,7 +121,7 @@ class SpaceReader(_Reader):
         keys = dict(zip([i.key for i in inputs], [i.key for i in m.inputs]))
         values, rates, accs, written = ({keys.get(k, k): v for k, v in d.items()}
                                         for d in (values, rates, accs, written))
-        self.jerks = {keys.get(k, k): v for k, v in self.jerks.items()}
+        self.r.jerks = {keys.get(k, k): v for k, v in self.jerks.items()}
         self.check_quantities(m, report, sens)
         study = Study(title=title if isinstance(title, str) else "", units=self.units,
                       inputs=values, rates=rates, accelerations=accs, report=report,
@@ -202,7 +218,7 @@ class SpaceReader(_Reader):
         if kind != "joint":
             return Input(kind, name)
         jname, _, coord = name.partition(".")
-        joints = {j.name: j for j in getattr(self, "joint_list", [])}
+        joints = {j.name: j for j in self.joint_list}
         if jname not in joints:
             self.err(f"{where}: joint: unknown joint {jname!r} (a joint is named by `name`, "
                      f"default its point)")

@@ -33,6 +33,8 @@ from .caches import Memo
 from .first_pose import FirstPose
 from .newton import lsolve as _lsolve, newton as _newton
 from .redundant import decide
+from .space_model import SpatialFirstPose, structure_key as _space_key
+from .space_symbolic import SpatialSymbolic
 from .structure import Structure
 from .symbolic import Symbolic
 from .tolerances import ACCEPT, IPOPT_TOL, MAX_ITER, MAX_STEP, REGULARIZE, TOL  # noqa: F401  (their old home)
@@ -82,8 +84,7 @@ def model_of(m: Mechanism, check: bool = True) -> "Model":
     """
     # built once per structure, however many threads ask (Symbolic never reads parameter values)
     if getattr(m, "space", "2d") == "3d":  # a spatial mechanism: the same interface
-        from .space_model import SpatialModel, structure_key
-        model = _CACHE.get_or_build(structure_key(m), lambda: SpatialModel(m))
+        model = _CACHE.get_or_build(_space_key(m), lambda: SpatialModel(m))
     else:
         model = _CACHE.get_or_build(_structure_key(m), lambda: Model(Symbolic(m)))
     if check and needs_rank_test(m):
@@ -359,3 +360,11 @@ class Model(FirstPose):
         f = self.sym.f_points.map(n)
         pts = np.asarray(f(Q.T, np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)))
         return pts.reshape(self.sym.dim, -1, n, order="F").transpose(2, 1, 0).reshape(n, -1)
+
+
+class SpatialModel(SpatialFirstPose, Model):
+    """`Model` of a spatial mechanism (kincas/core/space_symbolic.py): the same numerics, its
+    first pose from the drawing pose (kincas/core/space_model.py)."""
+
+    def __init__(self, m):
+        Model.__init__(self, SpatialSymbolic(m))

@@ -64,9 +64,6 @@ ASSEMBLIES = 8  # distinct assemblies examined at most (a wrong mechanism pays f
 def _start_inputs(m) -> np.ndarray:
     """Input values read off the guess: an angle input takes the angle that points its link
     at a guessed or ground point, a driven parameter its declared value, a slide 0."""
-    if getattr(m, "space", "2d") == "3d":  # the drawing pose: joint coordinates 0
-        from .numeric import model_of
-        return model_of(m, check=False).drawing_inputs(np.array([v for _, v in m.parameters], float))
     known = {k: tuple(map(m.value, xy)) for k, xy in (*m.ground, *m.guess)}
     u = []
     for inp in m.inputs:
@@ -158,7 +155,9 @@ def _starts(m, chain, rng) -> list[np.ndarray]:
     input whose link has no guessed point is otherwise a blind 0.3 rad, inconsistent with
     the guessed points: Gauss-Newton from there may end anywhere)."""
     guess = {k: tuple(map(m.value, xy)) for k, xy in m.guess}
-    u0 = _start_inputs(m)
+    # a spatial model starts where it is drawn: joint coordinates 0 (kincas/core/space_model.py)
+    drawn = getattr(chain.model, "drawing_inputs", None)
+    u0 = _start_inputs(m) if drawn is None else drawn(chain.p)
     us = [u0]
     for k, inp in enumerate(m.inputs):
         if inp.kind == "angle":

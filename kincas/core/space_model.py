@@ -1,5 +1,6 @@
-"""The numeric model of a spatial mechanism: `Model` (kincas/core/numeric.py) on the spatial
-symbolic model, with the first pose placed from the drawing pose and the guess.
+"""The first pose of a spatial mechanism, a part of its numeric model (`SpatialModel`,
+kincas/core/numeric.py: `Model` on the spatial symbolic model), placed from the drawing pose
+and the guess.
 
 Every body starts at the least-squares rigid fit of its drawn points to their guessed
 positions (Kabsch: the rotation R minimising sum |R a_i - b_i|^2 over centred points, from the
@@ -23,8 +24,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.mobility import GROUND
-from .numeric import Model
-from .space_symbolic import SpatialSymbolic, perpendiculars  # noqa: F401
 
 
 def structure_key(m):
@@ -80,15 +79,13 @@ def kabsch(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     return U @ D @ Vt
 
 
-class SpatialModel(Model):
-    """`Model` of a spatial mechanism: only its first pose differs."""
+class SpatialFirstPose:
+    """The first pose of a spatial `Model` (kincas/core/numeric.py `SpatialModel`), which
+    supplies the symbolic model and its geometry call."""
 
     # group by group assembly (kincas/core/assembly.py) spreads starts by turning angles;
     # a quaternion's components are not turned so: the start near the last pose, and one more
     assembly_starts = 2
-
-    def __init__(self, m):
-        super().__init__(SpatialSymbolic(m))
 
     def _drawn(self, u, p):
         """Per rigid body its drawn points (n x 3); the ground points by name."""

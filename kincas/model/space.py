@@ -24,7 +24,7 @@ from ..errors import ModelError
 from .checks import _number_check
 from .mobility import GROUND, Structure
 from .parts import Input, Num, as_param, is_number
-from .space_parts import ON_SECOND, Body, Joint, SpatialSlide, _triple
+from .space_parts import ON_SECOND, Body, Joint, SpatialSlide, _triple  # noqa: F401
 from .values import _table
 
 SPACE = "3d"
@@ -192,7 +192,23 @@ class SpatialMechanism:
         """(first, second) body of a joint: its `bodies`, else the two bodies (the ground
         counting as one; never a bar) that carry its point, the ground first, else in
         declaration order; for a joint whose point belongs to its second body only
-        (cylindrical, prismatic, planar), a point on one body alone pairs it with the ground."""
+        (cylindrical, prismatic, planar), a point on one body alone pairs it with the ground.
+
+        Parameters
+        ----------
+        j : Joint
+
+        Returns
+        -------
+        (str, str)
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.joint_bodies(m.joint("O"))
+        ('ground', 'arm')
+        """
         where = f"[[joints]] {j.name}"
         names = {b.name for b in self.bodies} | {GROUND}
         if j.bodies is not None:
@@ -234,7 +250,15 @@ class SpatialMechanism:
     def counts(self) -> tuple[int, int]:
         """(unknowns, equations without the inputs'): 7 per body (its reference point and
         unit quaternion), 3 per point only bars carry; 1 per body (the quaternion's norm),
-        3 per extra carrier of a point, 1 per bar, and each joint's and slide's own."""
+        3 per extra carrier of a point, 1 per bar, and each joint's and slide's own.
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.counts()  # 7 unknowns; the norm, the point, the axis: 6 equations
+        (7, 6)
+        """
         rigid = [b for b in self.bodies if not b.two_point]
         on_body = {p for b in rigid for p in b.point_names} | set(dict(self.ground))
         free_pts = {p for b in self.bodies for p in b.point_names} - on_body
@@ -253,7 +277,15 @@ class SpatialMechanism:
 
     def exempt(self) -> set:
         """(point, body): a first body's copy of a point that belongs to the second body of
-        its cylindrical, prismatic or planar joint (the joint's own equations hold it)."""
+        its cylindrical, prismatic or planar joint (the joint's own equations hold it).
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.exempt()
+        set()
+        """
         out = set()
         for j in self.joints:
             if j.type in ON_SECOND:
@@ -266,7 +298,15 @@ class SpatialMechanism:
     # --- lookups, as a planar Mechanism answers them ---
     @property
     def links(self) -> tuple:
-        """The bodies and bars (named like a planar mechanism's links)."""
+        """The bodies and bars (named like a planar mechanism's links).
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> [b.name for b in m.links]
+        ['arm']
+        """
         return self.bodies
 
     @property
@@ -286,43 +326,155 @@ class SpatialMechanism:
 
     @property
     def param_values(self) -> dict[str, float]:
-        """The parameters as a dict."""
+        """The parameters as a dict.
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.param_values
+        {}
+        """
         return dict(self.parameters)
 
     def parameter(self, name: str) -> float:
-        """A parameter's value."""
+        """A parameter's value.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        float
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.with_parameters() and SpatialMechanism(parameters={"r": 2.0}).parameter("r")
+        2.0
+        """
         return self.param_values[name]
 
     def link(self, name: str) -> Body:
-        """The body of that name."""
+        """The body of that name.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        Body
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.link("arm").point_names
+        ('O', 'P')
+        """
         return {b.name: b for b in self.bodies}[name]
 
     def joint(self, name: str) -> Joint:
-        """The joint of that name."""
+        """The joint of that name.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        Joint
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.joint("O").type
+        'revolute'
+        """
         return {j.name: j for j in self.joints}[name]
 
     def slide(self, name: str) -> SpatialSlide:
-        """The slide of that name."""
+        """The slide of that name.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        SpatialSlide
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body.bar("b", "O", "P", 1)], slides=[SpatialSlide("P", "ground", (0, 0, 0), normal=(0, 0, 1))], guess={"P": (1, 0, 0)}).slide("P").on_line
+        False
+        """
         return {s.name: s for s in self.slides}[name]
 
     @property
     def ground_points(self) -> tuple[str, ...]:
-        """The ground points' names."""
+        """The ground points' names.
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.ground_points
+        ('O',)
+        """
         return tuple(g for g, _ in self.ground)
 
     @property
     def moving_points(self) -> tuple[str, ...]:
-        """Points carried by bodies and not fixed to the ground, in declaration order."""
+        """Points carried by bodies and not fixed to the ground, in declaration order.
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.moving_points
+        ('P',)
+        """
         seen = dict.fromkeys(p for b in self.bodies for p in b.point_names)
         return tuple(p for p in seen if p not in dict(self.ground))
 
     @property
     def mobility(self) -> int:
-        """Degrees of freedom counted (unknowns minus equations)."""
+        """Degrees of freedom counted (unknowns minus equations).
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.mobility
+        1
+        """
         return self.structure.mobility
 
     def value(self, v: Num) -> float:
-        """The number `v`, resolving a parameter reference."""
+        """The number `v`, resolving a parameter reference.
+
+        Parameters
+        ----------
+        v : float, str or Param
+
+        Returns
+        -------
+        float
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> SpatialMechanism(parameters={"r": 2.0}).value("r")
+        2.0
+        """
         p = as_param(v)
         return float(v) if p is None else p.scale * self.param_values[p.name]
 
@@ -337,7 +489,19 @@ class SpatialMechanism:
 
     def size(self) -> float:
         """The largest distance between two points of a body, a bar's length or the span of
-        the ground points (1 if none)."""
+        the ground points (1 if none).
+
+        Returns
+        -------
+        float
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.size()
+        1.0
+        """
         ext = 0.0
         for b in self.bodies:
             if b.two_point:
@@ -350,7 +514,24 @@ class SpatialMechanism:
         return ext if ext > 0 else 1.0
 
     def check_guess(self, guess) -> tuple:
-        """A guess given to one call, checked as the mechanism's own (ModelError otherwise)."""
+        """A guess given to one call, checked as the mechanism's own (ModelError otherwise).
+
+        Parameters
+        ----------
+        guess : dict
+            Point -> (x, y, z).
+
+        Returns
+        -------
+        tuple
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.check_guess({"P": (0, 1, 0)})
+        (('P', (0, 1, 0)),)
+        """
         items = tuple((k, _triple(v, f"[guess] {k}")) for k, v in _table(guess, "guess", "(x, y, z)"))
         out: list[str] = []
         num = _number_check(self.param_values, out)
@@ -364,7 +545,23 @@ class SpatialMechanism:
         return items
 
     def with_parameters(self, **values: float) -> "SpatialMechanism":
-        """A new mechanism with some parameters changed."""
+        """A new mechanism with some parameters changed.
+
+        Parameters
+        ----------
+        **values : float
+
+        Returns
+        -------
+        SpatialMechanism
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> SpatialMechanism(parameters={"r": 2.0}).with_parameters(r=3).parameter("r")
+        3.0
+        """
         bad = [f"[parameters] {k}: no such parameter" for k in values if k not in self.param_values]
         bad += [f"[parameters] {k}: expected a number" for k, v in values.items() if not is_number(v)]
         if bad:
@@ -372,6 +569,22 @@ class SpatialMechanism:
         return replace(self, parameters={**self.param_values, **{k: float(v) for k, v in values.items()}})
 
     def with_guess(self, **points) -> "SpatialMechanism":
-        """A new mechanism whose guess is updated (point -> (x, y, z))."""
+        """A new mechanism whose guess is updated (point -> (x, y, z)).
+
+        Parameters
+        ----------
+        **points : (float, float, float)
+
+        Returns
+        -------
+        SpatialMechanism
+
+        Examples
+        --------
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> dict(m.with_guess(P=(0, 1, 0)).guess)["P"]
+        (0, 1, 0)
+        """
         return replace(self, guess={**dict(self.guess), **points})
 

@@ -115,16 +115,42 @@ class Body:
 
     @property
     def two_point(self) -> bool:
-        """Whether the body is a two-point bar (no unknowns of its own)."""
+        """Whether the body is a two-point bar (no unknowns of its own).
+
+        Examples
+        --------
+        >>> Body.bar("b", "P", "Q", 1).two_point
+        True
+        """
         return self.length is not None
 
     @property
     def point_names(self) -> tuple[str, ...]:
-        """The names of the body's points, in declaration order."""
+        """The names of the body's points, in declaration order.
+
+        Examples
+        --------
+        >>> Body("b", {"P": (0, 0, 0), "Q": (1, 0, 0)}).point_names
+        ('P', 'Q')
+        """
         return tuple(p for p, _ in self.points)
 
     def local(self, point: str):
-        """A point's coordinates as drawn (None for a bar's ends)."""
+        """A point's coordinates as drawn (None for a bar's ends).
+
+        Parameters
+        ----------
+        point : str
+
+        Returns
+        -------
+        (x, y, z) or None
+
+        Examples
+        --------
+        >>> Body("b", {"P": (0, 0, 1)}).local("P")
+        (0, 0, 1)
+        """
         return dict(self.points)[point]
 
 
@@ -194,7 +220,13 @@ class Joint:
 
     @property
     def coordinates(self) -> tuple[str, ...]:
-        """The joint's coordinate names ("angle", "s", "angle1", ...)."""
+        """The joint's coordinate names ("angle", "s", "angle1", ...).
+
+        Examples
+        --------
+        >>> Joint("planar", "P", axis=(0, 0, 1)).coordinates
+        ('s1', 's2', 'angle')
+        """
         return COORDINATES[self.type]
 
 
@@ -240,5 +272,11 @@ class SpatialSlide:
 
     @property
     def on_line(self) -> bool:
-        """Whether the slide keeps its point on a line (else on a plane)."""
+        """Whether the slide keeps its point on a line (else on a plane).
+
+        Examples
+        --------
+        >>> SpatialSlide("P", "ground", normal=(0, 0, 1)).on_line
+        False
+        """
         return self.direction is not None
