@@ -261,3 +261,13 @@ def test_unknown_quantity_and_bad_declarations_are_named():
     with pytest.raises(kincas.ModelError, match=r"\[guess\] P: missing"):
         SpatialMechanism(ground={"A": (0, 0, 0), "C": (2, 0, 0)},
                          bodies=[Body.bar("b1", "A", "P", 1), Body.bar("b2", "P", "C", 1.5)])
+
+
+def test_rssr_modes_are_the_two_roots_of_its_closure_and_its_range_a_full_turn():
+    modes = kincas.find_modes(rssr(), {"A.angle": 0.7}, starts=64)
+    got = sorted(md.angles["D.angle"] for md in modes)
+    want = sorted(wrap(rssr_closed(0.7, sign=s)) for s in (1.0, -1.0))
+    assert len(got) == 2 and np.allclose(got, want, atol=1e-10)
+    assert sum(md.from_guess for md in modes) == 1
+    r = kincas.input_range(rssr(), {"A.angle": 0.7})
+    assert r.full_turn

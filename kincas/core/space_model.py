@@ -164,6 +164,30 @@ class SpatialFirstPose:
             X1 = r1 + R1 @ (P0 - c1)
             pose[b2] = (r2 + (value - (X - X1) @ a) * a, R2, c2)
 
+    def scatter(self, m, n: int, L: float, rng) -> np.ndarray:
+        """n random starts (kincas.find_modes): each body's reference point uniform in a cube
+        of half-side L about a ground point, its quaternion uniform on the unit sphere of R^4
+        (a uniformly random rotation), a point only bars carry likewise in the cube."""
+        names, sym = self.unknown_names, self.sym
+        Q = np.zeros((n, len(names)))
+        o = np.array([m.value(c) for c in m.ground[0][1]]) if m.ground else np.zeros(3)
+        ground = np.array([[m.value(c) for c in xyz] for _, xyz in m.ground]).reshape(-1, 3) - o
+        ground = ground if len(ground) else np.zeros((1, 3))
+        for j, (nm, kind) in enumerate(sym.unknowns):
+            if nm.endswith((".rx", ".x")):  # a body's reference point, or a bar-only point
+                centre = ground[rng.integers(len(ground), size=n)]
+                Q[:, j:j + 3] = centre + rng.uniform(-L, L, size=(n, 3))
+            elif nm.endswith(".qw"):
+                e = rng.standard_normal((n, 4))
+                Q[:, j:j + 4] = e / np.linalg.norm(e, axis=1, keepdims=True)
+        return Q
+
+    def mode_angles(self) -> list[tuple[str, str]]:
+        """(name, quantity) of the angles a mode reports: every joint's angle coordinates."""
+        m = self.sym.mech
+        return [(f"{j.name}.{c}", f"{j.name}.{c}") for j in m.joints for c in j.coordinates
+                if c.startswith("angle")]
+
     def drawing_inputs(self, p) -> np.ndarray:
         """The inputs at the drawing pose: joint coordinates 0, a slide's s as drawn, a driven
         parameter its value (where the rank test of redundant joints starts)."""
