@@ -27,6 +27,7 @@ slides; every problem gathered into one `SceneError` naming the section and the 
 from __future__ import annotations
 
 from ..errors import KincasError, ModelError, SceneError
+from ..model.loads import Load
 from ..model.mechanism import GROUND, Input
 from ..model.space import SpatialMechanism
 from ..model.space_parts import JOINT_TYPES, Body, Joint, SpatialSlide
@@ -34,7 +35,8 @@ from ..model.space_parts import JOINT_TYPES, Body, Joint, SpatialSlide
 SPACE_SECTIONS = {"title", "space", "units", "parameters", "ground", "links", "joints", "slides",
                   "inputs", "guess", "output", "optimize", "tolerance", "study"}
 PLANAR_ONLY = {"gears": "gears", "racks": "racks", "cams": "cams", "cam_design": "cam design"}
-NOT_YET = {"gravity", "loads"}  # efforts in 3D: not built in this version
+NOT_YET: set = set()
+SPACE_SECTIONS |= {"gravity", "loads"}
 
 
 INPUT_KINDS = ("joint", "parameter", "slide")
@@ -103,6 +105,8 @@ class _Space:
         self.joint_list = [j for j in (self.joint(i, t) for i, t in enumerate(self.array("joints"))) if j]
         slides = [s for s in (self.slide(i, t) for i, t in enumerate(self.array("slides"))) if s]
         inputs, values, rates, accs, written = self.inputs()
+        gravity = self.xyz("gravity", doc["gravity"]) if "gravity" in doc else (0.0, 0.0, 0.0)
+        loads = self.loads()
         guess = {k: self.xyz(f"[guess] {k}", v) for k, v in self.table("guess").items()}
         report, sens = self.output()
         if not bodies and not self.problems:
@@ -111,7 +115,8 @@ class _Space:
             raise SceneError(self.problems)
         try:
             m = SpatialMechanism(parameters=self.lean_parameters(), ground=ground, bodies=bodies,
-                                 joints=self.joint_list, slides=slides, inputs=inputs, guess=guess)
+                                 joints=self.joint_list, slides=slides, inputs=inputs, guess=guess,
+                                 gravity=gravity, loads=loads)
         except KincasError as e:
             raise SceneError(e.problems) from None
         if report is None:
@@ -135,23 +140,69 @@ class _Space:
                      f"or a bar {{ points = [\"P\", \"Q\"], length = L }})")
             return None
         pts = t["points"]
+        inertia = {}
+        if "mass" in t:
+            inertia["mass"] = self.num(f"{where}: mass", t["mass"])
+        if "cg" in t:
+            inertia["cg"] = self.xyz(f"{where}: cg", t["cg"])
+        if "inertia" in t:
+            inertia["inertia"] = self.tensor(f"{where}: inertia", t["inertia"])
         if isinstance(pts, list):
-            self.fields(where, t, {"points", "length"})
+            self.fields(where, t, {"points", "length", "mass"})
             if len(pts) != 2 or not all(isinstance(p, str) for p in pts):
                 self.err(f"{where}: points: the two-point form takes two point names")
                 return None
             if "length" not in t:
                 self.err(f"{where}: length: missing (the two-point form needs a length)")
                 return None
-            return Body.bar(name, pts[0], pts[1], self.num(f"{where}: length", t["length"]))
+            return Body.bar(name, pts[0], pts[1], self.num(f"{where}: length", t["length"]))._with(**inertia)
         if isinstance(pts, dict):
-            self.fields(where, t, {"points"})
+            self.fields(where, t, {"points", "mass", "cg", "inertia"})
             if not pts:
                 self.err(f"{where}: points: a body needs at least one point")
                 return None
-            return Body(name, {p: self.xyz(f"{where}: points.{p}", v) for p, v in pts.items()})
+            return Body(name, {p: self.xyz(f"{where}: points.{p}", v) for p, v in pts.items()}, **inertia)
         self.err(f"{where}: points: expected a table of points as drawn or a list of two names")
         return None
+
+    def tensor(self, where, v):
+        """An inertia: a number, [Ixx, Iyy, Izz] or a 3 x 3 list (numbers or parameters)."""
+        if isinstance(v, list) and len(v) == 3 and all(isinstance(r, list) for r in v):
+            if not all(len(r) == 3 for r in v):
+                self.err(f"{where}: expected a number, [Ixx, Iyy, Izz] or a 3 x 3 list")
+                return 0.0
+            return [[self.num(where, c) for c in r] for r in v]
+        if isinstance(v, list):
+            return list(self.xyz(where, v))
+        return self.num(where, v)
+
+    def loads(self):
+        """[[loads]]: point + force = [fx, fy, fz], link + torque = [tx, ty, tz], or a spring."""
+        out = []
+        kinds = {"point": ("force",), "link": ("torque",), "spring": ("stiffness", "free_length")}
+        for i, t in enumerate(self.array("loads")):
+            where = f"[[loads]] {i + 1}"
+            kind = [k for k in kinds if k in t]
+            if len(kind) != 1 or any(f not in t for f in kinds[kind[0]]):
+                self.err(f"{where}: give a point with its force [fx, fy, fz], a link with its torque "
+                         f"[tx, ty, tz], or a spring with stiffness and free_length")
+                continue
+            kind = kind[0]
+            self.fields(where, t, {kind, *kinds[kind]})
+            if kind == "spring":
+                pts = t["spring"]
+                if not (isinstance(pts, list) and len(pts) == 2 and all(isinstance(p, str) for p in pts)):
+                    self.err(f"{where}: spring: expected two point names [\"A\", \"B\"]")
+                    continue
+                out.append(Load.spring(pts[0], pts[1], self.num(f"{where}: stiffness", t["stiffness"]),
+                                       self.num(f"{where}: free_length", t["free_length"])))
+            elif not isinstance(t[kind], str):
+                self.err(f"{where}: {kind}: expected a name")
+            else:
+                field = kinds[kind][0]
+                out.append(Load("force" if kind == "point" else "torque", at=t[kind],
+                                value=self.xyz(f"{where}: {field}", t[field])))
+        return out
 
     def joint(self, i, t):
         where = f"[[joints]] {t.get('name', t.get('point', i + 1))}"

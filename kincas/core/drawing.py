@@ -33,7 +33,7 @@ def _build_pose_function(model):
     out = [c for g in m.ground_points for c in sym.points[g]]
     out += [c for p in m.moving_points for c in sym.points[p]]
     if sym.dim == 3:  # a spatial slide: its `through` point and direction (or normal), world axes
-        from .space_symbolic import apply, rotation
+        from .quaternions import apply, rotation
         for sl in m.slides:
             X = sym.world(sl.along, sym._rel(sl.through))
             out += [X[i] + sym.origin[i] for i in range(3)]

@@ -92,8 +92,7 @@ class SpatialMechanism:
                 raise ModelError(bad)
             put(f, items)
         put("gravity", _triple(self.gravity, "gravity"))
-        if self.loads:
-            raise ModelError("[[loads]]: loads on a spatial mechanism are not built in this version")
+        put("loads", tuple(self._load(k, ld) for k, ld in enumerate(self.loads)))
         given = tuple((k, _triple(v, f"[guess] {k}")) for k, v in _table(self.guess, "guess", "(x, y, z)"))
         problems = self._check(given)
         if problems:
@@ -108,6 +107,16 @@ class SpatialMechanism:
         problems = _check_mobility(self)
         if problems:
             raise ModelError(problems)
+
+    def _load(self, k, ld):
+        """A load with its force or torque as a triple (kincas.Load, 3D values)."""
+        from .loads import Load
+        where = f"[[loads]] {k + 1}"
+        if not isinstance(ld, Load):
+            raise ModelError(f"{where}: expected a kincas.Load, got {ld!r:.60}")
+        if ld.kind in ("force", "torque"):
+            return replace(ld, value=_triple(ld.value, f"{where}: {ld.kind}"))
+        return ld
 
     # --- checks ---
     def _check(self, given) -> list[str]:
@@ -126,6 +135,30 @@ class SpatialMechanism:
         for g, xyz in self.ground:
             for c in xyz:
                 num(f"[ground] {g}", c)
+        for b in self.bodies:
+            where = f"[links] {b.name}"
+            num(f"{where}: mass", b.mass)
+            for c in (b.cg or ()):
+                num(f"{where}: cg", c)
+            for c in b.inertia:
+                num(f"{where}: inertia", c)
+            if b.two_point and (b.cg is not None or any(c != 0 for c in b.inertia)):
+                out.append(f"{where}: a two-point bar takes a mass only (at its middle; no cg, no inertia)")
+        for c in self.gravity:
+            num("gravity", c)
+        rigid = {b.name for b in self.bodies if not b.two_point}
+        known = {p for b in self.bodies for p in b.point_names} | set(dict(self.ground))
+        for k, ld in enumerate(self.loads):
+            where = f"[[loads]] {k + 1}"
+            if ld.kind == "force" and ld.at not in known:
+                out.append(f"{where}: point: unknown point {ld.at!r}")
+            elif ld.kind == "torque" and ld.at not in rigid:
+                out.append(f"{where}: link: {ld.at!r} is not a rigid body (a torque needs one)")
+            elif ld.kind == "spring":
+                out += [f"{where}: spring: unknown point {p!r}" for p in ld.points if p not in known]
+                num(f"{where}: stiffness", ld.stiffness), num(f"{where}: free_length", ld.free_length)
+            for c in (ld.value if ld.kind != "spring" else ()):
+                num(f"{where}: {ld.kind}", c)
         bodies = {b.name: b for b in self.bodies}
         carried = {p for b in self.bodies for p in b.point_names}
         for j in self.joints:

@@ -41,6 +41,20 @@ def _triple(v, where: str) -> tuple[Num, Num, Num]:
     return tuple(as_number(c) for c in items)
 
 
+def _tensor(v, where: str) -> tuple:
+    """An inertia tensor as 9 entries, row by row: a number (the same about every axis),
+    three (principal, along the drawing axes) or a 3 x 3 list."""
+    if isinstance(v, (int, float, str)) or is_number(v):
+        return (v, 0.0, 0.0, 0.0, v, 0.0, 0.0, 0.0, v)
+    rows = tuple(v)
+    if len(rows) == 3 and all(isinstance(r, (int, float, str)) or is_number(r) for r in rows):
+        a, b, c = rows
+        return (a, 0.0, 0.0, 0.0, b, 0.0, 0.0, 0.0, c)
+    if len(rows) == 3 and all(len(tuple(r)) == 3 for r in rows):
+        return tuple(as_number(x) for r in rows for x in r)
+    raise ModelError(f"{where}: expected a number, [Ixx, Iyy, Izz] or a 3 x 3 list, got {v!r}")
+
+
 def _direction(v, where: str) -> tuple[float, float, float]:
     """A non-zero direction of three plain numbers (axes are not parameters in this version)."""
     d = _triple(v, where)
@@ -79,9 +93,16 @@ class Body:
     name: str
     points: tuple = ()
     length: Num | None = None
+    mass: Num = 0.0
+    cg: tuple | None = None  # as drawn; None: the mean of its points
+    inertia: tuple = (0.0,) * 9  # about the cg, drawing axes, row by row
 
-    def __init__(self, name: str, points=(), length: Num | None = None):
+    def __init__(self, name: str, points=(), length: Num | None = None, *, mass: Num = 0.0,
+                 cg=None, inertia=0.0):
         where = f"[links] {name}"
+        object.__setattr__(self, "mass", as_number(mass))
+        object.__setattr__(self, "cg", None if cg is None else _triple(cg, f"{where}: cg"))
+        object.__setattr__(self, "inertia", _tensor(inertia, f"{where}: inertia"))
         object.__setattr__(self, "name", name)
         if length is None:
             items = _table(points, f"{where}: points", "(x, y, z)")
@@ -92,6 +113,11 @@ class Body:
                 raise ModelError(f"{where}: points: the two-point form takes two point names")
         object.__setattr__(self, "points", pts)
         object.__setattr__(self, "length", as_number(length))
+
+    def _with(self, mass: Num = 0.0, **_) -> "Body":
+        """The same bar with a mass (at its middle)."""
+        out = Body(self.name, self.point_names, self.length, mass=mass)
+        return out
 
     @classmethod
     def bar(cls, name: str, p: str, q: str, length: Num) -> "Body":
