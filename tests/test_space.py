@@ -271,3 +271,11 @@ def test_rssr_modes_are_the_two_roots_of_its_closure_and_its_range_a_full_turn()
     assert sum(md.from_guess for md in modes) == 1
     r = kincas.input_range(rssr(), {"A.angle": 0.7})
     assert r.full_turn
+
+
+def test_designs_of_a_spatial_mechanism_match_their_own_sweeps():
+    th = np.linspace(0, 6, 7)
+    r = kincas.sweep_designs(rssr(), {"lc": [120.0, 130.0]}, {"A.angle": th}, report=["D.angle"])
+    for k, lc in enumerate((120.0, 130.0)):
+        want = kincas.sweep(rssr(lc=lc), {"A.angle": th}, report=["D.angle"])["D.angle"]
+        assert np.allclose(r.values["D.angle"][k], want, atol=1e-11)

@@ -149,6 +149,9 @@ def design_table(m: Mechanism, params, names=None) -> tuple[list[str], np.ndarra
 
 def _sizes(m: Mechanism, P: np.ndarray, pnames: list[str]) -> np.ndarray:
     """`Mechanism.size()` of every design (rows of P), vectorised."""
+    own = getattr(m, "sizes", None)  # a mechanism that measures its designs itself
+    if own is not None:
+        return own(P, pnames)
     idx = {k: j for j, k in enumerate(pnames)}
 
     def val(v):

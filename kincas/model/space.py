@@ -546,6 +546,27 @@ class SpatialMechanism:
         ext = max([ext] + [math.dist(a, c) for a in g for c in g])
         return ext if ext > 0 else 1.0
 
+    def sizes(self, P, pnames) -> list[float]:
+        """`size()` of each design: row k of P gives the parameters `pnames`.
+
+        Parameters
+        ----------
+        P : array (designs x parameters)
+        pnames : list of str
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Examples
+        --------
+        >>> SpatialMechanism(parameters={"r": 2.0}, ground={"O": (0, 0, 0)}, bodies=[Body.bar("b", "O", "P", "r")],
+        ...     guess={"P": (2, 0, 0)}).sizes([[3.0], [4.0]], ["r"]).tolist()
+        [3.0, 4.0]
+        """
+        import numpy as np
+        return np.array([self.with_parameters(**dict(zip(pnames, map(float, row)))).size() for row in P])
+
     def check_guess(self, guess) -> tuple:
         """A guess given to one call, checked as the mechanism's own (ModelError otherwise).
 
