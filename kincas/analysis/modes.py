@@ -203,7 +203,7 @@ def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
     keep.sort(key=lambda t: tuple(np.round(t[1] / (SAME * L))))
     # each mode's angles: the links' (or, where the model names them, its own: joint angles)
     angles = getattr(model, "mode_angles", lambda: [(lk.name, f"{lk.name}.angle") for lk in m.links])()
-    links, dim = [a for a, _ in angles], model.sym.dim
+    links, dim = [a for a, _ in angles], model.dim
     out = []
     s = model.column_scale(L)  # columns scaled to O(1)
     for q, pts in keep:

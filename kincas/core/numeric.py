@@ -339,6 +339,11 @@ class Model(FirstPose):
         return [nm for nm, _ in self.sym.unknowns]
 
     @property
+    def dim(self) -> int:
+        """Coordinates of a point: 2, or 3 for a spatial mechanism."""
+        return self.sym.dim
+
+    @property
     def is_length(self) -> np.ndarray:
         """Per unknown: True for a length (a floating link's origin), False for an angle."""
         return self.sym.is_length

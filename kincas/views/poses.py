@@ -54,7 +54,7 @@ def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
     p = np.array([v for _, v in m.parameters], float)
     Q = np.where(ok[:, None], sweep.q, 0.0)  # what depends on q is masked below
     raw = pose_values(model, Q, U, p)
-    ng, dim = len(m.ground_points), model.sym.dim  # (x, y) or, in space, (x, y, z)
+    ng, dim = len(m.ground_points), model.dim  # (x, y) or, in space, (x, y, z)
     xy = raw[:, :dim * len(names)].reshape(n, len(names), dim).copy()
     xy[~ok, ng:] = np.nan  # ground points are known at every pose, moving ones when solved
     slides = {}
