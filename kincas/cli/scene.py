@@ -253,19 +253,7 @@ class _Reader(StudyReader):
         for k in doc:
             if k not in SECTIONS:
                 self.err(f"scene: unknown section or key {k!r} (expected {sorted(SECTIONS)})")
-        title = doc.get("title", "")
-        if not isinstance(title, str):
-            self.err("title: expected a string")
-        for k, v in self.table("parameters").items():
-            if isinstance(v, bool) or not isinstance(v, (int, float)):
-                self.err(f"[parameters] {k}: expected a number, got {v!r}")
-                self.bad_params.add(k)
-            elif not math.isfinite(v) or abs(v) > LARGEST:
-                self.err(f"[parameters] {k}: {v} is not a finite number" if not math.isfinite(v)
-                         else f"[parameters] {k}: {v:g} is too large (at most {LARGEST:g})")
-                self.bad_params.add(k)
-            else:
-                self.params[k] = float(v)
+        title = self.title_and_parameters()
         ground = {k: self.xy(f"[ground] {k}", v) for k, v in self.table("ground").items()}
         if GROUND in ground:
             self.err("[ground] ground: the name `ground` means the fixed frame")
@@ -297,6 +285,24 @@ class _Reader(StudyReader):
                       inputs=values, rates=rates, accelerations=accs, report=report,
                       sensitivity=sens, written=written, raw=doc, jerks=self.jerks)
         return Scene(m, study)
+
+    def title_and_parameters(self) -> str:
+        """The scene's title (checked) and its `[parameters]`, read into `self.params`."""
+        doc = self.doc
+        title = doc.get("title", "")
+        if not isinstance(title, str):
+            self.err("title: expected a string")
+        for k, v in self.table("parameters").items():
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                self.err(f"[parameters] {k}: expected a number, got {v!r}")
+                self.bad_params.add(k)
+            elif not math.isfinite(v) or abs(v) > LARGEST:
+                self.err(f"[parameters] {k}: {v} is not a finite number" if not math.isfinite(v)
+                         else f"[parameters] {k}: {v:g} is too large (at most {LARGEST:g})")
+                self.bad_params.add(k)
+            else:
+                self.params[k] = float(v)
+        return title
 
     def lean_parameters(self) -> dict:
         """The parameters the model is built with: all of them, unless more than LEAN are

@@ -35,7 +35,6 @@ from ..model.space_parts import JOINT_TYPES, Body, Joint, SpatialSlide
 SPACE_SECTIONS = {"title", "space", "units", "parameters", "ground", "links", "joints", "slides",
                   "inputs", "guess", "output", "optimize", "tolerance", "study"}
 PLANAR_ONLY = {"gears": "gears", "racks": "racks", "cams": "cams", "cam_design": "cam design"}
-NOT_YET: set = set()
 SPACE_SECTIONS |= {"gravity", "loads"}
 
 
@@ -84,20 +83,9 @@ class _Space:
             if k in PLANAR_ONLY:
                 self.err(f"[{k}]: {PLANAR_ONLY[k]} stay planar in this version: a spatial scene "
                          f"(space = \"3d\") cannot declare them")
-            elif k in NOT_YET:
-                self.err(f"{k}: forces in a spatial scene (gravity, loads, efforts) are not built "
-                         f"in this version")
             elif k not in SPACE_SECTIONS:
                 self.err(f"scene: unknown section or key {k!r} (expected {sorted(SPACE_SECTIONS)})")
-        title = doc.get("title", "")
-        if not isinstance(title, str):
-            self.err("title: expected a string")
-        for k, v in self.table("parameters").items():
-            if isinstance(v, bool) or not isinstance(v, (int, float)):
-                self.err(f"[parameters] {k}: expected a number, got {v!r}")
-                self.bad_params.add(k)
-            else:
-                self.params[k] = float(v)
+        title = self.title_and_parameters()
         ground = {k: self.xyz(f"[ground] {k}", v) for k, v in self.table("ground").items()}
         if GROUND in ground:
             self.err("[ground] ground: the name `ground` means the fixed frame")
