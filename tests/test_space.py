@@ -124,6 +124,13 @@ def test_cardan_joint_tan_th2_is_tan_th1_over_cos_beta_with_its_velocity_ratio()
     assert np.allclose(sw["out.omega"], ratio, rtol=1e-10)
     dratio = -np.cos(beta) * np.sin(beta) ** 2 * 2 * np.cos(th) * np.sin(th) / (1 - np.sin(beta) ** 2 * np.cos(th) ** 2) ** 2
     assert np.allclose(sw["out.alpha"], dratio, rtol=1e-8, atol=1e-10)
+    # the cross turns about the input's yoke y by angle1: the output's yoke z, seen from the
+    # input shaft, is Rot(x, -th1) Rot(s, th2) z = Rot(y, angle1) z = (sin a1, 0, cos a1)
+    cr = kincas.sweep(cardan(beta), {"in.angle": th[:9]}, report=["cross.angle1"])
+    s_ax = np.array([math.cos(beta), math.sin(beta), 0.0])
+    for k in range(9):
+        v = rotate(rotate(np.array([0, 0, 1.0]), s_ax, th2[k]), np.array([1.0, 0, 0]), -th[k])
+        assert abs(v[1]) < 1e-12 and abs(wrap(cr["cross.angle1"][k] - math.atan2(v[0], v[2]))) < 1e-12
 
 
 # --- spherical four-bar: four revolutes whose axes meet at O ---
@@ -279,3 +286,31 @@ def test_designs_of_a_spatial_mechanism_match_their_own_sweeps():
     for k, lc in enumerate((120.0, 130.0)):
         want = kincas.sweep(rssr(lc=lc), {"A.angle": th}, report=["D.angle"])["D.angle"]
         assert np.allclose(r.values["D.angle"][k], want, atol=1e-11)
+
+
+def rotz(t):
+    c, s = math.cos(t), math.sin(t)
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+
+
+def test_cylindrical_and_planar_joints_move_as_their_coordinates_say():
+    P0, X0 = np.array([2.0, 1.0, 0.5]), np.array([1.0, 0.0, 0.0])
+    cyl = SpatialMechanism(bodies=[Body("sleeve", {"X": tuple(X0), "P": tuple(P0)})],
+                           joints=[Joint("cylindrical", "X", axis=(0, 0, 1), name="c")],
+                           inputs=[Input.joint("c.angle"), Input.joint("c.s")])
+    th, s = np.array([0.3, 2.0, -2.9]), np.array([0.5, -1.0, 2.0])
+    sw = kincas.sweep(cyl, {"c.angle": th, "c.s": s}, report=["P.x", "P.y", "P.z", "c.angle", "c.s", "sleeve.omega_z"])
+    assert sw.ok.all() and sw.residual.max() < 1e-12
+    for k in range(3):
+        want = X0 + rotz(th[k]) @ (P0 - X0) + s[k] * np.array([0, 0, 1.0])
+        assert np.allclose([sw["P.x"][k], sw["P.y"][k], sw["P.z"][k]], want, atol=1e-12)
+    assert np.allclose(sw["c.angle"], th, atol=1e-12) and np.allclose(sw["c.s"], s, atol=1e-12)
+    assert np.allclose(sw["sleeve.omega_z"], 1.0)  # rate 1 of the angle input
+    pla = SpatialMechanism(bodies=[Body("puck", {"X": tuple(X0), "P": tuple(P0)})],
+                           joints=[Joint("planar", "X", axis=(0, 0, 1), name="pl")],
+                           inputs=[Input.joint("pl.s1"), Input.joint("pl.s2"), Input.joint("pl.angle")])
+    sw = kincas.sweep(pla, {"pl.s1": s, "pl.s2": -s, "pl.angle": th}, report=["P.x", "P.y", "P.z"])
+    assert sw.ok.all() and sw.residual.max() < 1e-12
+    for k in range(3):  # e1 = x (global x on the plane), e2 = n x e1 = y
+        want = X0 + rotz(th[k]) @ (P0 - X0) + np.array([s[k], -s[k], 0.0])
+        assert np.allclose([sw["P.x"][k], sw["P.y"][k], sw["P.z"][k]], want, atol=1e-12)
