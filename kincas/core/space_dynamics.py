@@ -70,7 +70,9 @@ def _bodies(sym):
 def _partials(sym, x):
     """d(x')/du' (len(x) x nu) for an expression x(q, u): x_q T + x_u."""
     x = _vec(x)
-    T = -sym.lsolve(sym.Ju)
+    T = getattr(sym, "_T", None)
+    if T is None:  # dq/du: one symbolic solve per model, shared by every partial velocity
+        T = sym._T = -sym.lsolve(sym.Ju)
     return ca.mtimes(ca.jacobian(x, sym.q), T) + ca.jacobian(x, sym.u)
 
 
