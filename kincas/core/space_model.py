@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.mobility import GROUND
+from .tolerances import IDENTITY_PULL, TINY
 
 
 def structure_key(m):
@@ -74,7 +75,7 @@ def kabsch(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     their line costs nothing), the one nearest the identity: a faint pull towards it is
     added to the correlation matrix (the drawing pose's orientation is the identity)."""
     H = B.T @ A
-    U, _, Vt = np.linalg.svd(H + 1e-9 * (np.trace(A.T @ A) + 1e-300) * np.eye(3))
+    U, _, Vt = np.linalg.svd(H + IDENTITY_PULL * (np.trace(A.T @ A) + TINY) * np.eye(3))
     D = np.diag([1.0, 1.0, np.sign(np.linalg.det(U @ Vt)) or 1.0])
     return U @ D @ Vt
 

@@ -41,6 +41,7 @@ from ..model.space_names import BODY_Q, POINT_Q3, SLIDE_Q, joint_attrs
 from ..model.space_parts import ON_SECOND
 from .quaternions import apply, apply_t, conj, cross, dot, qmul, rotation  # noqa: F401
 from .symbolic import Symbolic
+from .tolerances import PROJECTION
 
 IDENTITY = (1.0, 0.0, 0.0, 0.0)
 
@@ -60,7 +61,7 @@ def in_plane_axes(n) -> tuple[np.ndarray, np.ndarray]:
     n = np.asarray(n, float)
     for g in np.eye(3)[:2]:
         e1 = g - (g @ n) * n
-        if np.linalg.norm(e1) > 1e-9:
+        if np.linalg.norm(e1) > PROJECTION:
             e1 /= np.linalg.norm(e1)
             return e1, np.cross(n, e1)
     raise AssertionError("unreachable: x and y cannot both be normal to a plane")

@@ -72,3 +72,6 @@ FREE_LINKS = 6  # links left free by a guess that are tried in several turns (co
 NEARER = 1e-9  # another start's assembly is nearer the guessed points when its cost is below (1 - this) times
 CHOICE_STARTS = 128  # scattered starts finding a guessless sweep's other assemblies (analysis/choice.py)
 CHOICE_TRIES = 8  # of which at most this many are swept
+# spatial mechanisms (core/space_model.py, core/space_symbolic.py)
+IDENTITY_PULL = 1e-9  # a rigid fit's faint pull towards the identity, relative to its points' spread
+PROJECTION = 1e-9  # a unit axis projected on a plane shorter than this is normal to it
