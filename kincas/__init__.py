@@ -16,6 +16,8 @@ Jacobians, sensitivities to every named parameter. Angles are radians in Python.
 from . import _aliases
 from .errors import KincasError, ModelError, SceneError
 from .model import Input, Link, Load, Mechanism, Param, Slide
+from .model.space import SpatialMechanism
+from .model.space_parts import Body, Joint, SpatialSlide
 from .results import Pose, Sweep
 from .core.numeric import model_of
 from .analysis.sweeps import solve, sweep
@@ -45,6 +47,7 @@ def __getattr__(name):
 
 
 __all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "sweep",
+           "SpatialMechanism", "Body", "Joint", "SpatialSlide",
            "SweepMethod", "Fast", "Careful",
            "sweep_designs", "study", "model_of",
            "sensitivities", "analyse", "optimize", "find_modes", "input_range",

@@ -149,6 +149,9 @@ def design_table(m: Mechanism, params, names=None) -> tuple[list[str], np.ndarra
 
 def _sizes(m: Mechanism, P: np.ndarray, pnames: list[str]) -> np.ndarray:
     """`Mechanism.size()` of every design (rows of P), vectorised."""
+    own = getattr(m, "sizes", None)  # a mechanism that measures its designs itself
+    if own is not None:
+        return own(P, pnames)
     idx = {k: j for j, k in enumerate(pnames)}
 
     def val(v):
@@ -237,7 +240,7 @@ def sweep_designs(m: Mechanism, params, inputs=None, *, names=None, rates=None,
     P[:, [pnames.index(k) for k in names]] = X
     P = np.ascontiguousarray(P)
     Ls = np.ascontiguousarray(_sizes(m, P, pnames))
-    g = {k: (m.value(x), m.value(y)) for k, (x, y) in {**dict(m.guess), **dict(guess or {})}.items()}
+    g = {k: tuple(map(m.value, xy)) for k, xy in {**dict(m.guess), **dict(guess or {})}.items()}
     job = _Job(model, m, report, U, Ud, Udd, P, Ls, g, compile, progress)
     job.backend = backend
     workers = workers or os.cpu_count() or 1

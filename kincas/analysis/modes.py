@@ -77,7 +77,7 @@ class Mode:
         >>> Mode(np.zeros(1), ("a",), {"C": (1.0, -2.5)}, {}, 0.0, 1).guess_block()
         '[guess]\\nC = [1, -2.5]\\n'
         """
-        rows = [f"{p} = [{x:.{digits}g}, {y:.{digits}g}]" for p, (x, y) in self.points.items()]
+        rows = [f"{p} = [{', '.join(f'{c:.{digits}g}' for c in xy)}]" for p, xy in self.points.items()]
         return "[guess]\n" + "".join(r + "\n" for r in rows)
 
 
@@ -132,7 +132,7 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
     L = m_at.size()
 
     # The mechanism's own guess is start 0, so the mode a sweep would take is always found.
-    guess = {k: (m_at.value(x), m_at.value(y)) for k, (x, y) in m.guess}
+    guess = {k: tuple(map(m_at.value, xy)) for k, xy in m.guess}
     Q = np.vstack([model.initial_q(u, p, guess, L), _scatter(m_at, model, starts - 1, L, seed)])
     if tied(model).any():  # gears, racks: each start at the turns their relations want
         Q = np.array([turns(model, q, u, p) for q in Q])
@@ -159,6 +159,9 @@ def _scatter(m: Mechanism, model, n: int, L: float, seed: int) -> np.ndarray:
     """n starts over the reachable workspace: angles uniform in (-pi, pi]; the origin of a
     floating link uniform in a square of half-side L around a randomly chosen ground point."""
     rng = np.random.default_rng(seed)
+    spread = getattr(model, "scatter", None)  # a model with unknowns of its own kinds spreads them
+    if spread is not None:
+        return spread(m, n, L, rng)
     names = model.unknown_names
     Q = rng.uniform(-math.pi, math.pi, size=(n, len(names)))
     ground = np.array([(m.value(x), m.value(y)) for _, (x, y) in m.ground]).reshape(-1, 2)
@@ -198,16 +201,18 @@ def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
     rows = _point_rows(model, Q, u, p)
     keep = [(Q[k], rows[k]) for k in _unique(rows, SAME * L)]
     keep.sort(key=lambda t: tuple(np.round(t[1] / (SAME * L))))
-    links = [lk.name for lk in m.links]
+    # each mode's angles: the links' (or, where the model names them, its own: joint angles)
+    angles = getattr(model, "mode_angles", lambda: [(lk.name, f"{lk.name}.angle") for lk in m.links])()
+    links, dim = [a for a, _ in angles], model.dim
     out = []
     s = model.column_scale(L)  # columns scaled to O(1)
     for q, pts in keep:
-        ang = model.quantities([f"{lk}.angle" for lk in links], q[None, :], u[None, :], p,
+        ang = model.quantities([qn for _, qn in angles], q[None, :], u[None, :], p,
                                np.ones((1, len(u))), np.zeros((1, len(u))))[:, 0]
         det = np.linalg.det(model.jac(q, u, p) * s) if model.nq else 1.0
         res = float(np.abs(model.residual(q, u, p)).max(initial=0.0) / L)
         out.append(Mode(q=np.array(q), unknowns=tuple(model.unknown_names),
-                        points={nm: (float(pts[2 * j]), float(pts[2 * j + 1]))
+                        points={nm: tuple(float(c) for c in pts[dim * j:dim * j + dim])
                                 for j, nm in enumerate(names)},
                         angles={lk: float(wrap_angle(a)) for lk, a in zip(links, ang)},
                         residual=res, orientation=int(np.sign(det)) if abs(det) > BRANCH else 0,

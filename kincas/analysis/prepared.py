@@ -50,7 +50,7 @@ class Prepared:
         self.p.flags.writeable = False
         self.size = m.size()
         self.keys = tuple(i.key for i in m.inputs)
-        self.guess = {k: (m.value(x), m.value(y)) for k, (x, y) in dict(m.guess).items()}
+        self.guess = {k: tuple(map(m.value, xy)) for k, xy in dict(m.guess).items()}
         # gears and racks: the first pose's free angles are taken into (-pi, pi] after Newton
         # (core/turns.settle): that pose stays on the careful path
         self.plain = not (m.gears or m.racks)

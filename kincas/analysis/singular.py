@@ -140,12 +140,12 @@ def input_range(m: Mechanism, inputs: dict, key: str | None = None, *, max_steps
     p = np.array([v for _, v in m.parameters], float)
     L = m.size()
     u0 = input_table(m, inputs, "inputs", None)[0]
-    guess = {k: (m.value(x), m.value(y)) for k, (x, y) in m.guess}
+    guess = {k: tuple(map(m.value, xy)) for k, xy in m.guess}
     start = first_pose(model, u0, p, L, guess)  # the starting pose, as a sweep's first
     if not start.ok:
         raise ValueError(f"the mechanism does not assemble at {inputs}")
     q0 = start.q
-    is_angle = m.inputs[i].kind == "angle"
+    is_angle = m.inputs[i].is_angle
     cq, cu = _scales(model, L)
     # unknowns / scale are O(1): angles as they are, lengths over the size
     scale = np.concatenate([cq, [cu[i]]]) * L

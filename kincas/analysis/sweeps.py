@@ -126,7 +126,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     Udd = _per_pose(m, accelerations, "accelerations", 0.0, n, pm.keys)
     Uddd = None if jerks is None else derivative_table(m, jerks, "jerks", 0.0, n, pm.keys)
     p, L = pm.p, pm.size
-    g = pm.guess if not guess else {**pm.guess, **{k: (m.value(x), m.value(y)) for k, (x, y) in check_guess(m, guess)}}
+    g = pm.guess if not guess else {**pm.guess, **{k: tuple(map(m.value, xy)) for k, xy in check_guess(m, guess)}}
     events = []
 
     def first(k):

@@ -38,7 +38,7 @@ from ..results import Sweep
 from .scene_study import StudyReader
 
 LARGEST = 1e100  # beyond it, squared lengths overflow double precision
-SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
+SECTIONS = {"title", "space", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
             "output", "optimize", "tolerance", "gravity", "loads", "study", "gears", "racks",
             "cams", "cam_design"}
 
@@ -258,25 +258,16 @@ class _Reader(StudyReader):
     # --- sections ---
     def scene(self) -> Scene:
         doc = self.doc
+        space = doc.get("space", "2d")
+        if space == "3d":  # a spatial scene: kincas/cli/scene_space.py
+            from .scene_space import read_space
+            return read_space(self, Scene, Study)
+        if space != "2d":
+            self.err(f"space: expected \"2d\" or \"3d\", got {space!r}")
         for k in doc:
             if k not in SECTIONS:
                 self.err(f"scene: unknown section or key {k!r} (expected {sorted(SECTIONS)})")
-        title = doc.get("title", "")
-        if not isinstance(title, str):
-            self.err("title: expected a string")
-        for k, v in self.table("parameters").items():
-            v = self.ranged(k, v)
-            if v is None:
-                continue
-            if isinstance(v, bool) or not isinstance(v, (int, float)):
-                self.err(f"[parameters] {k}: expected a number, got {v!r}")
-                self.bad_params.add(k)
-            elif not math.isfinite(v) or abs(v) > LARGEST:
-                self.err(f"[parameters] {k}: {v} is not a finite number" if not math.isfinite(v)
-                         else f"[parameters] {k}: {v:g} is too large (at most {LARGEST:g})")
-                self.bad_params.add(k)
-            else:
-                self.params[k] = float(v)
+        title = self.title_and_parameters()
         ground = {k: self.xy(f"[ground] {k}", v) for k, v in self.table("ground").items()}
         if GROUND in ground:
             self.err("[ground] ground: the name `ground` means the fixed frame")
@@ -334,6 +325,27 @@ class _Reader(StudyReader):
             else:
                 self.ranges[name] = (float(r[0]), float(r[1]))
         return v["value"]
+
+    def title_and_parameters(self) -> str:
+        """The scene's title (checked) and its `[parameters]`, read into `self.params`."""
+        doc = self.doc
+        title = doc.get("title", "")
+        if not isinstance(title, str):
+            self.err("title: expected a string")
+        for k, v in self.table("parameters").items():
+            v = self.ranged(k, v)
+            if v is None:
+                continue
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                self.err(f"[parameters] {k}: expected a number, got {v!r}")
+                self.bad_params.add(k)
+            elif not math.isfinite(v) or abs(v) > LARGEST:
+                self.err(f"[parameters] {k}: {v} is not a finite number" if not math.isfinite(v)
+                         else f"[parameters] {k}: {v:g} is too large (at most {LARGEST:g})")
+                self.bad_params.add(k)
+            else:
+                self.params[k] = float(v)
+        return title
 
     def lean_parameters(self) -> dict:
         """The parameters the model is built with: all of them, unless more than LEAN are

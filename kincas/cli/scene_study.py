@@ -38,23 +38,31 @@ if TYPE_CHECKING:
 class StudyReader:
     """The `[[inputs]]` and `[output]` sections, read into the scene reader's problems."""
 
+    INPUT_KINDS = ("angle", "parameter", "slide")  # a spatial scene's: joint, parameter, slide
+
+    def make_input(self, kind: str, name: str, where: str):
+        """The `Input` an `[[inputs]]` entry names (None, with the problem said, if none)."""
+        return Input(kind, name)
+
     def inputs(self):
         inputs, values, rates, accs, steps, written = [], {}, {}, {}, set(), {}
+        kinds_allowed = self.INPUT_KINDS
         for i, t in enumerate(self.array("inputs")):
             where = f"[[inputs]] {i + 1}"
-            self.fields(where, t, {"angle", "parameter", "slide", "value", "sweep", "rate",
-                                   "acceleration", "jerk"})
-            kinds = [k for k in ("angle", "parameter", "slide") if k in t]
+            self.fields(where, t, {*kinds_allowed, "value", "sweep", "rate", "acceleration", "jerk"})
+            kinds = [k for k in kinds_allowed if k in t]
             if len(kinds) != 1:
-                self.err(f"{where}: give exactly one of angle, parameter or slide")
+                self.err(f"{where}: give exactly one of {', '.join(kinds_allowed[:-1])} or {kinds_allowed[-1]}")
                 continue
             kind = kinds[0]
             if not isinstance(t[kind], str):
                 self.err(f"{where}: {kind}: expected a name")
                 continue
-            inp = Input(kind, t[kind])
+            inp = self.make_input(kind, t[kind], where)
+            if inp is None:
+                continue
             where = f"[[inputs]] {inp.key}"
-            ang = kind == "angle"
+            ang = inp.is_angle
             if ("value" in t) == ("sweep" in t):
                 self.err(f"{where}: give either `value` or `sweep`")
                 continue

@@ -310,6 +310,9 @@ def assemble(model, u, p, L, want=None, near=None, starts: int = 8) -> Solution 
     """
     bl = blocks(model)
     u, p = np.asarray(u, float), np.asarray(p, float)
+    # a model whose groups are not spread by turning angles (a spatial one: quaternions)
+    # says how many spread starts are worth a Newton run each
+    starts = min(starts, getattr(model, "assembly_starts", starts))
 
     def place(i, q):
         if i == len(bl):

@@ -32,6 +32,13 @@ def _build_pose_function(model):
     sym, m = model.sym, model.sym.mech
     out = [c for g in m.ground_points for c in sym.points[g]]
     out += [c for p in m.moving_points for c in sym.points[p]]
+    if sym.dim == 3:  # a spatial slide: its `through` point and direction (or normal), world axes
+        from .quaternions import apply, rotation
+        for sl in m.slides:
+            X = sym.world(sl.along, sym._rel(sl.through))
+            out += [X[i] + sym.origin[i] for i in range(3)]
+            out += apply(rotation(sym.frames[sl.along][1]), list(sl.direction or sl.normal))
+        return ca.Function("pose", [sym.q, sym.u, sym.p], [ca.vertcat(*out)])
     for sl in m.slides:
         ox, oy, th = sym.frames[sl.along]
         tx, ty = (sym.val(v) for v in sl.through)
@@ -50,6 +57,8 @@ def _mapped(f, Q, U, p):
 def pose_values(model, Q, U, p) -> np.ndarray:
     """Per pose: the ground points' and moving points' (x, y), then for each slide the point
     its line goes `through` (x, y) and the line's direction angle, in world coordinates.
+    For a spatial mechanism (`model.sym.dim` 3): points' (x, y, z), then per slide its
+    `through` point (x, y, z) and its direction (a plane's normal), a unit vector.
 
     Parameters
     ----------
@@ -62,7 +71,7 @@ def pose_values(model, Q, U, p) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        N x (2 (ground + moving points) + 3 slides).
+        N x (2 (ground + moving points) + 3 slides); in space N x (3 points + 6 slides).
 
     Examples
     --------

@@ -102,7 +102,7 @@ class FirstPose:
             if self._nlp is None:
                 self._nlp = self._build_nlp()
         solver, _ = self._nlp
-        T = np.zeros((2, len(names)))
+        T = np.zeros((sym.dim, len(names)))
         W = np.zeros(len(names))
         for k, n in enumerate(names):
             if n in targets:
@@ -118,7 +118,7 @@ class FirstPose:
         sym, names = self.sym, list(self.sym.mech.moving_points)
         x = ca.SX.sym("x", self.nq)
         npt = len(names)
-        T, W = ca.SX.sym("T", 2, npt), ca.SX.sym("W", npt)
+        T, W = ca.SX.sym("T", sym.dim, npt), ca.SX.sym("W", npt)
         x0, Ls = ca.SX.sym("x0", self.nq), ca.SX.sym("L")
         qscale = ca.if_else(ca.DM(sym.is_length.astype(float)), Ls, 1)
         q = x * qscale

@@ -63,7 +63,7 @@ class Time:
         sym = self.sym
         size = self.size
         ud = self.zd[sym.nq:]
-        terms = [ca.fabs(ud[k]) * (size if i.kind == "angle" else 1.0) for k, i in enumerate(sym.mech.inputs)]
+        terms = [ca.fabs(ud[k]) * (size if i.is_angle else 1.0) for k, i in enumerate(sym.mech.inputs)]
         return sum(terms, ca.SX(0))
 
     @property

@@ -83,9 +83,10 @@ def _cost(model, u, p, guess):
     held = [k for k, nm in enumerate(names) if nm in guess and owner[k] >= 0]
     if not held:
         return None
-    rows = np.ravel([(2 * k, 2 * k + 1) for k in held]).astype(int)
+    dim = model.sym.dim
+    rows = np.ravel([[dim * k + i for i in range(dim)] for k in held]).astype(int)
     G = np.ravel([np.asarray(guess[names[k]], float) for k in held])
-    lp = np.repeat([eq[model.blocks[owner[k]].rows[0]] for k in held], 2)
+    lp = np.repeat([eq[model.blocks[owner[k]].rows[0]] for k in held], dim)
 
     def cost(q):
         d = (np.asarray(call(q, u, p)[0]).ravel()[rows] - G) / lp
@@ -103,8 +104,8 @@ def _points(model):
         group = np.full(sym.nq, -1)
         for i, b in enumerate(model.blocks):
             group[b.cols] = i
-        owner = np.full(P.numel() // 2, -1)
+        owner = np.full(P.numel() // sym.dim, -1)
         for r, c in zip(*ca.jacobian(P, sym.q).sparsity().get_triplet()):
-            owner[r // 2] = max(owner[r // 2], group[c])
+            owner[r // sym.dim] = max(owner[r // sym.dim], group[c])
         return _Call(ca.Function("guessed_points", [sym.q, sym.u, sym.p], [P])), owner
     return model.memo("guessed.points", build)

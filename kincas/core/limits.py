@@ -41,7 +41,7 @@ from .tolerances import MAX_ITER, NULL_RESIDUAL, ROUNDING, STEP_SLACK, TINY
 
 def _scales(model, L):
     """Column scales of g_q (unknowns) and g_u (inputs): a size-L mechanism gives O(1) entries."""
-    cu = np.array([1.0 / L if i.kind == "angle" else 1.0 for i in model.sym.mech.inputs])
+    cu = np.array([1.0 / L if i.is_angle else 1.0 for i in model.sym.mech.inputs])
     return model.column_scale(L), cu
 
 

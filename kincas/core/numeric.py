@@ -33,6 +33,8 @@ from .caches import Memo
 from .first_pose import FirstPose
 from .newton import lsolve as _lsolve, newton as _newton
 from .redundant import decide
+from .space_model import SpatialFirstPose, structure_key as _space_key
+from .space_symbolic import SpatialSymbolic
 from .structure import Structure
 from .symbolic import Symbolic
 from .tolerances import ACCEPT, IPOPT_TOL, MAX_ITER, MAX_STEP, REGULARIZE, TOL  # noqa: F401  (their old home)
@@ -81,7 +83,10 @@ def model_of(m: Mechanism, check: bool = True) -> "Model":
     (2, [2], True)
     """
     # built once per structure, however many threads ask (Symbolic never reads parameter values)
-    model = _CACHE.get_or_build(_structure_key(m), lambda: Model(Symbolic(m)))
+    if getattr(m, "space", "2d") == "3d":  # a spatial mechanism: the same interface
+        model = _CACHE.get_or_build(_space_key(m), lambda: SpatialModel(m))
+    else:
+        model = _CACHE.get_or_build(_structure_key(m), lambda: Model(Symbolic(m)))
     if check and needs_rank_test(m):
         decide(m, model)
     return model
@@ -150,7 +155,7 @@ class Model(FirstPose):
         self.nq, self.nu, self.ng = sym.nq, sym.nu, sym.ng
         self.square = self.ng == self.nq  # tall: redundant joints (a consistent system)
         m = sym.mech
-        locs = [sym.val(c) for lk in m.links for _, xy in lk.points for c in xy]
+        locs = [c for lk in m.links for xy in sym.local_points(lk) for c in xy]
         self.f_local = ca.Function("local", [sym.u, sym.p], [ca.vertcat(*locs)])
         gxy = [c for g, _ in m.ground for c in sym.points[g]]
         self.f_ground = ca.Function("ground", [sym.u, sym.p], [ca.vertcat(*gxy) if gxy else ca.SX(0, 1)])
@@ -289,7 +294,7 @@ class Model(FirstPose):
         return self._resjac(q, u, p)[1]
 
     def points(self, q, u, p) -> np.ndarray:
-        """World positions of the moving points, 2 x n."""
+        """World positions of the moving points, 2 x n (3 x n in space)."""
         return np.asarray(self.sym.f_points(q, u, p))
 
     def memo(self, key, build):
@@ -334,6 +339,11 @@ class Model(FirstPose):
         return [nm for nm, _ in self.sym.unknowns]
 
     @property
+    def dim(self) -> int:
+        """Coordinates of a point: 2, or 3 for a spatial mechanism."""
+        return self.sym.dim
+
+    @property
     def is_length(self) -> np.ndarray:
         """Per unknown: True for a length (a floating link's origin), False for an angle."""
         return self.sym.is_length
@@ -354,4 +364,12 @@ class Model(FirstPose):
             return np.zeros((0, 0))
         f = self.sym.f_points.map(n)
         pts = np.asarray(f(Q.T, np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)))
-        return pts.reshape(2, -1, n, order="F").transpose(2, 1, 0).reshape(n, -1)
+        return pts.reshape(self.sym.dim, -1, n, order="F").transpose(2, 1, 0).reshape(n, -1)
+
+
+class SpatialModel(SpatialFirstPose, Model):
+    """`Model` of a spatial mechanism (kincas/core/space_symbolic.py): the same numerics, its
+    first pose from the drawing pose (kincas/core/space_model.py)."""
+
+    def __init__(self, m):
+        Model.__init__(self, SpatialSymbolic(m))

@@ -64,7 +64,7 @@ ASSEMBLIES = 8  # distinct assemblies examined at most (a wrong mechanism pays f
 def _start_inputs(m) -> np.ndarray:
     """Input values read off the guess: an angle input takes the angle that points its link
     at a guessed or ground point, a driven parameter its declared value, a slide 0."""
-    known = {k: (m.value(x), m.value(y)) for k, (x, y) in (*m.ground, *m.guess)}
+    known = {k: tuple(map(m.value, xy)) for k, xy in (*m.ground, *m.guess)}
     u = []
     for inp in m.inputs:
         v = 0.0
@@ -93,7 +93,7 @@ class _Chain:
         self.model, self.nq, self.nu = model, model.nq, len(m.inputs)
         self.p = np.array([v for _, v in m.parameters], float)
         self.L = m.size()
-        self.angle = np.concatenate([~model.sym.is_length, [i.kind == "angle" for i in m.inputs]])
+        self.angle = np.concatenate([~model.sym.is_length, [i.is_angle for i in m.inputs]])
         self.unit = np.where(self.angle, 1.0, self.L)
         # the chain's own coordinates: q and the inputs that are not driven parameters
         self.chain = np.array(list(range(self.nq)) + [self.nq + k for k, i in enumerate(m.inputs)
@@ -154,8 +154,10 @@ def _starts(m, chain, rng) -> list[np.ndarray]:
     with the inputs read off it, and with each angle input turned through the circle (an
     input whose link has no guessed point is otherwise a blind 0.3 rad, inconsistent with
     the guessed points: Gauss-Newton from there may end anywhere)."""
-    guess = {k: (m.value(x), m.value(y)) for k, (x, y) in m.guess}
-    u0 = _start_inputs(m)
+    guess = {k: tuple(map(m.value, xy)) for k, xy in m.guess}
+    # a spatial model starts where it is drawn: joint coordinates 0 (kincas/core/space_model.py)
+    drawn = getattr(chain.model, "drawing_inputs", None)
+    u0 = _start_inputs(m) if drawn is None else drawn(chain.p)
     us = [u0]
     for k, inp in enumerate(m.inputs):
         if inp.kind == "angle":

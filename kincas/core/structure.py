@@ -90,7 +90,8 @@ class Structure:
         """The block's links and the bodies joined to them (the bodies its loops pass through),
         and the ground points the block's links carry."""
         m = self.sym.mech
-        pts = {p for lk in m.links if lk.name in links for p in lk.point_names}
+        # (a point that only bars carry owns its own unknowns: kincas/core/space_symbolic.py)
+        pts = {p for lk in m.links if lk.name in links for p in lk.point_names} | set(links)
         # bodies meeting the block's links at a pin, or at a slide (either side of it)
         slid = {s.along for s in m.slides if s.point in pts}
         slid_pts = {s.point for s in m.slides if s.along in links}
@@ -107,20 +108,20 @@ class Structure:
         `ground` the ground points' coordinates, both at the parameter values in use. A block
         with no extent takes the whole mechanism's length (`Mechanism.size()`'s definition,
         from these same values: the model is shared by every parameter value)."""
-        m = self.sym.mech
+        m, dim = self.sym.mech, self.sym.dim
         ext, k = [], 0
         for lk in m.links:
             n = len(lk.points)
-            pts = local[k:k + 2 * n].reshape(n, 2)
-            k += 2 * n
+            pts = local[k:k + dim * n].reshape(n, dim)
+            k += dim * n
             ext.append(max((math.dist(a, b) for a in pts for b in pts), default=0.0))
-        gxy = ground.reshape(-1, 2)
+        gxy = ground.reshape(-1, dim)
         out = np.empty(len(self.blocks))
         for i, (near, gidx) in enumerate(self._extent_links):
             span = max((math.dist(gxy[a], gxy[b]) for a in gidx for b in gidx), default=0.0)
             out[i] = max([span] + [ext[j] for j in near])
         if not out.all():
-            box = np.ptp(gxy, axis=0) if len(gxy) else np.zeros(2)
+            box = np.ptp(gxy, axis=0) if len(gxy) else np.zeros(dim)
             out[out == 0] = max(max(ext, default=0.0), math.hypot(*box)) or 1.0
         return out
 
@@ -132,10 +133,10 @@ class Structure:
 
         sym, m = self.sym, self.sym.mech
         fmax = lambda xs, d=0.0: _reduce(ca.fmax, xs, d)
-        dist = lambda a, b: ca.sqrt((a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2)
+        dist = lambda a, b: ca.sqrt(sum((a[i] - b[i]) ** 2 for i in range(len(a))))
         ext = []
         for lk in m.links:
-            pts = [(sym.val(x), sym.val(y)) for _, (x, y) in lk.points]
+            pts = sym.local_points(lk)
             ext.append(fmax([dist(a, b) for i, a in enumerate(pts) for b in pts[i + 1:]]))
         gxy = [sym.points[g] for g, _ in m.ground]
         out = []
@@ -144,8 +145,8 @@ class Structure:
             out.append(fmax(span + [ext[j] for j in near]))
         if gxy:
             box = [fmax([g[c] for g in gxy], -ca.inf) - _reduce(ca.fmin, [g[c] for g in gxy], ca.inf)
-                   for c in (0, 1)]
-            whole = fmax([fmax(ext), ca.sqrt(box[0] ** 2 + box[1] ** 2)])
+                   for c in range(sym.dim)]
+            whole = fmax([fmax(ext), ca.sqrt(sum(b ** 2 for b in box))])
         else:
             whole = fmax(ext)
         whole = ca.if_else(whole == 0, 1.0, whole)

@@ -60,6 +60,8 @@ def needs_jerk(name: str) -> bool:
 class Symbolic:
     """The symbolic model of one mechanism structure; parameters stay symbolic."""
 
+    dim = 2  # coordinates of a point (kincas/core/space_symbolic.py: 3)
+
     def __init__(self, mech: Mechanism):
         self.mech = mech
         self.pnames = [k for k, _ in mech.parameters]
@@ -123,13 +125,18 @@ class Symbolic:
         for k, i in enumerate(m.inputs):
             if i.kind == "slide":
                 eqs.append(self.slide_s[i.target] - self.u[k])
+        self.angles = {lk.name: self.frames[lk.name][2] for lk in m.links}
+        self._finish(qs, eqs)
+
+    def _finish(self, qs, eqs):
+        """The unknowns q and residual g from their lists, g's Jacobians and the Functions
+        every solve calls (shared with the spatial model, kincas/core/space_symbolic.py)."""
         self.q = ca.vertcat(*qs) if qs else ca.SX(0, 1)
         self.nq = len(qs)
         self.g = ca.vertcat(*eqs) if eqs else ca.SX(0, 1)
         self.ng = self.g.numel()
         if self.ng < self.nq:  # guarded by the model's mobility check
             raise ModelError(f"[inputs]: {self.nq} unknowns but {self.ng} equations")
-        self.angles = {lk.name: self.frames[lk.name][2] for lk in m.links}
         self.is_length = np.array([k == "length" for _, k in self.unknowns], dtype=bool)
         self.Jq = ca.jacobian(self.g, self.q)
         self.Ju = ca.jacobian(self.g, self.u)
@@ -141,7 +148,11 @@ class Symbolic:
 
     def _point_matrix(self):
         pts = [self.points[p] for p in self.mech.moving_points]
-        return ca.horzcat(*[ca.vertcat(x, y) for x, y in pts]) if pts else ca.SX(2, 0)
+        return ca.horzcat(*[ca.vertcat(*xy) for xy in pts]) if pts else ca.SX(self.dim, 0)
+
+    def local_points(self, lk) -> list[tuple]:
+        """A link's points in its own frame, as expressions of the parameters."""
+        return [tuple(self.val(c) for c in xy) for _, xy in lk.points]
 
     def lsolve(self, b):
         """g_q^-1 b, or for a tall consistent system (redundant joints) the solution of its

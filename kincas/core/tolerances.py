@@ -89,3 +89,7 @@ CHOICE_TRIES = 8  # of which at most this many are swept
 
 # --- pictures ---
 END_ON = 1e-6  # a slide's unit direction drawn shorter than this is seen end on (views/projection.py)
+
+# spatial mechanisms (core/space_model.py, core/space_symbolic.py)
+IDENTITY_PULL = 1e-9  # a rigid fit's faint pull towards the identity, relative to its points' spread
+PROJECTION = 1e-9  # a unit axis projected on a plane shorter than this is normal to it

@@ -84,6 +84,8 @@ def check_guess(m: Mechanism, guess) -> tuple:
       [guess] Z: is not a point of any link
       [guess] Z: nan is not a finite number
     """
+    if getattr(m, "space", "2d") == "3d":  # (x, y, z): kincas/model/space.py checks its own
+        return m.check_guess(guess)
     items = tuple((k, _pair(v, f"[guess] {k}")) for k, v in _table(guess, "guess"))
     out: list[str] = []
     _guess_problems(items, set(m.moving_points), set(m.ground_points),

@@ -43,6 +43,11 @@ def is_angular(name: str, mech=None) -> bool:
     kind, a, b = parse_quantity(name)
     if kind == "sens":
         return is_angular(a, mech)
+    if getattr(mech, "space", "2d") == "3d":
+        from .space_names import ANGULAR, linear_jerks
+        if b == "jerk" and a in linear_jerks(mech):
+            return False
+        return b in LINK_Q or b in ANGULAR
     if b == "jerk" and mech is not None and a in {s.name for s in mech.slides}:
         return False
     return b in LINK_Q or b in ANGULAR_ATTRS
@@ -63,6 +68,9 @@ def plain_quantity(m, name: str) -> bool:
     if kind == "sens":
         driven = {i.target for i in m.inputs if i.kind == "parameter"}
         return plain_quantity(m, a) and b in m.param_values and b not in driven
+    if getattr(m, "space", "2d") == "3d":
+        from .space_names import space_quantity
+        return space_quantity(m, a, b)
     points = set(m.ground_points) | {p for lk in m.links for p in lk.point_names}
     return ((b in POINT_Q and a in points) or (b in LINK_Q and a in {lk.name for lk in m.links})
             or (b in SLIDE_Q and a in {s.name for s in m.slides}))
@@ -77,4 +85,7 @@ def default_report(m) -> list[str]:
     ...                          inputs=[Input.angle("crank")]))
     ['A.x', 'A.y', 'crank.angle']
     """
+    if getattr(m, "space", "2d") == "3d":
+        from .space_names import space_report
+        return space_report(m)
     return [f"{p}.{c}" for p in m.moving_points for c in "xy"] + [f"{lk.name}.angle" for lk in m.links]

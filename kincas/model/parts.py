@@ -216,7 +216,7 @@ class Input:
     ('crank.angle', 'guide.s', 'stroke')
     """
 
-    kind: str  # "angle" | "slide" | "parameter"
+    kind: str  # "angle" | "slide" | "parameter" | "joint" (a spatial joint's coordinate)
     target: str
 
     @classmethod
@@ -280,6 +280,26 @@ class Input:
         return cls("slide", slide)
 
     @classmethod
+    def joint(cls, coordinate: str) -> "Input":
+        """A spatial joint's coordinate: "J" (a joint with one coordinate) or "J.angle1",
+        "J.s", ... (kincas.SpatialMechanism keys it by its coordinate: "J.angle").
+
+        Parameters
+        ----------
+        coordinate : str
+
+        Returns
+        -------
+        Input
+
+        Examples
+        --------
+        >>> Input.joint("A.angle").key, Input.joint("cross.angle2").is_angle
+        ('A.angle', True)
+        """
+        return cls("joint", coordinate)
+
+    @classmethod
     def parameter(cls, name: str) -> "Input":
         """A parameter driven as an input (a link that changes length, say).
 
@@ -319,4 +339,6 @@ class Input:
         >>> Input.angle("crank").is_angle, Input.slide("guide").is_angle
         (True, False)
         """
+        if self.kind == "joint":
+            return self.target.rpartition(".")[2].startswith("angle")
         return self.kind == "angle"

@@ -60,10 +60,19 @@ def geometry(m: Mechanism, sweep: Sweep) -> Geometry:
     p = np.array([v for _, v in m.parameters], float)
     Q = np.where(ok[:, None], sweep.q, 0.0)  # what depends on q is masked below
     raw = pose_values(model, Q, U, p)
-    ng = len(m.ground_points)
-    xy = raw[:, :2 * len(names)].reshape(n, len(names), 2).copy()
+    ng, dim = len(m.ground_points), model.dim  # (x, y) or, in space, (x, y, z)
+    xy = raw[:, :dim * len(names)].reshape(n, len(names), dim).copy()
     xy[~ok, ng:] = np.nan  # ground points are known at every pose, moving ones when solved
     slides = {}
+    if dim == 3:  # per slide: through (N x 3), unit direction or normal (N x 3), s (N,)
+        for k, sl in enumerate(m.slides):
+            c = 3 * len(names) + 6 * k
+            through, d = raw[:, c:c + 3].copy(), raw[:, c + 3:c + 6].copy()
+            if sl.along != GROUND:
+                through[~ok], d[~ok] = np.nan, np.nan
+            s = np.einsum("ij,ij->i", xy[:, names.index(sl.point)] - through, d)
+            slides[sl.name] = (through, d, s)
+        return Geometry(names, xy, slides, ok, None)
     for k, sl in enumerate(m.slides):
         c = 2 * len(names) + 3 * k
         through, angle = raw[:, c:c + 2].copy(), raw[:, c + 2].copy()

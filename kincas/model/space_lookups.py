@@ -1,0 +1,357 @@
+"""What a spatial mechanism answers as a planar `Mechanism` does (its parameters, bodies,
+joints, points, size, new values): a part of `kincas.SpatialMechanism` (kincas/model/space.py).
+
+>>> from kincas import SpatialMechanism
+>>> SpatialMechanism(parameters={"r": 2.0}).parameter("r")
+2.0
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from ..errors import ModelError
+from .checks import _number_check
+from typing import TYPE_CHECKING
+
+from .parts import Num, as_param, is_number
+from .space_parts import Body, Joint, SpatialSlide, _triple
+
+if TYPE_CHECKING:
+    from .space import SpatialMechanism
+from .values import _table
+
+
+class SpatialLookups:
+    """Lookups and new values of a `SpatialMechanism` (the fields are the dataclass's)."""
+
+    @property
+    def links(self) -> tuple:
+        """The bodies and bars (named like a planar mechanism's links).
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> [b.name for b in m.links]
+        ['arm']
+        """
+        return self.bodies
+
+    @property
+    def redundant(self) -> int:
+        """Equations implied by the others (Bennett's, Bricard's linkage): decided by the
+        constraint Jacobian's rank at generic assemblies, whatever the guess (as
+        `Mechanism.redundant`).
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")]).redundant
+        0
+        """
+        from .mechanism import Mechanism
+        return Mechanism.redundant.fget(self)
+
+    @property
+    def param_values(self) -> dict[str, float]:
+        """The parameters as a dict.
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.param_values
+        {}
+        """
+        return dict(self.parameters)
+
+    def parameter(self, name: str) -> float:
+        """A parameter's value.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        float
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.with_parameters() and SpatialMechanism(parameters={"r": 2.0}).parameter("r")
+        2.0
+        """
+        return self.param_values[name]
+
+    def link(self, name: str) -> Body:
+        """The body of that name.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        Body
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.link("arm").point_names
+        ('O', 'P')
+        """
+        return {b.name: b for b in self.bodies}[name]
+
+    def joint(self, name: str) -> Joint:
+        """The joint of that name.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        Joint
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.joint("O").type
+        'revolute'
+        """
+        return {j.name: j for j in self.joints}[name]
+
+    def slide(self, name: str) -> SpatialSlide:
+        """The slide of that name.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        SpatialSlide
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body.bar("b", "O", "P", 1)],
+        ...     slides=[SpatialSlide("P", "ground", (0, 0, 0), direction=(1, 0, 0))], guess={"P": (1, 0, 0)}).slide("P").on_line
+        True
+        """
+        return {s.name: s for s in self.slides}[name]
+
+    @property
+    def ground_points(self) -> tuple[str, ...]:
+        """The ground points' names.
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.ground_points
+        ('O',)
+        """
+        return tuple(g for g, _ in self.ground)
+
+    @property
+    def moving_points(self) -> tuple[str, ...]:
+        """Points carried by bodies and not fixed to the ground, in declaration order.
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.moving_points
+        ('P',)
+        """
+        seen = dict.fromkeys(p for b in self.bodies for p in b.point_names)
+        return tuple(p for p in seen if p not in dict(self.ground))
+
+    @property
+    def mobility(self) -> int:
+        """Degrees of freedom counted (unknowns minus equations).
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.mobility
+        1
+        """
+        return self.structure.mobility
+
+    def value(self, v: Num) -> float:
+        """The number `v`, resolving a parameter reference.
+
+        Parameters
+        ----------
+        v : float, str or Param
+
+        Returns
+        -------
+        float
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> SpatialMechanism(parameters={"r": 2.0}).value("r")
+        2.0
+        """
+        p = as_param(v)
+        return float(v) if p is None else p.scale * self.param_values[p.name]
+
+    def _drawn(self):
+        """(point, (x, y, z)) as drawn, for every moving point a rigid body carries."""
+        out = {}
+        for b in self.bodies:
+            for p, xyz in b.points:
+                if xyz is not None and p not in dict(self.ground):
+                    out.setdefault(p, xyz)
+        return tuple(out.items())
+
+    def size(self) -> float:
+        """The largest distance between two points of a body, a bar's length or the span of
+        the ground points (1 if none).
+
+        Returns
+        -------
+        float
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.size()
+        1.0
+        """
+        ext = 0.0
+        for b in self.bodies:
+            if b.two_point:
+                ext = max(ext, abs(self.value(b.length)))
+                continue
+            pts = [tuple(map(self.value, xyz)) for _, xyz in b.points]
+            ext = max([ext] + [math.dist(a, c) for a in pts for c in pts])
+        g = [tuple(map(self.value, xyz)) for _, xyz in self.ground]
+        ext = max([ext] + [math.dist(a, c) for a in g for c in g])
+        return ext if ext > 0 else 1.0
+
+    def sizes(self, P, pnames) -> list[float]:
+        """`size()` of each design: row k of P gives the parameters `pnames`.
+
+        Parameters
+        ----------
+        P : array (designs x parameters)
+        pnames : list of str
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> SpatialMechanism(parameters={"r": 2.0}, ground={"O": (0, 0, 0)}, bodies=[Body.bar("b", "O", "P", "r")],
+        ...     slides=[SpatialSlide("P", "ground", (0, 0, 0), direction=(1, 0, 0))], guess={"P": (2, 0, 0)}).sizes([[3.0], [4.0]], ["r"]).tolist()
+        [3.0, 4.0]
+        """
+        import numpy as np
+        return np.array([self.with_parameters(**dict(zip(pnames, map(float, row)))).size() for row in P])
+
+    def check_guess(self, guess) -> tuple:
+        """A guess given to one call, checked as the mechanism's own (ModelError otherwise).
+
+        Parameters
+        ----------
+        guess : dict
+            Point -> (x, y, z).
+
+        Returns
+        -------
+        tuple
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> m.check_guess({"P": (0, 1, 0)})
+        (('P', (0, 1, 0)),)
+        """
+        items = tuple((k, _triple(v, f"[guess] {k}")) for k, v in _table(guess, "guess", "(x, y, z)"))
+        out: list[str] = []
+        num = _number_check(self.param_values, out)
+        for p, xyz in items:
+            if p not in self.moving_points:
+                out.append(f"[guess] {p}: is not a moving point")
+            for c in xyz:
+                num(f"[guess] {p}", c)
+        if out:
+            raise ModelError(out)
+        return items
+
+    def with_parameters(self, **values: float) -> "SpatialMechanism":
+        """A new mechanism with some parameters changed.
+
+        Parameters
+        ----------
+        **values : float
+
+        Returns
+        -------
+        SpatialMechanism
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> SpatialMechanism(parameters={"r": 2.0}).with_parameters(r=3).parameter("r")
+        3.0
+        """
+        bad = [f"[parameters] {k}: no such parameter" for k in values if k not in self.param_values]
+        bad += [f"[parameters] {k}: expected a number" for k, v in values.items() if not is_number(v)]
+        if bad:
+            raise ModelError(bad)
+        return replace(self, parameters={**self.param_values, **{k: float(v) for k, v in values.items()}})
+
+    def with_guess(self, **points) -> "SpatialMechanism":
+        """A new mechanism whose guess is updated (point -> (x, y, z)).
+
+        Parameters
+        ----------
+        **points : (float, float, float)
+
+        Returns
+        -------
+        SpatialMechanism
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+        >>> dict(m.with_guess(P=(0, 1, 0)).guess)["P"]
+        (0, 1, 0)
+        """
+        return replace(self, guess={**dict(self.guess), **points})
+
