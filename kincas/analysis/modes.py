@@ -30,6 +30,8 @@ True
 from __future__ import annotations
 
 import math
+import sys
+import types
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -82,6 +84,46 @@ class Mode:
 
 
 # --- the search ---
+
+
+def modes(mechanism: Mechanism, inputs=None, *, certify: bool = False, **options) -> "Modes":
+    """Every real assembly of `mechanism` at `inputs`: by the multistart search
+    (`find_modes`, not certified), or with `certify=True` by an exact real-root solver whose
+    answer proves the list complete (`kincas.analysis.certify.certify_modes`: needs
+    `pip install "kincas[certify]"`; pins and slides only).
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+    inputs : dict or float, optional
+        Input key -> value (radians for angles); a number for a one-input mechanism.
+    certify : bool
+        Prove the list complete (each mode isolated in a box by msolve, refined by Newton).
+    **options
+        Passed on: `starts`, `seed`, `iterations` (multistart), or `threads`, `timeout`
+        (certified).
+
+    Returns
+    -------
+    Modes
+        A list of `Mode`; `.certified` tells which search made it. Certified, each mode also
+        has `halfwidth`, `multiplicity` and `flag`, and the list its `count`.
+
+    Examples
+    --------
+    >>> import numpy as np, kincas
+    >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+    ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+    ...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
+    >>> found = kincas.modes(m, {"crank.angle": np.pi / 2}, starts=64)
+    >>> len(found), found.certified
+    (2, False)
+    """
+    if certify:
+        from .certify import certify_modes
+        return certify_modes(mechanism, inputs, **options)
+    return find_modes(mechanism, inputs, **options)
+
 
 
 def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
@@ -192,25 +234,45 @@ def _unique(rows: np.ndarray, tol: float) -> list[int]:
 def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
     """One Mode per distinct assembly: two solutions are the same mode when all their moving
     points agree to SAME * L (the points fix every link's angle modulo 2 pi)."""
-    names = m.moving_points
     picked = None if picked_q is None else model.points(picked_q, u, p).T.ravel()
     Q = np.array(found).reshape(len(found), model.nq)
     rows = _point_rows(model, Q, u, p)
     keep = [(Q[k], rows[k]) for k in _unique(rows, SAME * L)]
     keep.sort(key=lambda t: tuple(np.round(t[1] / (SAME * L))))
-    links = [lk.name for lk in m.links]
-    out = []
-    s = model.column_scale(L)  # columns scaled to O(1)
-    for q, pts in keep:
-        ang = model.quantities([f"{lk}.angle" for lk in links], q[None, :], u[None, :], p,
-                               np.ones((1, len(u))), np.zeros((1, len(u))))[:, 0]
-        det = np.linalg.det(model.jac(q, u, p) * s) if model.nq else 1.0
-        res = float(np.abs(model.residual(q, u, p)).max(initial=0.0) / L)
-        out.append(Mode(q=np.array(q), unknowns=tuple(model.unknown_names),
-                        points={nm: (float(pts[2 * j]), float(pts[2 * j + 1]))
-                                for j, nm in enumerate(names)},
-                        angles={lk: float(wrap_angle(a)) for lk, a in zip(links, ang)},
-                        residual=res, orientation=int(np.sign(det)) if abs(det) > BRANCH else 0,
-                        from_guess=bool(picked is not None and np.abs(pts - picked).max() <= SAME * L),
-                        inputs={i.key: float(v) for i, v in zip(m.inputs, u)}))
+    out = [mode_at(m, model, q, u, p, L, picked, pts) for q, pts in keep]
     return [md for md in out if md.residual <= ACCEPT]  # each checked by its residual
+
+
+def mode_at(m, model, q, u, p, L, picked=None, pts=None, kind=None, **extra) -> Mode:
+    """The `Mode` at unknowns q: its points, link angles, relative residual, orientation, and
+    whether it is the assembly `picked` (a row of points, or None); `kind` a subclass of
+    Mode built with the `extra` fields (kincas/analysis/certify.py)."""
+    names = m.moving_points
+    pts = model.points(q, u, p).T.ravel() if pts is None else pts
+    links = [lk.name for lk in m.links]
+    s = model.column_scale(L)  # columns scaled to O(1)
+    ang = model.quantities([f"{lk}.angle" for lk in links], q[None, :], u[None, :], p,
+                           np.ones((1, len(u))), np.zeros((1, len(u))))[:, 0]
+    det = np.linalg.det(model.jac(q, u, p) * s) if model.nq else 1.0
+    res = float(np.abs(model.residual(q, u, p)).max(initial=0.0) / L)
+    return (kind or Mode)(
+        q=np.array(q), unknowns=tuple(model.unknown_names),
+        points={nm: (float(pts[2 * j]), float(pts[2 * j + 1])) for j, nm in enumerate(names)},
+        angles={lk: float(wrap_angle(a)) for lk, a in zip(links, ang)},
+        residual=res, orientation=int(np.sign(det)) if abs(det) > BRANCH else 0,
+        from_guess=bool(picked is not None and np.abs(pts - picked).max() <= SAME * L),
+        inputs={i.key: float(v) for i, v in zip(m.inputs, u)}, **extra)
+
+
+# --- `kincas.modes(...)`: the function, also reachable by its 0.1 module path ---
+
+
+class _CallableModule(types.ModuleType):
+    """`kincas.modes` is both this module (`import kincas.modes`, the path of 0.1) and the
+    function `modes`: calling the module calls it."""
+
+    def __call__(self, *args, **kwargs) -> "Modes":
+        return modes(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

@@ -72,3 +72,10 @@ FREE_LINKS = 6  # links left free by a guess that are tried in several turns (co
 NEARER = 1e-9  # another start's assembly is nearer the guessed points when its cost is below (1 - this) times
 CHOICE_STARTS = 128  # scattered starts finding a guessless sweep's other assemblies (analysis/choice.py)
 CHOICE_TRIES = 8  # of which at most this many are swept
+
+# --- certified assembly modes (kincas/core/polynomial*.py, kincas/analysis/certify*.py) ---
+CERTIFY_DENOMINATOR = 2 ** 20  # a driven or line angle's half-angle tangent rounded to a rational of this denominator at most (angle within ~1e-12 rad)
+CERTIFY_BITS = 64  # msolve's precision of the isolating boxes (bits; boxes far smaller than a float's rounding)
+CERTIFY_SLACK = 1e-12  # a refined float point lies in its box when within this (times the size, or 1 for a cosine) of it
+CERTIFY_TIMEOUT = 120.0  # seconds msolve may take before the certificate is given up
+CERTIFY_NUDGE = 1e-7  # input change (rad, or times the size) that splits coinciding assemblies to count them
