@@ -90,7 +90,7 @@ class CertifiedModes(Modes):
         return f"{len(self)} assembly modes (certified: every real assembly)"
 
 
-def certify_modes(m: Mechanism, inputs=None, *, threads: int = 2,
+def certify_modes(m: Mechanism, inputs=None, *, threads: int = 1,
                   timeout: float = CERTIFY_TIMEOUT) -> CertifiedModes:
     """Every real assembly of `m` at `inputs`, proven complete by an exact solver.
 
@@ -101,7 +101,8 @@ def certify_modes(m: Mechanism, inputs=None, *, threads: int = 2,
     inputs : dict or float, optional
         Input key -> value; a number for a one-input mechanism.
     threads : int
-        msolve's threads.
+        msolve's threads (one: on a loaded machine two were 10 times slower on these small
+        systems).
     timeout : float
         Seconds before msolve is stopped (`SolverFailed`).
 

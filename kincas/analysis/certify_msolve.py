@@ -65,7 +65,7 @@ def available() -> bool:
     return executable() is not None
 
 
-def solve(text: str, *, threads: int = 2, timeout: float = CERTIFY_TIMEOUT,
+def solve(text: str, *, threads: int = 1, timeout: float = CERTIFY_TIMEOUT,
           bits: int = CERTIFY_BITS) -> tuple[str, list]:
     """Run msolve on an input file's text; ("finite" | "positive", boxes) as `parse` gives.
 
@@ -93,13 +93,14 @@ def solve(text: str, *, threads: int = 2, timeout: float = CERTIFY_TIMEOUT,
 def _wait(proc, timeout: float) -> None:
     """Wait for msolve, killing it (and its threads) on a timeout or an interruption."""
     import time
-    end = time.monotonic() + timeout
+    end, poll = time.monotonic() + timeout, 0.005  # most systems take milliseconds: poll fast first
     try:
         while True:
             try:
-                proc.wait(timeout=WAIT)
+                proc.wait(timeout=poll)
                 return
             except subprocess.TimeoutExpired:
+                poll = min(2 * poll, WAIT)
                 checkpoint()  # raises Cancelled when this work was cancelled
                 if time.monotonic() > end:
                     _kill(proc)
