@@ -234,3 +234,60 @@ def test_cli_json_contract_and_scenes_written(capsys, tmp_path):
     code, text, err = run_cli(capsys, "modes", EXAMPLES / "fairbairn.toml", "--certify")
     assert code == 0 and "certified" in text and "not certified" not in text and "count 2" in text
     json.dumps(out)  # plain JSON
+
+
+# ----------------------------------------------------------------------------- the subprocess
+
+def fake_msolve(tmp_path, body):
+    exe = tmp_path / "msolve"
+    exe.write_text("#!/bin/sh\n" + body + "\n", encoding="utf-8")
+    exe.chmod(0o755)
+    return exe
+
+
+def test_a_slow_solver_is_killed_at_its_timeout_and_on_cancel(tmp_path, monkeypatch):
+    import threading
+    import time
+
+    from kincas.core.cancel import Cancelled, Token, cancelling
+    pidfile = tmp_path / "pid"
+    monkeypatch.setenv("KINCAS_MSOLVE", str(fake_msolve(tmp_path, f"echo $$ > {pidfile}; exec sleep 30")))
+    t0 = time.monotonic()
+    with pytest.raises(certify_msolve.SolverFailed, match="longer than"):
+        certify_msolve.solve("x0\n0\nx0", timeout=0.5)
+    assert time.monotonic() - t0 < 5
+
+    def gone():
+        pid = int(pidfile.read_text())
+        try:
+            import os
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return True
+        return False
+    assert gone()
+    token, caught = Token(), []
+
+    def work():
+        with cancelling(token):
+            try:
+                certify_msolve.solve("x0\n0\nx0", timeout=60)
+            except Cancelled:
+                caught.append(True)
+    pidfile.unlink()
+    th = threading.Thread(target=work)
+    th.start()
+    while not pidfile.exists():
+        time.sleep(0.01)
+    token.cancel()  # what Ctrl-C does to the work it interrupts
+    th.join(5)
+    assert caught == [True] and not th.is_alive() and gone()
+
+
+def test_a_solver_that_fails_or_babbles_is_an_error(tmp_path, monkeypatch):
+    monkeypatch.setenv("KINCAS_MSOLVE", str(fake_msolve(tmp_path, "exit 1")))
+    with pytest.raises(certify_msolve.SolverFailed):
+        certify_msolve.solve("x0\n0\nx0")
+    monkeypatch.setenv("KINCAS_MSOLVE", str(fake_msolve(tmp_path, 'while [ $# -gt 0 ]; do [ "$1" = -o ] && o=$2; shift; done; echo "what?" > "$o"')))
+    with pytest.raises(certify_msolve.SolverFailed, match="not understood"):
+        certify_msolve.solve("x0\n0\nx0")
