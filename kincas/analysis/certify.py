@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from fractions import Fraction
 
 import numpy as np
 
@@ -124,7 +125,7 @@ def certify_modes(m: Mechanism, inputs=None, *, threads: int = 1,
     """
     u = _input_vector(m, inputs)
     S = closure(m, u)
-    kind, boxes = solve(S.msolve_input(), threads=threads, timeout=timeout)
+    kind, boxes, value = _solve(S, threads, timeout)
     u_r = np.array([S.at.get(i.key, float(v)) for i, v in zip(m.inputs, u)])
     m_r = _rounded_lines(m, S)
     driven = {i.target: float(v) for i, v in zip(m.inputs, u) if i.kind == "parameter"}
@@ -147,7 +148,7 @@ def certify_modes(m: Mechanism, inputs=None, *, threads: int = 1,
         if corank:
             others = [np.abs((c - o) / scale).max() for j, o in enumerate(centres) if j != k]
             mult = max(1 + corank, _split_count(m, u, S, c, scale, L, min(others, default=1.0)))
-        halfwidth = max((P.spread(box) for xy in S.points.values() for P in xy), default=0.0)
+        halfwidth = max((P.subs(value).spread(box) for xy in S.points.values() for P in xy), default=0.0)
         md = mode_at(m_r, model, q, u_r, p, L, picked, kind=CertifiedMode, halfwidth=halfwidth,
                      multiplicity=mult, flag="singular" if mult > 1 else "", note=note)
         if md.residual <= ACCEPT:  # the rule for an assembly (every real root should pass)
@@ -158,6 +159,36 @@ def certify_modes(m: Mechanism, inputs=None, *, threads: int = 1,
     rows = lambda md: np.array([v for xy in md.points.values() for v in xy])
     out.sort(key=lambda md: tuple(np.round(rows(md) / (SAME * L))))
     return CertifiedModes(out, rounded=S.rounded, rejected=rejected, inputs=used)
+
+
+def _solve(S, threads=1, timeout=CERTIFY_TIMEOUT):
+    """("finite" | "positive", a box per real solution over all of S's variables, the
+    eliminated variables as affine Polys in the free ones). The linear equations are solved
+    exactly first (`PolySystem.eliminated`): msolve sees only the free variables, and the
+    eliminated ones' intervals follow exactly (affine in the free ones)."""
+    red = S.eliminated()
+    if red is None:  # the linear equations contradict each other
+        return "finite", [], {}
+    eqs, free, value = red
+    if not free:  # every variable fixed by linear equations: one solution, or none
+        found = [[]] if not eqs else []
+        kind = "finite"
+    else:
+        kind, found = solve(S.msolve_input(eqs, free), threads=threads, timeout=timeout)
+    boxes = []
+    for fb in found:
+        box = [None] * len(S.names)
+        for v, iv in zip(free, fb):
+            box[v] = iv
+        centre = [None if b is None else (b[0] + b[1]) / 2 for b in box]
+        for v, expr in value.items():
+            mid = sum((c * math.prod((centre[w] ** e for w, e in mono), start=Fraction(1))
+                       for mono, c in expr.terms.items()), Fraction(0))
+            half = sum((abs(c) * (box[mono[0][0]][1] - box[mono[0][0]][0]) / 2
+                        for mono, c in expr.terms.items() if mono), Fraction(0))
+            box[v] = (mid - half, mid + half)
+        boxes.append(box)
+    return kind, boxes, value
 
 
 def _rounded_lines(m: Mechanism, S) -> Mechanism:
@@ -228,7 +259,7 @@ def _split_count(m, u, S, c, scale, L, nearest) -> int:
     for sign in (1, -1):
         v = np.array(u, dtype=float)
         v[0] += sign * step
-        kind, boxes = solve(closure(m, v).msolve_input())
+        kind, boxes, _ = _solve(closure(m, v))
         if kind == "finite":
             near = [b for b in boxes
                     if np.abs((np.array([float((a + z) / 2) for a, z in b]) - c) / scale).max() <= radius]

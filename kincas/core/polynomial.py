@@ -135,6 +135,24 @@ class Poly:
             total += abs(c) * max(hi - mid, mid - lo)
         return float(total)
 
+    def subs(self, values: dict) -> "Poly":
+        """The polynomial with variables replaced (variable index -> Poly)."""
+        out = Poly()
+        for m, c in self.terms.items():
+            term = Poly.const(c)
+            for v, e in m:
+                base = values.get(v, Poly.var(v))
+                for _ in range(e):
+                    term = term * base
+            out = out + term
+        return out
+
+    def linear(self) -> tuple[dict, Fraction] | None:
+        """(variable -> coefficient, constant) when the degree is at most one, else None."""
+        if self.degree > 1:
+            return None
+        return ({m[0][0]: c for m, c in self.terms.items() if m}, self.terms.get((), Fraction(0)))
+
     def integer_terms(self) -> dict:
         """The same equation with coprime integer coefficients (denominators cleared)."""
         lcm = math.lcm(*(c.denominator for c in self.terms.values())) if self.terms else 1
@@ -172,11 +190,54 @@ class PolySystem:
         self.length.append(length)
         return Poly.var(len(self.names) - 1)
 
-    def msolve_input(self) -> str:
+    def msolve_input(self, equations=None, variables=None) -> str:
         """msolve's input: the variables, the characteristic 0, the equations expanded with
-        integer coefficients (msolve misreads parentheses and fractions)."""
-        rows = [_write(p.integer_terms()) for p in self.equations if p.terms]
-        return ",".join(f"x{k}" for k in range(len(self.names))) + "\n0\n" + ",\n".join(rows)
+        integer coefficients (msolve misreads parentheses and fractions). `variables`: the
+        indices written (as x0, x1, ... in this order); default all."""
+        eqs = self.equations if equations is None else equations
+        used = list(range(len(self.names))) if variables is None else list(variables)
+        rename = {v: Poly.var(k) for k, v in enumerate(used)}
+        rows = [_write(p.subs(rename).integer_terms()) for p in eqs if p.terms]
+        return ",".join(f"x{k}" for k in range(len(used))) + "\n0\n" + ",\n".join(rows)
+
+    def eliminated(self):
+        """The linear equations solved exactly (Gauss-Jordan over the rationals) and
+        substituted into the others: (equations in the free variables, the free variables,
+        variable -> affine Poly in them for every eliminated one), or None when the linear
+        equations are inconsistent (no solution). Fewer variables make msolve's work far
+        smaller (the 56-solution Assur group 4.4: 16 variables -> 8)."""
+        rows, rest = [], []
+        for p in self.equations:
+            lin = p.linear()
+            (rows if lin is not None else rest).append(lin if lin is not None else p)
+        pivots: dict = {}  # variable -> (coefficients of the others, constant): var = -(...)
+        for coef, const in rows:
+            coef, const = dict(coef), const
+            for v, (pc, pk) in pivots.items():  # reduce by earlier pivots
+                if v in coef:
+                    f = coef.pop(v)
+                    for w, c in pc.items():
+                        coef[w] = coef.get(w, 0) - f * c
+                    const -= f * pk
+            coef = {w: c for w, c in coef.items() if c != 0}
+            if not coef:
+                if const != 0:
+                    return None  # 0 = const: inconsistent
+                continue
+            v = max(coef)  # the latest variable: kept ones are the first links' angles
+            f = coef.pop(v)
+            pc, pk = {w: c / f for w, c in coef.items()}, const / f
+            for u, (uc, uk) in list(pivots.items()):  # back-substitute into earlier pivots
+                if v in uc:
+                    g = uc.pop(v)
+                    for w, c in pc.items():
+                        uc[w] = uc.get(w, 0) - g * c
+                    pivots[u] = ({w: c for w, c in uc.items() if c != 0}, uk - g * pk)
+            pivots[v] = (pc, pk)
+        value = {v: Poly({((w, 1),): -c for w, c in pc.items()}) - pk for v, (pc, pk) in pivots.items()}
+        eqs = [q for q in (p.subs(value) for p in rest) if q.terms]
+        free = [k for k in range(len(self.names)) if k not in value]
+        return eqs, free, value
 
 
 def _write(terms: dict) -> str:
