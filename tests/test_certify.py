@@ -306,3 +306,91 @@ def test_a_solver_that_fails_or_babbles_is_an_error(tmp_path, monkeypatch):
     monkeypatch.setenv("KINCAS_MSOLVE", str(fake_msolve(tmp_path, 'while [ $# -gt 0 ]; do [ "$1" = -o ] && o=$2; shift; done; echo "what?" > "$o"')))
     with pytest.raises(certify_msolve.SolverFailed, match="not understood"):
         certify_msolve.solve("x0\n0\nx0")
+
+
+# ----------------------------------------------------------------------------- Assur group 4.4
+
+# Class 4, order 4: the ternary links T1..T4 close a quadrilateral J1 J2 J3 J4 (T_i carries
+# J_i, J_i+1 and P_i), each held to the ground by a binary leg G_i P_i. 56 complex assemblies
+# for generic dimensions. This integer geometry (found by a random search, kept for its count)
+# has 10 real ones.
+G44 = {"G1": (127, 19), "G2": (-98, -23), "G3": (-148, -119), "G4": (-7, 240)}
+LEGS44 = (153, 108, 135, 253)
+TERN44 = ((74, 29, 76), (110, 3, -12), (103, -7, -17), (125, 12, -17))  # |J_i J_i+1|, P_i in T_i's frame
+
+
+def group44():
+    links = []
+    for i in range(4):
+        a, b = f"J{i + 1}", f"J{(i + 1) % 4 + 1}"
+        L, px, py = TERN44[i]
+        links += [Link.bar(f"leg{i + 1}", f"G{i + 1}", f"P{i + 1}", LEGS44[i]),
+                  Link(f"T{i + 1}", {a: (0, 0), b: (L, 0), f"P{i + 1}": (px, py)})]
+    return Mechanism(ground=G44, links=links)
+
+
+def group44_assemblies(starts=800, seed=1):
+    """Independently: the angles of leg 1 (t) and of T1, T2, T4 place leg 1, then T1 (J1,
+    J2) from P1, T2 from J2 and T4 from J1; four equations: P2 and P4 on their legs' circles,
+    J3J4 of T3's length, and P3 (T3 placed on J3 towards J4) on leg 3's circle. Newton with
+    central differences from random starts (every angle uniform), the distinct roots
+    polished by mpmath at 30 digits (each a real root to 1e-20)."""
+    import mpmath as mp
+    g = {k: (float(x), float(y)) for k, (x, y) in G44.items()}
+    (L1, p1x, p1y), (L2, p2x, p2y), (L3, p3x, p3y), (L4, p4x, p4y) = TERN44
+    l1, l2, l3, l4 = LEGS44
+
+    def place(t, f1, f2, f4, lib=np):
+        cos, sin = lib.cos, lib.sin
+        atan2 = mp.atan2 if lib is mp else np.arctan2
+        R = lambda a, x, y: (cos(a) * x - sin(a) * y, sin(a) * x + cos(a) * y)
+        add = lambda p, q, s=1: (p[0] + s * q[0], p[1] + s * q[1])
+        P1 = (g["G1"][0] + l1 * cos(t), g["G1"][1] + l1 * sin(t))
+        J1 = add(P1, R(f1, p1x, p1y), -1)
+        J2 = add(J1, R(f1, L1, 0))
+        P2, J3 = add(J2, R(f2, p2x, p2y)), add(J2, R(f2, L2, 0))
+        P4, J4 = add(J1, R(f4, p4x - L4, p4y)), add(J1, R(f4, -L4, 0))
+        f3 = atan2(J4[1] - J3[1], J4[0] - J3[0])
+        P3 = add(J3, R(f3, p3x, p3y))
+        d2 = lambda p, q: (p[0] - q[0]) ** 2 + (p[1] - q[1]) ** 2
+        res = (d2(P2, g["G2"]) - l2 * l2, d2(P4, g["G4"]) - l4 * l4, d2(J4, J3) - L3 * L3,
+               d2(P3, g["G3"]) - l3 * l3)
+        return res, {"J1": J1, "J2": J2, "J3": J3, "J4": J4, "P1": P1, "P2": P2, "P3": P3, "P4": P4}
+
+    x = np.random.default_rng(seed).uniform(-math.pi, math.pi, (4, starts))
+    F = lambda x: np.array(place(*x)[0])
+    h = 1e-7
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for _ in range(40):
+            r = F(x)
+            J = np.stack([(F(x + h * np.eye(4)[:, [j]]) - F(x - h * np.eye(4)[:, [j]])) / (2 * h)
+                          for j in range(4)], axis=1)  # 4 x 4 x starts
+            step = np.linalg.solve(J.transpose(2, 0, 1), r.T[:, :, None])[:, :, 0].T
+            x = x - np.clip(np.nan_to_num(step, nan=0.0), -0.5, 0.5)
+        r = np.abs(F(x)).max(axis=0)
+    found = []
+    for root in x[:, np.isfinite(r) & (r < 1e-6)].T:
+        pts = place(*root)[1]
+        row = np.array([c for k in sorted(pts) for c in pts[k]])
+        if all(np.abs(row - other).max() > 1e-6 for other, _ in found):
+            found.append((row, root))
+    mp.mp.dps = 30
+    out = []
+    for _, root in found:
+        z = mp.findroot(lambda *a: place(*a, lib=mp)[0], [mp.mpf(float(v)) for v in root])
+        res, pts = place(*z, lib=mp)
+        assert max(abs(v) for v in res) < mp.mpf(10) ** -20
+        out.append({k: np.array([float(p[0]), float(p[1])]) for k, p in pts.items()})
+    return out
+
+
+@needs_msolve
+def test_assur_group_44_ten_real_of_56():
+    m = group44()
+    expected = group44_assemblies()
+    assert len(expected) == 10  # the independent search finds ten distinct real assemblies
+    found = certified(m, None)
+    match(found, expected, m.size(), ["J1", "J2", "J3", "J4", "P1", "P2", "P3", "P4"])
+    S = closure(m, [])
+    eqs, free, _ = S.eliminated()
+    assert certify_msolve.complex_count(S.msolve_input(eqs, free)) == 56

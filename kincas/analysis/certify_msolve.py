@@ -71,13 +71,18 @@ def solve(text: str, *, threads: int = 1, timeout: float = CERTIFY_TIMEOUT,
 
     Temporary files, removed afterwards; msolve runs in its own process group, killed at
     the timeout, at Ctrl-C, or when the work this thread belongs to is cancelled."""
+    return parse(_run(text, ["-t", str(int(threads)), "-p", str(int(bits))], timeout))
+
+
+def _run(text: str, options: list[str], timeout: float) -> str:
+    """msolve's output file for an input file's text, with these options."""
     exe = executable()
     if exe is None:
         raise SolverMissing(INSTALL)
     with tempfile.TemporaryDirectory(prefix="kincas-msolve-") as tmp:
         src, out = Path(tmp, "system.ms"), Path(tmp, "roots.ms")
         src.write_text(text + "\n", encoding="ascii")
-        cmd = [exe, "-f", str(src), "-o", str(out), "-t", str(int(threads)), "-p", str(int(bits))]
+        cmd = [exe, "-f", str(src), "-o", str(out), *options]
         try:
             proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                     start_new_session=True)  # Ctrl-C reaches us, not it: we kill it
@@ -87,7 +92,18 @@ def solve(text: str, *, threads: int = 1, timeout: float = CERTIFY_TIMEOUT,
         err = proc.stderr.read().decode(errors="replace").strip() if proc.stderr else ""
         if proc.returncode != 0 or not out.exists():
             raise SolverFailed(f"msolve failed (exit {proc.returncode}): {err.splitlines()[-1] if err else 'no output'}")
-        return parse(out.read_text(encoding="ascii", errors="replace"))
+        return out.read_text(encoding="ascii", errors="replace")
+
+
+def complex_count(text: str, *, timeout: float = CERTIFY_TIMEOUT) -> int | None:
+    """The number of complex solutions of a zero-dimensional system (the degree of msolve's
+    rational parametrization, `-P 1`), or None when they are not finite in number."""
+    raw = _run(text, ["-P", "1"], timeout)
+    head = re.match(r"\s*\[0,\s*\[0,\s*(\d+),\s*(\d+),", raw)
+    if head:
+        return int(head.group(2))
+    kind, boxes = parse(raw)
+    return 0 if kind == "finite" and not boxes else None
 
 
 def _wait(proc, timeout: float) -> None:
