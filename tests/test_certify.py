@@ -229,6 +229,20 @@ def test_coinciding_assemblies_listed_once_multiplicity_two():
     assert np.allclose(md.points["C"], (1.6, 1.8), atol=1e-12)
 
 
+@needs_msolve
+def test_infinitely_many_assemblies_reported(capsys, tmp_path):
+    """Crank 4 at 0 puts B on D: coupler 2 and rocker 2 then let C turn on a whole circle."""
+    found = kincas.modes(fourbar(a=4.0, b=2.0, c=2.0), 0.0, certify=True)
+    assert found.positive_dimension and found.count is None and len(found) == 0
+    scene = {"ground": {"A": [0, 0], "D": [4, 0]},
+             "links": {"crank": {"points": ["A", "B"], "length": 4},
+                       "coupler": {"points": ["B", "C"], "length": 2},
+                       "rocker": {"points": ["D", "C"], "length": 2}},
+             "inputs": [{"angle": "crank", "value": 0}], "guess": {"C": [4, 2]}}
+    code, out, err = run_cli(capsys, "modes", write_scene(tmp_path, scene), "--certify", "--json")
+    assert code == 3 and out["positive_dimension"] is True and out["count"] is None
+
+
 # ----------------------------------------------------------------------------- the CLI's contract
 
 @needs_msolve
@@ -248,6 +262,9 @@ def test_cli_json_contract_and_scenes_written(capsys, tmp_path):
         assert max(abs(a - b) for p in guess for a, b in zip(guess[p], md["points"][p])) < 1e-9
     code, text, err = run_cli(capsys, "modes", EXAMPLES / "fairbairn.toml", "--certify")
     assert code == 0 and "certified" in text and "not certified" not in text and "count 2" in text
+    guessless = (EXAMPLES / "fairbairn.toml").read_text(encoding="utf-8").split("[guess]")[0]
+    code, out, err = run_cli(capsys, "modes", write_scene(tmp_path, guessless), "--certify", "--json")
+    assert code == 0 and out["certified"] is True and out["count"] == 2  # still certified
     json.dumps(out)  # plain JSON
 
 

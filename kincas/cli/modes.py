@@ -129,14 +129,14 @@ def _solve_starts_on(sc, modes):
     pose (an "assembly" event, kincas/analysis/choice.py): that one is marked instead."""
     from dataclasses import replace
 
-    from ..frames import Modes
     chosen = next((e for e in sc.run().events if e["kind"] == "assembly"), None)
     if chosen is None:
         return modes
     size = sc.mechanism.size()
     same = lambda md: all(max(abs(a - b) for a, b in zip(md.points[pt], xy)) <= 1e-6 * size
                           for pt, xy in chosen["guess"].items())
-    return Modes(replace(md, from_guess=same(md)) for md in modes)
+    modes[:] = [replace(md, from_guess=same(md)) for md in modes]  # in place: a certified list stays one
+    return modes
 
 
 def _write_scenes(path, directory, modes) -> list[Path]:
