@@ -167,12 +167,14 @@ def test_planar_3rpr_with_prismatic_legs():
 
 
 @needs_msolve
-def test_stephenson_six_bar():
-    m = kincas.cli.scene.load(EXAMPLES / "stephenson3.toml").mechanism
-    a = math.radians(100)
-    expected = stephenson_assemblies(a, 50_001)
+@pytest.mark.parametrize("scene, deg, independent, points", [
+    ("stephenson3", 100, stephenson_assemblies, ["A", "B", "C", "D"]),  # driven through its triad
+    ("eightbar", 60, eightbar_assemblies, ["E", "P", "Q", "R", "S", "H", "G"])])  # a class-IV group
+def test_stephenson_six_bar_and_class_iv_eight_bar(scene, deg, independent, points):
+    m = kincas.cli.scene.load(EXAMPLES / f"{scene}.toml").mechanism
+    expected = independent(math.radians(deg), 50_001)
     assert len(expected) == 2
-    match(certified(m, a), expected, m.size(), ["A", "B", "C", "D"])
+    match(certified(m, math.radians(deg)), expected, m.size(), points)
 
 
 @needs_msolve
@@ -195,15 +197,6 @@ def test_watt_six_bar_four_assemblies():
             expected.append({"A": A[:, 0], "B": B, "C": C, "D": D})
     assert all(np.isfinite(a["D"]).all() for a in expected)
     match(certified(m, th), expected, m.size(), ["A", "B", "C", "D"])
-
-
-@needs_msolve
-def test_class_iv_eight_bar():
-    m = kincas.cli.scene.load(EXAMPLES / "eightbar.toml").mechanism
-    a = math.radians(60)
-    expected = eightbar_assemblies(a, 50_001)
-    assert len(expected) == 2
-    match(certified(m, a), expected, m.size(), ["E", "P", "Q", "R", "S", "H", "G"])
 
 
 # ----------------------------------------------------------------------------- none, singular

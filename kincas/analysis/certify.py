@@ -51,7 +51,8 @@ from ..frames import Modes
 from ..model.joints import split_relative
 from ..model.mechanism import Mechanism
 from .certify_msolve import solve
-from .modes import SAME, Mode, _input_vector, mode_at
+from ..core.tolerances import SAME_ASSEMBLY as SAME
+from .assembly_mode import Mode, input_vector as _input_vector, mode_at
 
 
 @dataclass(frozen=True)

@@ -32,55 +32,18 @@ from __future__ import annotations
 import math
 import sys
 import types
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import Mechanism
-from ..results import wrap_angle
 from ..core.turns import tied, turns
 from ..core.assembly import first_pose
 from ..core.scatter import newton_starts
 from ..core.numeric import model_of
-from ..core.tolerances import ACCEPT, BRANCH, SAME_ASSEMBLY as SAME, START_CONVERGED as CONVERGED
-from .inputs import input_table
+from ..core.tolerances import ACCEPT, SAME_ASSEMBLY as SAME, START_CONVERGED as CONVERGED
+from .assembly_mode import Mode, input_vector as _input_vector, mode_at  # noqa: F401  (their old home)
 
 # SAME: two assemblies are one mode when every point agrees to this times the size
-
-
-# --- a mode ---
-
-
-@dataclass(frozen=True)
-class Mode:
-    """One real assembly: the unknowns `q`, the moving points' positions, the link angles
-    (radians, wrapped to (-pi, pi]), the relative residual after polishing, the sign of the
-    Jacobian's determinant (which side of the singular positions the mode lies on; 0 when
-    singular), and whether the mechanism's own guess leads to it."""
-
-    q: np.ndarray
-    unknowns: tuple[str, ...]
-    points: dict[str, tuple[float, float]]
-    angles: dict[str, float]
-    residual: float
-    orientation: int
-    from_guess: bool = False
-    inputs: dict[str, float] = field(default_factory=dict)
-
-    @property
-    def guess(self) -> dict[str, tuple[float, float]]:
-        """The points as a guess: `kincas.sweep(m, ..., guess=mode.guess)` follows this mode."""
-        return dict(self.points)
-
-    def guess_block(self, digits: int = 12) -> str:
-        """A `[guess]` section for a scene file that picks this mode.
-
-        >>> Mode(np.zeros(1), ("a",), {"C": (1.0, -2.5)}, {}, 0.0, 1).guess_block()
-        '[guess]\\nC = [1, -2.5]\\n'
-        """
-        rows = [f"{p} = [{x:.{digits}g}, {y:.{digits}g}]" for p, (x, y) in self.points.items()]
-        return "[guess]\n" + "".join(r + "\n" for r in rows)
 
 
 # --- the search ---
@@ -189,14 +152,6 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
     return Modes(_distinct(m, model, found + ([picked] if picked is not None else []), u, p, L, picked))
 
 
-def _input_vector(m: Mechanism, inputs) -> np.ndarray:
-    """One finite value per input (the pose at which the modes are wanted)."""
-    U = input_table(m, {} if inputs is None and not m.inputs else inputs, "inputs", None)
-    if U.shape[0] != 1:
-        raise ModelError("inputs: expected one value per input (modes are found at one pose)")
-    return U[0]
-
-
 def _scatter(m: Mechanism, model, n: int, L: float, seed: int) -> np.ndarray:
     """n starts over the reachable workspace: angles uniform in (-pi, pi]; the origin of a
     floating link uniform in a square of half-side L around a randomly chosen ground point."""
@@ -241,27 +196,6 @@ def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
     keep.sort(key=lambda t: tuple(np.round(t[1] / (SAME * L))))
     out = [mode_at(m, model, q, u, p, L, picked, pts) for q, pts in keep]
     return [md for md in out if md.residual <= ACCEPT]  # each checked by its residual
-
-
-def mode_at(m, model, q, u, p, L, picked=None, pts=None, kind=None, **extra) -> Mode:
-    """The `Mode` at unknowns q: its points, link angles, relative residual, orientation, and
-    whether it is the assembly `picked` (a row of points, or None); `kind` a subclass of
-    Mode built with the `extra` fields (kincas/analysis/certify.py)."""
-    names = m.moving_points
-    pts = model.points(q, u, p).T.ravel() if pts is None else pts
-    links = [lk.name for lk in m.links]
-    s = model.column_scale(L)  # columns scaled to O(1)
-    ang = model.quantities([f"{lk}.angle" for lk in links], q[None, :], u[None, :], p,
-                           np.ones((1, len(u))), np.zeros((1, len(u))))[:, 0]
-    det = np.linalg.det(model.jac(q, u, p) * s) if model.nq else 1.0
-    res = float(np.abs(model.residual(q, u, p)).max(initial=0.0) / L)
-    return (kind or Mode)(
-        q=np.array(q), unknowns=tuple(model.unknown_names),
-        points={nm: (float(pts[2 * j]), float(pts[2 * j + 1])) for j, nm in enumerate(names)},
-        angles={lk: float(wrap_angle(a)) for lk, a in zip(links, ang)},
-        residual=res, orientation=int(np.sign(det)) if abs(det) > BRANCH else 0,
-        from_guess=bool(picked is not None and np.abs(pts - picked).max() <= SAME * L),
-        inputs={i.key: float(v) for i, v in zip(m.inputs, u)}, **extra)
 
 
 # --- `kincas.modes(...)`: the function, also reachable by its 0.1 module path ---
