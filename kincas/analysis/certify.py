@@ -46,7 +46,8 @@ import numpy as np
 from ..core.assembly import first_pose
 from ..core.numeric import model_of
 from ..core.polynomial_planar import closure
-from ..core.tolerances import ACCEPT, CERTIFY_NUDGE, CERTIFY_SLACK, CERTIFY_TIMEOUT, RANK
+from ..core.tolerances import (ACCEPT, CERTIFY_NUDGE, CERTIFY_SLACK, CERTIFY_SPLIT, CERTIFY_TIMEOUT,
+                               RANK, TINY)
 from ..frames import Modes
 from ..model.joints import split_relative
 from ..model.mechanism import Mechanism
@@ -245,16 +246,16 @@ def _corank(model, q, u, p, L) -> int:
     if model.nq == 0:
         return 0
     sv = np.linalg.svd(model.jac(q, u, p) * model.column_scale(L), compute_uv=False)
-    return int(model.nq - np.sum(sv > RANK * max(sv.max(initial=0.0), 1e-300)))
+    return int(model.nq - np.sum(sv > RANK * max(sv.max(initial=0.0), TINY)))
 
 
 def _split_count(m, u, S, c, scale, L, nearest) -> int:
     """How many real roots the multiple root at c splits into when the first input moves by
     +-CERTIFY_NUDGE (times the size for a length): the larger count of the two sides, within
-    half the distance to the nearest other root (at most 1e-2 of the size)."""
+    half the distance to the nearest other root (at most CERTIFY_SPLIT, scaled)."""
     if not len(u):
         return 0
-    radius = min(0.5 * nearest, 1e-2)
+    radius = min(0.5 * nearest, CERTIFY_SPLIT)
     step = CERTIFY_NUDGE * (1.0 if m.inputs[0].is_angle else L)
     best = 0
     for sign in (1, -1):

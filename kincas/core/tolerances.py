@@ -78,4 +78,5 @@ CERTIFY_DENOMINATOR = 2 ** 20  # a driven or line angle's half-angle tangent rou
 CERTIFY_BITS = 64  # msolve's precision of the isolating boxes (bits; boxes far smaller than a float's rounding)
 CERTIFY_SLACK = 1e-12  # a refined float point lies in its box when within this (times the size, or 1 for a cosine) of it
 CERTIFY_TIMEOUT = 120.0  # seconds msolve may take before the certificate is given up
+CERTIFY_SPLIT = 1e-2  # roots a multiple root splits into are counted within this (scaled) distance of it, at most
 CERTIFY_NUDGE = 1e-7  # input change (rad, or times the size) that splits coinciding assemblies to count them
