@@ -3,7 +3,8 @@
 Scripts written against the first README import `kincas.modes`, `kincas.plot`, ...; those
 modules now live in subpackages. A meta-path finder resolves the old names lazily, so
 `import kincas` stays cheap and `import kincas.modes` still works, for one more release: it
-warns (DeprecationWarning) and names the new path. `kincas.optimize` (the function itself) and
+warns (DeprecationWarning) and names the new path. `kincas.optimize` and `kincas.modes` (the
+functions themselves: calling the module calls them) and
 `kincas.scene`, `kincas.plot`, `kincas.outputs` (the README's entry points for scenes and
 drawings) stay quiet. The presentation modules that left `kincas/cli` for `kincas/views`
 (`kincas.cli.plot`, `kincas.cli.svg`, `kincas.notebook`, ...) still import under their old
@@ -27,7 +28,7 @@ OLD = {
     "checks": "synthesis.checks", "scene": "cli.scene", "outputs": "cli.outputs",
     "plot": "views.plot", "progress": "cli.progress",
 }
-QUIET = {"optimize", "scene", "plot", "outputs"}  # current entry points: no warning
+QUIET = {"optimize", "scene", "plot", "outputs", "modes"}  # current entry points: no warning
 # paths of this release's predecessor: warned (DeprecationWarning), removed in the next release
 MOVED = {f"cli.{m}": f"views.{m}" for m in ("plot", "svg", "picture", "draw_joints",
                                            "draw_geometry", "dxf", "html", "mapplot", "numbers",

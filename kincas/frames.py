@@ -219,14 +219,18 @@ def optimize_to_xarray(r, length: str = ""):
 class Modes(list, Result):
     """The assembly modes `find_modes` returns: a list of `Mode` (indexed, iterated and
     printed as a list), with `to_pandas()` (a row per mode: points, angles, residual,
-    orientation, from_guess), `to_xarray()`, `ok` (some mode was found) and `summary()`."""
+    orientation, from_guess), `to_xarray()`, `ok` (some mode was found) and `summary()`;
+    `certified` is False for the multistart search (kincas/analysis/certify.py proves it)."""
+
+    certified = False
 
     @property
     def ok(self) -> bool:
         return len(self) > 0
 
     def summary(self) -> str:
-        return f"{len(self)} assembly modes" + ("" if self else " (none found)")
+        return (f"{len(self)} assembly modes" + ("" if self else " (none found)")
+                + ("" if self.certified else " (multistart search, not certified)"))
 
     def to_pandas(self, length: str = "", angle: str = "rad"):
         return in_angle(modes_to_pandas(self, length), angle)

@@ -43,8 +43,17 @@ EXAMPLES = {
     "analyse": lambda: kincas.analyse(crank(), {"crank.angle": T}, {"a": 0.01}, ["A.x"], draws=20),
     "optimize": lambda: kincas.optimize(crank(), {"crank.angle": T}, {"a": (1.0, 3.0)}, "sum((A.x - 1.5)^2)"),
     "find_modes": lambda: kincas.find_modes(four_bar(), {"crank.angle": 0.5}, starts=32),
+    # certified where msolve is installed (kincas[certify]), else the multistart
+    "modes": lambda: kincas.modes(four_bar(), {"crank.angle": 0.5}, certify=_certify_available()),
     "input_range": lambda: kincas.input_range(four_bar(), {"crank.angle": 0.5}),
 }
+
+
+def _certify_available():
+    from kincas.analysis.certify_msolve import available
+    return available()
+
+
 # public functions that return no result (a compiled model)
 NOT_RESULTS = {"model_of", "compile", "widget"}  # widget: a Jupyter widget, no result
 
@@ -107,6 +116,8 @@ def test_result_round_trips(name):
     if name == "optimize":  # minimum of (a - 1.5)^2 + (a cos 0.5 - 1.5)^2
         c = math.cos(0.5)
         assert abs(r.varied["a"] - 1.5 * (1 + c) / (1 + c * c)) < 1e-6
+    if name == "modes":
+        assert len(df) == 2 and ds.sizes["mode"] == 2 and r.certified == _certify_available()
     if name == "find_modes":  # a four-bar's link angles, in degrees on request
         assert np.allclose(r.to_pandas(angle="deg")["rocker.angle"], np.degrees(df["rocker.angle"]), rtol=1e-15)
         assert len(df) == 2 and ds.sizes["mode"] == 2 and r[0] is list(r)[0]  # still a list

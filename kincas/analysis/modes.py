@@ -30,58 +30,63 @@ True
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-
+import sys
+import types
 import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import Mechanism
-from ..results import wrap_angle
 from ..core.turns import tied, turns
 from ..core.assembly import first_pose
 from ..core.scatter import newton_starts
 from ..core.numeric import model_of
-from ..core.tolerances import ACCEPT, BRANCH, SAME_ASSEMBLY as SAME, START_CONVERGED as CONVERGED
-from .inputs import input_table
+from ..core.tolerances import ACCEPT, SAME_ASSEMBLY as SAME, START_CONVERGED as CONVERGED
+from .assembly_mode import Mode, input_vector as _input_vector, mode_at  # noqa: F401  (their old home)
 
 # SAME: two assemblies are one mode when every point agrees to this times the size
 
 
-# --- a mode ---
-
-
-@dataclass(frozen=True)
-class Mode:
-    """One real assembly: the unknowns `q`, the moving points' positions, the link angles
-    (radians, wrapped to (-pi, pi]), the relative residual after polishing, the sign of the
-    Jacobian's determinant (which side of the singular positions the mode lies on; 0 when
-    singular), and whether the mechanism's own guess leads to it."""
-
-    q: np.ndarray
-    unknowns: tuple[str, ...]
-    points: dict[str, tuple[float, float]]
-    angles: dict[str, float]
-    residual: float
-    orientation: int
-    from_guess: bool = False
-    inputs: dict[str, float] = field(default_factory=dict)
-
-    @property
-    def guess(self) -> dict[str, tuple[float, float]]:
-        """The points as a guess: `kincas.sweep(m, ..., guess=mode.guess)` follows this mode."""
-        return dict(self.points)
-
-    def guess_block(self, digits: int = 12) -> str:
-        """A `[guess]` section for a scene file that picks this mode.
-
-        >>> Mode(np.zeros(1), ("a",), {"C": (1.0, -2.5)}, {}, 0.0, 1).guess_block()
-        '[guess]\\nC = [1, -2.5]\\n'
-        """
-        rows = [f"{p} = [{', '.join(f'{c:.{digits}g}' for c in xy)}]" for p, xy in self.points.items()]
-        return "[guess]\n" + "".join(r + "\n" for r in rows)
-
-
 # --- the search ---
+
+
+def modes(mechanism: Mechanism, inputs=None, *, certify: bool = False, **options) -> "Modes":
+    """Every real assembly of `mechanism` at `inputs`: by the multistart search
+    (`find_modes`, not certified), or with `certify=True` by an exact real-root solver whose
+    answer proves the list complete (`kincas.analysis.certify.certify_modes`: needs
+    `pip install "kincas[certify]"`; pins and slides only).
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+    inputs : dict or float, optional
+        Input key -> value (radians for angles); a number for a one-input mechanism.
+    certify : bool
+        Prove the list complete (each mode isolated in a box by msolve, refined by Newton).
+    **options
+        Passed on: `starts`, `seed`, `iterations` (multistart), or `threads`, `timeout`
+        (certified).
+
+    Returns
+    -------
+    Modes
+        A list of `Mode`; `.certified` tells which search made it. Certified, each mode also
+        has `halfwidth`, `multiplicity` and `flag`, and the list its `count`.
+
+    Examples
+    --------
+    >>> import numpy as np, kincas
+    >>> m = kincas.Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+    ...     links=[kincas.Link.bar("crank", "A", "B", 1), kincas.Link.bar("coupler", "B", "C", 3.5),
+    ...            kincas.Link.bar("rocker", "D", "C", 3)], inputs=[kincas.Input.angle("crank")])
+    >>> found = kincas.modes(m, {"crank.angle": np.pi / 2}, starts=64)
+    >>> len(found), found.certified
+    (2, False)
+    """
+    if certify:
+        from .certify import certify_modes
+        return certify_modes(mechanism, inputs, **options)
+    return find_modes(mechanism, inputs, **options)
+
 
 
 def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
@@ -147,14 +152,6 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
     return Modes(_distinct(m, model, found + ([picked] if picked is not None else []), u, p, L, picked))
 
 
-def _input_vector(m: Mechanism, inputs) -> np.ndarray:
-    """One finite value per input (the pose at which the modes are wanted)."""
-    U = input_table(m, {} if inputs is None and not m.inputs else inputs, "inputs", None)
-    if U.shape[0] != 1:
-        raise ModelError("inputs: expected one value per input (modes are found at one pose)")
-    return U[0]
-
-
 def _scatter(m: Mechanism, model, n: int, L: float, seed: int) -> np.ndarray:
     """n starts over the reachable workspace: angles uniform in (-pi, pi]; the origin of a
     floating link uniform in a square of half-side L around a randomly chosen ground point."""
@@ -195,27 +192,24 @@ def _unique(rows: np.ndarray, tol: float) -> list[int]:
 def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
     """One Mode per distinct assembly: two solutions are the same mode when all their moving
     points agree to SAME * L (the points fix every link's angle modulo 2 pi)."""
-    names = m.moving_points
     picked = None if picked_q is None else model.points(picked_q, u, p).T.ravel()
     Q = np.array(found).reshape(len(found), model.nq)
     rows = _point_rows(model, Q, u, p)
     keep = [(Q[k], rows[k]) for k in _unique(rows, SAME * L)]
     keep.sort(key=lambda t: tuple(np.round(t[1] / (SAME * L))))
-    # each mode's angles: the links' (or, where the model names them, its own: joint angles)
-    angles = getattr(model, "mode_angles", lambda: [(lk.name, f"{lk.name}.angle") for lk in m.links])()
-    links, dim = [a for a, _ in angles], model.dim
-    out = []
-    s = model.column_scale(L)  # columns scaled to O(1)
-    for q, pts in keep:
-        ang = model.quantities([qn for _, qn in angles], q[None, :], u[None, :], p,
-                               np.ones((1, len(u))), np.zeros((1, len(u))))[:, 0]
-        det = np.linalg.det(model.jac(q, u, p) * s) if model.nq else 1.0
-        res = float(np.abs(model.residual(q, u, p)).max(initial=0.0) / L)
-        out.append(Mode(q=np.array(q), unknowns=tuple(model.unknown_names),
-                        points={nm: tuple(float(c) for c in pts[dim * j:dim * j + dim])
-                                for j, nm in enumerate(names)},
-                        angles={lk: float(wrap_angle(a)) for lk, a in zip(links, ang)},
-                        residual=res, orientation=int(np.sign(det)) if abs(det) > BRANCH else 0,
-                        from_guess=bool(picked is not None and np.abs(pts - picked).max() <= SAME * L),
-                        inputs={i.key: float(v) for i, v in zip(m.inputs, u)}))
+    out = [mode_at(m, model, q, u, p, L, picked, pts) for q, pts in keep]
     return [md for md in out if md.residual <= ACCEPT]  # each checked by its residual
+
+
+# --- `kincas.modes(...)`: the function, also reachable by its 0.1 module path ---
+
+
+class _CallableModule(types.ModuleType):
+    """`kincas.modes` is both this module (`import kincas.modes`, the path of 0.1) and the
+    function `modes`: calling the module calls it."""
+
+    def __call__(self, *args, **kwargs) -> "Modes":
+        return modes(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

@@ -20,6 +20,9 @@ def cli_arguments(parser) -> None:
     parser.add_argument("--starts", type=int, default=512,
                         help="number of scattered Newton starts (default 512)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the scattered starts")
+    parser.add_argument("--certify", action="store_true",
+                        help="prove the list complete: every real assembly, by an exact solver "
+                             '(msolve: pip install "kincas[certify]"; pins and slides only)')
     parser.add_argument("--write", metavar="DIR",
                         help="also write DIR/<scene>_mode<k>.toml: the scene with mode k's [guess]")
 
@@ -31,7 +34,13 @@ def cli_run(args) -> int:
         raise SceneError(f"--starts: expected a whole number >= 1, got {args.starts}")
     sc = load(args.scene)
     at = {k: float(v[0]) for k, v in sc.study.inputs.items()}
-    modes = find_modes(sc.mechanism, at, starts=args.starts, seed=args.seed)
+    if args.certify:
+        modes = _certified(sc.mechanism, at)
+        if modes is None:
+            return 2
+        at = dict(modes.inputs)  # the pose certified (rounded where it says so)
+    else:
+        modes = find_modes(sc.mechanism, at, starts=args.starts, seed=args.seed)
     if not sc.mechanism.guess and modes:
         modes = _solve_starts_on(sc, modes)
     deg = sc.study.deg
@@ -41,16 +50,46 @@ def cli_run(args) -> int:
         _write_scenes(args.scene, args.write, modes)
     if args.json:
         doc = {"title": sc.study.title, "units": sc.study.units, "inputs": user_in,
-               "starts": args.starts, "seed": args.seed,
+               "certified": modes.certified,
                "modes": [{"points": {p: list(xy) for p, xy in md.points.items()},
                           "angles": ang, "residual": md.residual, "orientation": md.orientation,
-                          "from_guess": md.from_guess, "guess": md.guess_block()}
+                          "from_guess": md.from_guess, "guess": md.guess_block(),
+                          **_certificate(md)}
                          for md, ang in zip(modes, user_ang)]}
+        if modes.certified:
+            doc.update(count=modes.count, rounded=modes.rounded, rejected=modes.rejected,
+                       positive_dimension=modes.positive_dimension)
+        else:
+            doc.update(starts=args.starts, seed=args.seed)
         json.dump(doc, sys.stdout, allow_nan=False)
         sys.stdout.write("\n")
     else:
         _print_modes(sc, modes, user_in, user_ang, args)
     return 0 if modes else 3
+
+
+def _certified(m, at):
+    """The certified modes, or None after one line on why there are none (exit 2): a
+    constraint that is not polynomial, or no solver."""
+    from ..analysis.certify import certify_modes
+    from ..analysis.certify_msolve import SolverFailed, SolverMissing
+    from ..core.polynomial_planar import refusal
+    why = refusal(m)
+    try:
+        if why is None:
+            return certify_modes(m, at)
+    except (SolverMissing, SolverFailed) as e:
+        why = str(e)
+    print(f"kincas: --certify: {why}", file=sys.stderr)
+    return None
+
+
+def _certificate(md) -> dict:
+    """A certified mode's box half-width, multiplicity, flag (and a note if any)."""
+    if not hasattr(md, "halfwidth"):
+        return {}
+    out = {"halfwidth": md.halfwidth, "multiplicity": md.multiplicity, "flag": md.flag}
+    return {**out, "note": md.note} if md.note else out
 
 
 def _print_modes(sc, modes, user_in, user_ang, args):
@@ -60,17 +99,29 @@ def _print_modes(sc, modes, user_in, user_ang, args):
     at = ", ".join(f"{k} = {v:.6g}" + (f" {unit[k]}" if unit[k] else "") for k, v in user_in.items())
     print(sc.study.title or "kincas")
     n = len(modes)
-    print(f"{n} assembly mode{'s' if n != 1 else ''}" + (f" at {at}" if at else "")
-          + f" ({args.starts} starts, seed {args.seed})")
+    how = (f"certified: every real assembly (msolve), count {n}" if modes.certified
+           else f"{args.starts} starts, seed {args.seed}; multistart search, not certified")
+    print(f"{n} assembly mode{'s' if n != 1 else ''}" + (f" at {at}" if at else "") + f" ({how})")
+    for note in getattr(modes, "rounded", []):
+        print(f"  the certificate is for the rounded pose: {note}")
+    for note in getattr(modes, "rejected", []):
+        print(f"  rejected: {note}")
     for k, (md, ang) in enumerate(zip(modes, user_ang), 1):
         mark = "" if not md.from_guess else ("  <- the scene's [guess] gives this one" if sc.mechanism.guess
                                              else "  <- `kincas solve` starts on this one (no [guess])")
-        print(f"\nmode {k} of {n}: residual {md.residual:.1e}, orientation {md.orientation:+d}{mark}")
+        box = _certificate(md)
+        box = (f", box half-width {box['halfwidth']:.1e}, multiplicity {box['multiplicity']}"
+               + (f" ({box['flag']})" if box["flag"] else "") + (f"; {box['note']}" if "note" in box else "")
+               if box else "")
+        print(f"\nmode {k} of {n}: residual {md.residual:.1e}, orientation {md.orientation:+d}{box}{mark}")
         print("  angles: " + ", ".join(f"{lk} {a:.6g}" for lk, a in ang.items())
               + f" {units.get('angle', 'deg')}")
         print(md.guess_block(), end="")
-    if not modes:
-        print("no assembly found: the mechanism cannot be put together at this input")
+    if getattr(modes, "positive_dimension", False):
+        print("infinitely many assemblies at this pose: a link is free to turn (no finite list)")
+    elif not modes:
+        print("no assembly" + (" (certified)" if modes.certified else " found")
+              + ": the mechanism cannot be put together at this input")
 
 
 def _solve_starts_on(sc, modes):
@@ -78,14 +129,14 @@ def _solve_starts_on(sc, modes):
     pose (an "assembly" event, kincas/analysis/choice.py): that one is marked instead."""
     from dataclasses import replace
 
-    from ..frames import Modes
     chosen = next((e for e in sc.run().events if e["kind"] == "assembly"), None)
     if chosen is None:
         return modes
     size = sc.mechanism.size()
     same = lambda md: all(max(abs(a - b) for a, b in zip(md.points[pt], xy)) <= 1e-6 * size
                           for pt, xy in chosen["guess"].items())
-    return Modes(replace(md, from_guess=same(md)) for md in modes)
+    modes[:] = [replace(md, from_guess=same(md)) for md in modes]  # in place: a certified list stays one
+    return modes
 
 
 def _write_scenes(path, directory, modes) -> list[Path]:
