@@ -32,6 +32,8 @@ COMMANDS = {
     "tolerance": ("kincas.cli.tolerance", "first-order and Monte-Carlo spread of outputs from parameter tolerances"),
     "study": ("kincas.cli.study", "many designs at once: the scene's [study] section, one row per design"),
     "cam": ("kincas.cli.cam", "design a disc cam from the scene's [cam_design] section (profile, pressure angle, curvature)"),
+    "simulate": ("kincas.cli.simulate", "motion of the free inputs under the loads over time ([simulate]); --steady: periodic steady state"),
+    "flywheel": ("kincas.cli.flywheel", "smallest flywheel inertia keeping the steady speed fluctuation below --fluctuation"),
 }
 
 

@@ -40,7 +40,7 @@ from .scene_study import StudyReader
 LARGEST = 1e100  # beyond it, squared lengths overflow double precision
 SECTIONS = {"title", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
             "output", "optimize", "tolerance", "gravity", "loads", "study", "gears", "racks",
-            "cams", "cam_design"}
+            "cams", "cam_design", "simulate", "data"}
 
 
 @dataclass
@@ -57,6 +57,8 @@ class Study:
     written: dict[str, np.ndarray] = field(default_factory=dict)  # inputs as the file gives them
     jerks: dict[str, float] = field(default_factory=dict)  # the inputs' third derivatives
     raw: dict = field(default_factory=dict, repr=False)  # the parsed TOML, for extensions
+    # free inputs, loads' expressions, [data], [simulate] (kincas/cli/scene_simulate.py)
+    simulation: dict = field(default_factory=dict)
 
     @property
     def deg(self) -> bool:
@@ -78,10 +80,19 @@ class Scene:
         `user_values(sweep)` give the numbers in the scene's units, as `kincas solve` prints."""
         from ..analysis.sweeps import sweep  # casadi stays out of scene parsing
         st = self.study
+        self.refuse_expressions("kincas solve")
         if any(st.jerks.values()):
             kw.setdefault("jerks", st.jerks)
         return sweep(self.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
                      report=self.quantities, **kw)
+
+    def refuse_expressions(self, what: str) -> None:
+        """Loads written as expressions of the state are only evaluated along a motion."""
+        exprs = self.study.simulation.get("expressions")
+        if exprs:
+            raise SceneError(f"[[loads]]: {len(exprs)} load component(s) are expressions of the "
+                             f"state and time ({next(iter(exprs.values()))!r}): {what} takes numbers "
+                             f"or parameters; `kincas simulate` evaluates expressions")
 
     def refuse_jerks(self, texts, where: str) -> None:
         """Only `kincas solve` passes the inputs' `jerk` on; elsewhere they would be taken as 0,
@@ -189,6 +200,8 @@ class _Reader(StudyReader):
         self.params = {}
         self.jerks: dict[str, float] = {}
         self.bad_params = set()  # reported once, where declared; not again where used
+        self.free: list[str] = []  # inputs moved by the forces
+        self.expressions: dict[str, tuple[str, str]] = {}  # hidden parameter -> (text, where)
 
     def err(self, msg: str):
         self.problems.append(msg)
@@ -270,6 +283,8 @@ class _Reader(StudyReader):
         inputs, values, rates, accs, written = self.inputs()
         from . import scene_loads
         grav, loads = scene_loads.gravity(self, doc), scene_loads.read_loads(self)
+        from . import scene_simulate
+        simulation = scene_simulate.read(self, doc, {lk.name for lk in links if lk}, inputs)
         guess = {k: self.xy(f"[guess] {k}", v) for k, v in self.table("guess").items()}
         report, sens = self.output()
         if not self.doc.get("links"):
@@ -289,7 +304,8 @@ class _Reader(StudyReader):
         self.check_quantities(m, report, sens)
         study = Study(title=title if isinstance(title, str) else "", units=self.units,
                       inputs=values, rates=rates, accelerations=accs, report=report,
-                      sensitivity=sens, written=written, raw=doc, jerks=self.jerks)
+                      sensitivity=sens, written=written, raw=doc, jerks=self.jerks,
+                      simulation=simulation)
         return Scene(m, study)
 
     def lean_parameters(self) -> dict:

@@ -43,7 +43,7 @@ class StudyReader:
         for i, t in enumerate(self.array("inputs")):
             where = f"[[inputs]] {i + 1}"
             self.fields(where, t, {"angle", "parameter", "slide", "value", "sweep", "rate",
-                                   "acceleration", "jerk"})
+                                   "acceleration", "jerk", "free"})
             kinds = [k for k in ("angle", "parameter", "slide") if k in t]
             if len(kinds) != 1:
                 self.err(f"{where}: give exactly one of angle, parameter or slide")
@@ -77,6 +77,10 @@ class StudyReader:
                 b = self.value(f"{where}: sweep.to", sw["to"])
                 vals = np.linspace(a, b, n)
                 steps.add(n)
+            if t.get("free", False) not in (True, False):
+                self.err(f"{where}: free: expected true or false, got {t['free']!r}")
+            elif t.get("free", False):
+                self.free.append(inp.key)  # moved by the forces (kincas simulate)
             inputs.append(inp)
             written[inp.key] = vals
             values[inp.key] = vals * k

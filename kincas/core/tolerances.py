@@ -72,3 +72,12 @@ FREE_LINKS = 6  # links left free by a guess that are tried in several turns (co
 NEARER = 1e-9  # another start's assembly is nearer the guessed points when its cost is below (1 - this) times
 CHOICE_STARTS = 128  # scattered starts finding a guessless sweep's other assemblies (analysis/choice.py)
 CHOICE_TRIES = 8  # of which at most this many are swept
+
+# --- forward dynamics (kincas/core/motion.py, kincas/analysis/simulate.py) ---
+ROOT_ABSTOL = 1e-12  # CasADi's Newton for q(u) inside the equations of motion: residual over the size
+ROOT_STEPTOL = 1e-13  # ... or a step (radians, lengths) below this
+SIM_RTOL = 1e-10  # the integrator's relative tolerance unless [simulate] tolerance says
+SIM_ATOL = 1e-12  # its absolute tolerance, times the state's scale (the size, or 1 rad)
+SIM_SINGULAR = 1e-4  # smallest scaled singular value of g_q (over the largest) at which the motion stops: a limit (delta u ~ 1e-8 of the size) ahead
+EVENT_TIME = 1e-12  # events are located to this times the duration
+SIM_MAX_STEPS = 5000  # integrator steps per output interval at most: more means a singular position ahead

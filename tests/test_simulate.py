@@ -1,0 +1,184 @@
+"""Forward dynamics (kincas.simulate, `kincas simulate`), checked against answers written here:
+energy conservation, an independent scipy integration of the slider-crank's reduced-inertia
+equation, the kinetostatic effort of the simulated motion, and the events that stop it."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import kincas
+from kincas.analysis.simulate import simulate
+from kincas.cli.app import main
+from kincas.cli.scene import load
+
+G = 9.81
+
+
+def _fourbar():
+    return kincas.Mechanism(
+        ground={"A": (0, 0), "D": (0.4, 0)}, gravity=(0, -G),
+        links=[kincas.Link.bar("crank", "A", "B", 0.2, mass=1.0, inertia=0.004),
+               kincas.Link.bar("coupler", "B", "C", 0.5, mass=2.0, inertia=0.05),
+               kincas.Link.bar("rocker", "D", "C", 0.4, mass=1.5, inertia=0.02)],
+        inputs=[kincas.Input.angle("crank")], guess={"C": (0.5, 0.4)})
+
+
+def _energy(r):
+    """Kinetic plus potential energy from the points' velocities (each link's centre of
+    gravity is the middle of its two points): nothing of kincas's efforts."""
+    v = r.values
+    mid = lambda a, b: (np.asarray(a) + np.asarray(b)) / 2  # noqa: E731
+    T = (0.5 * 1.0 * (mid(0, v["B.vx"]) ** 2 + mid(0, v["B.vy"]) ** 2) + 0.5 * 0.004 * v["crank.omega"] ** 2
+         + 0.5 * 2.0 * (mid(v["B.vx"], v["C.vx"]) ** 2 + mid(v["B.vy"], v["C.vy"]) ** 2)
+         + 0.5 * 0.05 * v["coupler.omega"] ** 2
+         + 0.5 * 1.5 * (mid(0, v["C.vx"]) ** 2 + mid(0, v["C.vy"]) ** 2) + 0.5 * 0.02 * v["rocker.omega"] ** 2)
+    V = G * (1.0 * mid(0, v["B.y"]) + 2.0 * mid(v["B.y"], v["C.y"]) + 1.5 * mid(0, v["C.y"]))
+    return T + V
+
+
+REPORT = ["B.vx", "B.vy", "C.vx", "C.vy", "B.y", "C.y", "crank.omega", "coupler.omega", "rocker.omega"]
+
+
+def test_pendulum_fourbar_conserves_energy():
+    r = simulate(_fourbar(), 2.0, 201, initial={"crank.angle": math.radians(30)}, report=REPORT,
+                 tolerance=1e-12)
+    assert r.ok
+    E = _energy(r)
+    scale = np.ptp(_energy_kinetic(r)) or 1.0
+    assert np.max(np.abs(E - E[0])) / scale < 1e-9
+    assert np.ptp(r.inputs["crank.angle"]) > 1.0  # it did swing
+
+
+def _energy_kinetic(r):
+    v = r.values
+    return 0.5 * (v["B.vx"] ** 2 + v["C.vx"] ** 2 + v["crank.omega"] ** 2)
+
+
+def test_effort_of_the_free_input_vanishes_along_the_motion():
+    """The simulated accelerations are the rates' derivatives (central differences), and with
+    them kincas's kinetostatics needs no effort on the free input."""
+    r = simulate(_fourbar(), 0.3, 301, initial={"crank.angle": 0.5}, rates={"crank.angle": 2.0},
+                 tolerance=1e-12)
+    w, a, h = r.rates["crank.angle"], r.accelerations["crank.angle"], r.time[1] - r.time[0]
+    fd = (w[2:] - w[:-2]) / (2 * h)
+    assert np.max(np.abs(fd - a[1:-1])) < 1e-3 * np.max(np.abs(a))
+    sw = kincas.sweep(_fourbar(), {"crank.angle": r.inputs["crank.angle"]}, rates={"crank.angle": w},
+                      accelerations={"crank.angle": a}, report=["effort(crank.angle)"])
+    torque_scale = G * 4.5 * 0.4
+    assert np.max(np.abs(sw["effort(crank.angle)"])) < 1e-9 * torque_scale
+
+
+# --- the slider-crank against its own reduced-inertia equation, integrated by scipy ---
+
+R, L, MP, JC, T0 = 0.05, 0.18, 2.0, 0.01, 3.0
+
+
+def _slider_crank(torque="T"):
+    return kincas.Mechanism(
+        parameters={"T": 0.0, "F": 0.0}, ground={"O": (0, 0)},
+        links=[kincas.Link.bar("crank", "O", "A", R, inertia=JC, cg=(0, 0)),
+               kincas.Link.bar("rod", "A", "B", L, mass=MP, cg=(L, 0))],
+        slides=[kincas.Slide(point="B", along="ground", through=(0, 0), angle=0.0, name="guide")],
+        inputs=[kincas.Input.angle("crank")], guess={"B": (0.23, 0)},
+        loads=[kincas.Load.torque("crank", torque), kincas.Load.force("B", ("F", 0))])
+
+
+def _hand_written(theta0, w0, times, force):
+    """(J + m x'^2) theta'' + m x' x'' theta'^2 = T + F(theta, w) x', with x the piston's
+    position in closed form."""
+    from scipy.integrate import solve_ivp
+
+    def rhs(t, y):
+        th, w = y
+        s, c = math.sin(th), math.cos(th)
+        S = math.sqrt(L * L - R * R * s * s)
+        x1 = -R * s - R * R * s * c / S
+        x2 = -R * c - R * R * (c * c - s * s) / S - R ** 4 * s * s * c * c / S ** 3
+        return [w, (T0 + force(th, w) * x1 - MP * x1 * x2 * w * w) / (JC + MP * x1 * x1)]
+    sol = solve_ivp(rhs, (times[0], times[-1]), [theta0, w0], t_eval=times, rtol=1e-12, atol=1e-12,
+                    method="DOP853")
+    return sol.y
+
+
+def test_slider_crank_against_scipy_reduced_inertia():
+    times = np.linspace(0, 0.5, 51)
+    r = simulate(_slider_crank(), 0.5, 51, initial={"crank.angle": 0.3}, rates={"crank.angle": 5.0},
+                 expressions={"T": str(T0), "F": "-20 * (1 + sin(crank.angle)) - 0.5 * B.vx"},
+                 tolerance=1e-12)
+    th, w = _hand_written(0.3, 5.0, times, lambda th, w: -20 * (1 + math.sin(th))
+                          - 0.5 * (-R * math.sin(th) - R * R * math.sin(th) * math.cos(th)
+                                   / math.sqrt(L * L - R * R * math.sin(th) ** 2)) * w)
+    assert r.ok
+    assert np.max(np.abs(r.inputs["crank.angle"] - th)) < 1e-8
+    assert np.max(np.abs(r.rates["crank.angle"] - w)) < 1e-7 * np.max(np.abs(w))
+
+
+# --- events ---
+
+
+def test_a_free_slider_stops_at_its_dead_centre():
+    """The piston as the free input, pushed outwards: it reaches s = l + r (the crank and the
+    rod in line), a limit of its own coordinate, in finite time, and the motion stops there."""
+    m = kincas.Mechanism(
+        ground={"O": (0, 0)},
+        links=[kincas.Link.bar("crank", "O", "A", R, inertia=JC, cg=(0, 0)),
+               kincas.Link.bar("rod", "A", "B", L, mass=MP, cg=(L, 0))],
+        slides=[kincas.Slide(point="B", along="ground", through=(0, 0), angle=0.0, name="guide")],
+        inputs=[kincas.Input.slide("guide")], guess={"A": (0.03, 0.04)},
+        loads=[kincas.Load.force("B", (50.0, 0))])
+    r = simulate(m, 1.0, 101, initial={"guide.s": 0.2})
+    assert not r.ok and len(r.events) == 1
+    e = r.events[0]
+    assert "limit" in e["reason"] and 0 < e["time"] < 1.0
+    s = r.inputs["guide.s"]
+    last = s[np.isfinite(s)][-1]
+    assert last < R + L and R + L - last < 1e-3
+    assert np.all(r.status[r.time > e["time"]] == "not reached")
+
+
+def test_cam_follower_leaves_a_weak_spring(tmp_path, capsys):
+    status = main(["simulate", "examples/simulate_cam_spring.toml", "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert status == 3
+    (e,) = doc["events"]
+    assert "contact lost" in e["reason"] and 0 < e["time"] < doc["inputs"]["t"][-1]
+    n = sum(t <= e["time"] for t in doc["inputs"]["t"])
+    assert all(v is not None for v in doc["values"]["contact(cam)"][:n])
+    assert doc["values"]["contact(cam)"][n - 1] > 0
+    assert all(v is None for v in doc["values"]["contact(cam)"][n:])
+    # the tappet's own equation of motion, vertically: N n_y + spring - m g = m a_y, with n
+    # from the cam's centre to the roller's and the spring k (d - d0) on T = F + (0, 0.02)
+    th = np.radians(doc["inputs"]["cam.angle"][:n])
+    Fy, ay, N = (np.array(doc["values"][k][:n]) for k in ("F.y", "F.ay", "contact(cam)"))
+    cx, cy = 0.01 * np.cos(th), 0.01 * np.sin(th)
+    ny = (Fy - cy) / np.hypot(0 - cx, Fy - cy)
+    d = 0.1 - (Fy + 0.02)
+    assert np.max(np.abs(N * ny + 200 * (d - 0.06) - 0.5 * G - 0.5 * ay)) < 1e-9 * 20
+
+
+def test_cli_simulate_pendulum_json_and_csv(tmp_path, capsys):
+    out = tmp_path / "p.csv"
+    status = main(["simulate", "examples/simulate_pendulum_fourbar.toml", "--json", "--csv", str(out)])
+    doc = json.loads(capsys.readouterr().out)
+    assert status == 0
+    assert set(doc) >= {"inputs", "values", "events"} and doc["events"] == []
+    assert len(doc["inputs"]["t"]) == 201 and doc["inputs"]["crank.angle"][0] == pytest.approx(30)
+    assert max(abs(x) for x in doc["values"]["effort(crank.angle)"]) < 1e-9
+    assert out.read_text().count("\n") >= 201
+
+
+def test_scene_errors_name_the_field(tmp_path):
+    text = open("examples/simulate_pendulum_fourbar.toml").read()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace("duration = 2.0", "duration = -1"))
+    with pytest.raises(kincas.SceneError, match=r"\[simulate\] duration"):
+        load(bad)
+    bad.write_text(text + '\n[[loads]]\nlink = "crank"\ntorque = "1 + nosuch(crank.omega)"\n')
+    with pytest.raises(kincas.SceneError, match=r"\[\[loads\]\] 1: torque: unknown function 'nosuch'"):
+        load(bad)
+    bad.write_text(text + '\n[[loads]]\nlink = "crank"\ntorque = "2 * crank.omega"\n')
+    with pytest.raises(kincas.SceneError, match="kincas simulate"):
+        load(bad).run()
