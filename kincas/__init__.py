@@ -47,6 +47,6 @@ def __getattr__(name):
 __all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "sweep",
            "SweepMethod", "Fast", "Careful",
            "sweep_designs", "study", "model_of",
-           "sensitivities", "analyse", "optimize", "find_modes", "input_range",
+           "sensitivities", "analyse", "optimize", "find_modes", "input_range", "simulate",
            "Pose", "Sweep", "KincasError", "ModelError", "SceneError"]
 __version__ = "0.1.0"

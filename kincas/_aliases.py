@@ -71,7 +71,8 @@ def install() -> None:
 # 0.1's path and, being callable, the function too: see synthesis/optimize.py)
 FUNCTIONS = {"sensitivities": "analysis.sensitivity", "analyse": "analysis.tolerance",
              "find_modes": "analysis.modes", "input_range": "analysis.singular",
-             "sweep_designs": "analysis.designs", "study": "synthesis.study"}
+             "sweep_designs": "analysis.designs", "study": "synthesis.study",
+             "simulate": "analysis.simulate"}
 
 
 def attribute(name: str):

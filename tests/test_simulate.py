@@ -182,3 +182,61 @@ def test_scene_errors_name_the_field(tmp_path):
     bad.write_text(text + '\n[[loads]]\nlink = "crank"\ntorque = "2 * crank.omega"\n')
     with pytest.raises(kincas.SceneError, match="kincas simulate"):
         load(bad).run()
+
+
+# --- periodic steady state and flywheel ---
+
+WHEEL = """
+title = "wheel"
+units = { length = "m", angle = "rad", time = "s" }
+[parameters]
+T0 = 10
+ws = 100
+A = 2
+[ground]
+O = [0, 0]
+[links]
+wheel = { points = ["O", "P"], length = 0.1, inertia = 0.01, cg = [0, 0] }
+[[loads]]
+link = "wheel"
+torque = "T0 * (1 - wheel.omega / ws) + A * sin(wheel.angle)"
+[[inputs]]
+angle = "wheel"
+free = true
+value = 0
+rate = 90
+[simulate]
+duration = 1
+steps = 11
+flywheel = { link = "wheel", inertia = 0.0 }
+"""
+
+
+def test_flywheel_of_a_sinusoidal_torque_against_the_energy_method(tmp_path, capsys):
+    """T = T0 (1 - w/ws) + A sin(theta) on a wheel: the swing of the work is 2A, so to first
+    order in Cs the inertia needed in all is 2A / (Cs w^2) (the energy method, exact as Cs -> 0)."""
+    scene = tmp_path / "wheel.toml"
+    scene.write_text(WHEEL)
+    assert main(["flywheel", str(scene), "--fluctuation", "0.01", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    need = 2 * 2 / (0.01 * doc["w_mean"] ** 2)
+    assert doc["fluctuation"] <= 0.01 and doc["fluctuation"] > 0.01 * (1 - 1e-6)
+    assert abs(doc["estimate"] - need) < 1e-4 * need  # dE = 2A from kincas's net torque
+    assert abs(doc["inertia"] + 0.01 - need) < 0.03 * need
+    assert abs(doc["w_mean"] - 100) < 0.1
+
+
+def test_steady_state_is_periodic_in_an_independent_time_integration(capsys):
+    assert main(["simulate", "examples/simulate_engine.toml", "--steady", "--json"]) == 0
+    st = json.loads(capsys.readouterr().out)
+    assert st["cycle"] == pytest.approx(720)
+    sc = load("examples/simulate_engine.toml")
+    from kincas.cli.simulate import arguments_of
+    kw = arguments_of(sc)
+    kw["rates"]["crank.angle"] = math.radians(st["w0"])
+    r = simulate(sc.mechanism, st["period"], 2001, **kw)
+    th, w = np.degrees(r.inputs["crank.angle"]), np.degrees(r.rates["crank.angle"])
+    assert abs(th[-1] - th[0] - 720) < 2e-8 * 720 and abs(w[-1] - w[0]) < 1e-7 * w[0]  # tolerance 1e-10
+    assert st["w_mean"] == pytest.approx(720 / st["period"], rel=1e-12)
+    assert 0 <= st["w_max"] - w.max() < 1e-5 * w.max() and 0 <= w.min() - st["w_min"] < 1e-5 * w.max()
+    assert st["fluctuation"] == pytest.approx((st["w_max"] - st["w_min"]) / st["w_mean"], rel=1e-12)

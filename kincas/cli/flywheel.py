@@ -68,7 +68,7 @@ class _Machine:
 def print_steady(sc, args) -> int:
     st, _ = _Machine(sc).steady()
     k = 180 / math.pi if sc.study.deg else 1.0
-    doc = {"cycle": st.cycle * k, "period": st.period, "w_mean": st.w_mean * k, "w_max": st.w_max * k,
+    doc = {"cycle": st.cycle * k, "period": st.period, "w0": st.w0 * k, "w_mean": st.w_mean * k, "w_max": st.w_max * k,
            "w_min": st.w_min * k, "fluctuation": st.fluctuation}
     if args.json:
         sys.stdout.write(json.dumps(doc) + "\n")
