@@ -46,9 +46,14 @@ class _Machine:
         self.shoot = Shooting(setup)
         key = setup.free[0]
         self.th0, self.w0 = kw["initial"][key], kw["rates"][key]
-        if self.w0 == 0:
-            raise SceneError(f"[[inputs]] {key}: rate: a steady state is sought from a running "
-                             f"start (give the rate it runs at, roughly)")
+        if self.w0 == 0:  # from rest: shoot from where the [simulate] run-up ends
+            sim = sc.study.simulation
+            r = setup.run(sim["duration"], sim["steps"] or 101, kw["initial"], kw["rates"], kw["accelerations"],
+                          kw.get("tolerance", 1e-10), [], None)
+            if not r.ok or r.rates[key][-1] == 0:
+                raise SceneError(f"[[inputs]] {key}: rate: the machine does not run up from rest "
+                                 f"over [simulate] duration; give the rate it runs at, roughly")
+            self.th0, self.w0 = float(r.inputs[key][-1]), float(r.rates[key][-1])
         first = sweep(setup.m, {key: [self.th0]}, report=[])
         if not first.ok[0]:
             raise SceneError(f"[[inputs]] {key}: no assembly at value {self.th0}")
