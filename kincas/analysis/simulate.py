@@ -245,7 +245,7 @@ class _Setup:
                     "show_eval_warnings": False}
             return ca.integrator("motion", "cvodes", {"x": x, "t": tau, "p": ca.vertcat(par, t0h),
                                                       "ode": ode}, 0, list(range(1, n + 1)), opts)
-        return self.model.memo(("integrator", id(mo), n, tol), build)
+        return self.model.memo(("integrator", id(mo), mo.exact, n, tol), build)
 
     def _post(self):
         """x, t, par -> (q, u_f'', contact forces, vec(g_q)) at output states."""
@@ -313,23 +313,30 @@ class _Setup:
             q, acc, C, J = (np.asarray(a) for a in post.map(len(ts))(xs.T, ts, np.tile(par[:, None], len(ts))))
         except RuntimeError:  # Newton did not converge on a state: singular there
             return (0, self._singular_reason()), sign
-        nq = self.model.nq
-        scale = self.model.column_scale(self.m.size())
-        for i in range(len(ts)):
-            if self.cams and np.any(C[:, i] <= 0):
-                c = self.cams[int(np.argmax(C[:, i] <= 0))]
-                return (i, f"contact lost on cam {c} (its contact force reached zero)"), sign
-            if not np.all(np.isfinite(acc[:, i])):
-                return (i, self._singular_reason()), sign
-            if nq:
-                Jq = J[:, i].reshape(-1, nq, order="F") * scale
-                sv = np.linalg.svd(Jq, compute_uv=False)
-                s_i = np.sign(np.linalg.det(Jq)) if Jq.shape[0] == nq else 0.0
-                if not np.all(np.isfinite(sv)) or sv[-1] <= SIM_SINGULAR * sv[0] or \
-                        (sign is not None and s_i != sign):
-                    return (i, self._singular_reason()), sign
-                sign = s_i
-        return None, sign
+        nq, n = self.model.nq, len(ts)
+        bad = np.zeros(n, bool)
+        why = np.full(n, "", dtype=object)
+        if self.cams:
+            lost = np.any(C <= 0, axis=0)
+            why[lost] = [f"contact lost on cam {self.cams[int(np.argmax(C[:, i] <= 0))]} (its contact "
+                         f"force reached zero)" for i in np.flatnonzero(lost)]
+            bad |= lost
+        sing = ~np.all(np.isfinite(acc), axis=0)
+        signs = np.zeros(n)
+        if nq:  # all states at once: (n, ng, nq) Jacobians, columns scaled
+            Js = J.T.reshape(n, nq, -1).transpose(0, 2, 1) * self.model.column_scale(self.m.size())
+            sv = np.linalg.svd(Js, compute_uv=False)
+            sing |= ~np.all(np.isfinite(sv), axis=1) | (sv[:, -1] <= SIM_SINGULAR * sv[:, 0])
+            if Js.shape[1] == nq:
+                signs = np.sign(np.linalg.det(Js))
+                prev = np.concatenate([[sign if sign is not None else signs[0]], signs[:-1]])
+                sing |= signs != prev
+        why[sing & ~bad] = self._singular_reason()
+        bad |= sing
+        if bad.any():
+            i = int(np.argmax(bad))
+            return (i, why[i]), sign
+        return None, (signs[-1] if nq else sign)
 
     def _singular_reason(self) -> str:
         free = ", ".join(self.free)
