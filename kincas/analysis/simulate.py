@@ -21,7 +21,6 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 
-import casadi as ca
 import numpy as np
 
 from ..core.motion import Motion
@@ -228,29 +227,6 @@ class _Setup:
         self.motion = self.model.memo(key, lambda: Motion(self.model, self.free, exprs, angle, cams))
         self.cams = cams
 
-    # --- integration ---
-    def _integrator(self, n: int, tol: float):
-        """x(tau = 1..n) from x(0), with t = t0 + h tau: one integrator per n (and tolerance)
-        serves every interval, shifted and scaled by its parameters (t0, h)."""
-        mo = self.motion
-
-        def build():
-            dae = mo.rhs()
-            S = type(dae["x"])  # SX (q carried) or MX (q solved inside)
-            x, par, tau, t0h = S.sym("x", dae["x"].numel()), S.sym("par", dae["p"].numel()), S.sym("tau"), S.sym("t0h", 2)
-            f = ca.Function("f", [dae["x"], dae["t"], dae["p"]], [dae["ode"]])
-            ode = t0h[1] * f(x, t0h[0] + t0h[1] * tau, par)
-            opts = {"reltol": tol, "abstol": SIM_ATOL / SIM_RTOL * tol, "max_num_steps": SIM_MAX_STEPS,
-                    "linear_multistep_method": "adams", "nonlinear_solver_iteration": "functional",
-                    "show_eval_warnings": False}
-            return ca.integrator("motion", "cvodes", {"x": x, "t": tau, "p": ca.vertcat(par, t0h),
-                                                      "ode": ode}, 0, list(range(1, n + 1)), opts)
-        return self.model.memo(("integrator", id(mo), mo.exact, n, tol), build)
-
-    def _post(self):
-        """x, t, par -> (q, u_f'', contact forces, vec(g_q)) at output states."""
-        return self.motion.rhs()["post"]
-
     def run(self, duration, steps, initial, rates, accs, tol, report, guess):
         from .sweeps import sweep
         if not (isinstance(steps, int) and steps >= 2) or not (duration > 0 and math.isfinite(duration)):
@@ -286,9 +262,7 @@ class _Setup:
         while k < n - 1:
             size = min(size, n - 1 - k)
             try:
-                F = self._integrator(size, tol)
-                out = F(x0=X[k], p=np.concatenate([par, [times[k], h]]))
-                xs = np.asarray(out["xf"]).T
+                xs = self.motion.integrate(X[k], par, times[k], h, size, tol)
                 bad, last = self._events(xs, times[k + 1:k + 1 + size], par, sign)
             except RuntimeError:
                 xs, bad, last = None, (0, "the integration failed"), sign
@@ -308,9 +282,8 @@ class _Setup:
         """((index, reason) of the first state of `xs` where the motion must stop, or None;
         the sign of det g_q at the last state). Passing a limit of a free input (a dead
         centre), q moves to the other assembly: det g_q changes sign, as in a sweep."""
-        post = self._post()
         try:
-            q, acc, C, J = (np.asarray(a) for a in post.map(len(ts))(xs.T, ts, np.tile(par[:, None], len(ts))))
+            q, acc, C, J = self.motion.post(xs, ts, par)
         except RuntimeError:  # Newton did not converge on a state: singular there
             return (0, self._singular_reason()), sign
         nq, n = self.model.nq, len(ts)
@@ -344,12 +317,11 @@ class _Setup:
 
     def _locate(self, x, t_lo, t_hi, par, tol, reason, sign):
         """The event's time, by bisection between a good state at t_lo and a bad one at t_hi."""
-        F = self._integrator(1, tol)
         span = t_hi - t_lo
         while t_hi - t_lo > EVENT_TIME * max(span, abs(t_hi)):
             mid = 0.5 * (t_lo + t_hi)
             try:
-                xm = np.asarray(F(x0=x, p=np.concatenate([par, [t_lo, mid - t_lo]]))["xf"]).ravel()
+                xm = self.motion.integrate(x, par, t_lo, mid - t_lo, 1, tol)[0]
                 bad, s_mid = self._events(xm[None, :], np.array([mid]), par, sign)
             except RuntimeError:
                 bad = (0, reason)
@@ -374,11 +346,10 @@ class _Setup:
         idx = np.flatnonzero(ok)
         P = np.tile(par[:len(m.parameters)][:, None], n)
         if idx.size:
-            q, acc, _, _ = (np.asarray(a) for a in self._post().map(idx.size)(
-                X[idx].T, times[idx], np.tile(par[:, None], idx.size)))
+            q, acc, _, _ = mo.post(X[idx], times[idx], par)
             Q[idx] = q.T
             Udd[np.ix_(idx, mo.free)] = acc.T
-            P[:, idx] = np.asarray(mo.f_params.map(idx.size)(q, U[idx].T, Ud[idx].T, times[idx], P[:, idx]))
+            P[:, idx] = mo.parameters(q, U[idx].T, Ud[idx].T, times[idx], P[:, idx])
         U[~ok], Ud[~ok], Udd[~ok] = np.nan, np.nan, np.nan
         names = list(report) if report is not None else []
         values = {nm: np.full(n, np.nan) for nm in names}

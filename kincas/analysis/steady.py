@@ -22,11 +22,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
-from .simulate import FLYWHEEL, _Setup, with_flywheel  # noqa: F401
+from ..core.motion import CycleODE
+from .simulate import _Setup
 
 SAMPLES = 720  # samples of a cycle where the extremes of the speed are first looked for
 
@@ -78,34 +78,14 @@ class Shooting:
             raise ModelError("--steady: expected one free angle input and no other input")
         self.setup, self.key = setup, setup.free[0]
         self.cycle = cycle_of(setup, self.key)
-        sym, nq = mo.sym, mo.sym.nq
-        y, th, par = ca.SX.sym("y", nq + 2), ca.SX.sym("th"), ca.SX.sym("par", sym.np + 2)
-        tau, p = th, par[:sym.np]
-        theta = par[sym.np] + par[sym.np + 1] * tau  # theta0 + Theta tau, tau in [0, 1]
-        t, q, w = y[0], y[1:nq + 1], y[nq + 1]
-        u, ud = ca.SX.zeros(sym.nu), ca.SX.zeros(sym.nu)
-        u[mo.free[0]], ud[mo.free[0]] = theta, w
-        acc, _ = mo.f_acc(q, u, ud, t, p, ca.SX(0, 1))
-        dy = ca.vertcat(1 / w, mo.f_qdot(q, u, p, ud) / w, acc / w) * par[sym.np + 1]
-        self.f_slope = ca.Function("slope", [y, th, par], [dy])
-        self.dae = {"x": y, "t": tau, "p": par, "ode": dy}
-        self.f_mass = mo.f_mass
-        self._int = {}
-
-    def integrator(self, n: int, tol: float):
-        if (n, tol) not in self._int:
-            opts = {"reltol": tol, "abstol": tol * 1e-2, "max_num_steps": 20000,
-                    "linear_multistep_method": "adams", "nonlinear_solver_iteration": "functional"}
-            self._int[(n, tol)] = ca.integrator("cycle", "cvodes", self.dae, 0,
-                                                [k / n for k in range(1, n + 1)], opts)
-        return self._int[(n, tol)]
+        self.ode = CycleODE(mo)
 
     def run(self, q0, th0, w0, p, tol, n=SAMPLES):
         """(y at the n samples of one cycle from (q0, theta0, w0)), the cycle signed as w0."""
         cyc = math.copysign(self.cycle, w0)
         par = np.concatenate([p, [th0, cyc]])
         y0 = np.concatenate([[0.0], q0, [w0]])
-        return np.asarray(self.integrator(n, tol)(x0=y0, p=par)["xf"]).T, par, y0
+        return self.ode.run(y0, par, n, tol), par, y0
 
     def steady(self, q0, th0, w0, p, tol) -> Steady:
         """Shoot on w0 until the speed at the end of a cycle is the speed at its start."""
@@ -140,7 +120,7 @@ class Shooting:
             if a < 0 or a + 1 >= len(Y):
                 continue
             h = taus[a + 1] - taus[a]
-            d0, d1 = (float(self.f_slope(Y[k], taus[k], par)[-1]) * h for k in (a, a + 1))
+            d0, d1 = (self.ode.slope(Y[k], taus[k], par)[-1] * h for k in (a, a + 1))
             w0, w1 = Y[a, -1], Y[a + 1, -1]
             # w(s) = (2s^3 - 3s^2 + 1) w0 + (s^3 - 2s^2 + s) d0 + (-2s^3 + 3s^2) w1 + (s^3 - s^2) d1
             c2, c1 = 3 * (2 * w0 + d0 - 2 * w1 + d1), 2 * (-3 * w0 - 2 * d0 + 3 * w1 - d1)
@@ -149,8 +129,8 @@ class Shooting:
                 if abs(np.imag(r)) > 0 or not 0 < np.real(r) < 1:
                     continue
                 pp = par.copy()
-                pp[-2], pp[-1] = par[-2] + par[-1] * taus[a], par[-1] * h * float(np.real(r))
-                v = abs(float(np.asarray(self.integrator(1, tol)(x0=Y[a], p=pp)["xf"])[-1, 0]))
+                pp[-2] = par[-2] + par[-1] * taus[a]  # from sample a, over the fraction h r
+                v = abs(self.ode.run(Y[a], pp, 1, tol, upto=h * float(np.real(r)))[-1, -1])
                 best = max(best, v) if larger else min(best, v)
         return best
 
@@ -165,7 +145,7 @@ class Shooting:
         for k, th in enumerate(ths):
             u, ud = np.array([th]), np.array([w_mean])
             acc, _ = mo.accelerations(sw.q[k], u, ud, 0.0, p)
-            M = float(mo.f_mass(sw.q[k], u, ud, 0.0, p, np.zeros(0)))
+            M = float(mo.mass(sw.q[k], u, ud, 0.0, p)[0, 0])
             T[k] = M * acc[0]
         T -= np.trapezoid(T, ths) / (ths[-1] - ths[0])
         E = np.concatenate([[0.0], np.cumsum((T[1:] + T[:-1]) / 2 * np.diff(ths))])

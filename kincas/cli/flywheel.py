@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import OutputError, SceneError
 from .common import EXIT_OK
 from .scene import load
-from .simulate import arguments_of
+from .scene_simulate import arguments_of
 
 
 def cli_arguments(parser) -> None:

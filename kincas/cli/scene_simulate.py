@@ -34,6 +34,8 @@ from __future__ import annotations
 
 import math
 
+from ..errors import SceneError
+
 FIELDS = {"duration", "steps", "flywheel", "tolerance"}
 
 
@@ -109,3 +111,21 @@ def read(reader, doc: dict, mechanism_links, inputs) -> dict:
                 reader.err(f"[simulate] flywheel: inertia: must not be negative, got {J}")
             out["flywheel"] = (fw["link"], J)
     return out
+
+
+def arguments_of(sc) -> dict:
+    """The keyword arguments of `kincas.simulate` that the scene gives (radians inside)."""
+    sim = sc.study.simulation
+    if not sim.get("free"):
+        raise SceneError("[[inputs]]: no input is `free = true` (kincas simulate moves the free "
+                         "inputs under the loads)")
+    if sim.get("duration") is None:
+        raise SceneError("[simulate]: missing (duration = T, steps = N)")
+    st = sc.study
+    kw = dict(free=sim["free"], initial={k: float(v[0]) for k, v in st.inputs.items()},
+              rates=dict(st.rates), accelerations=dict(st.accelerations),
+              expressions=sim["expressions"], data=sim["data"], flywheel=sim["flywheel"],
+              angle=math.pi / 180 if st.deg else 1.0)
+    if sim.get("tolerance"):
+        kw["tolerance"] = sim["tolerance"]
+    return kw

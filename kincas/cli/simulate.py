@@ -14,9 +14,9 @@ import sys
 
 import numpy as np
 
-from ..errors import SceneError
 from .common import EXIT_OK, EXIT_UNSOLVED, _list, _unit
 from .scene import load
+from .scene_simulate import arguments_of
 
 
 def cli_arguments(parser) -> None:
@@ -30,24 +30,6 @@ def cli_arguments(parser) -> None:
     parser.add_argument("--steady", action="store_true",
                         help="the periodic steady state: mean speed and coefficient of speed fluctuation")
     parser.add_argument("--no-progress", action="store_true", help="(accepted for symmetry with solve)")
-
-
-def arguments_of(sc) -> dict:
-    """The keyword arguments of `kincas.simulate` that the scene gives (radians inside)."""
-    sim = sc.study.simulation
-    if not sim.get("free"):
-        raise SceneError("[[inputs]]: no input is `free = true` (kincas simulate moves the free "
-                         "inputs under the loads)")
-    if sim.get("duration") is None:
-        raise SceneError("[simulate]: missing (duration = T, steps = N)")
-    st = sc.study
-    kw = dict(free=sim["free"], initial={k: float(v[0]) for k, v in st.inputs.items()},
-              rates=dict(st.rates), accelerations=dict(st.accelerations),
-              expressions=sim["expressions"], data=sim["data"], flywheel=sim["flywheel"],
-              angle=math.pi / 180 if st.deg else 1.0)
-    if sim.get("tolerance"):
-        kw["tolerance"] = sim["tolerance"]
-    return kw
 
 
 def run_scene(sc):

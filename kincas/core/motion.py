@@ -88,7 +88,7 @@ class Motion:
         self.f_params = ca.Function("parameters", [q, u, ud, t, p], [p_eff])
         qd = -sym.lsolve(ca.mtimes(sym.Ju, ud))
         self.f_qdot = ca.Function("qdot", [sym.q, sym.u, sym.p, ud], [ca.densify(qd)])
-        self._rhs = None
+        self._rhs, self._int = None, {}
 
     # --- the loads' expressions as parameters ---
     def _substituted(self, q, u, ud, t, p, expressions, k):
@@ -167,6 +167,41 @@ class Motion:
                 self._rhs = {"x": xs, "t": ts, "p": ps, "ode": ode, "post": post}
         return self._rhs
 
+    # --- integrators (numbers in, numbers out: the analysis floor holds no CasADi object) ---
+    def integrate(self, x0, par, t0: float, h: float, n: int, tol: float) -> np.ndarray:
+        """The states at t0 + h, ..., t0 + n h (one row each) from x0 at t0, by CVODES
+        (Adams, functional iteration: the motion is not stiff). RuntimeError when it fails.
+        One integrator per (n, tol) serves every interval: time enters as t0 + h tau."""
+        key = ("integrator", self.exact, n, tol)
+        if key not in self._int:
+            from .tolerances import SIM_ATOL, SIM_MAX_STEPS, SIM_RTOL
+            dae = self.rhs()
+            S = type(dae["x"])  # SX (q carried) or MX (q solved inside)
+            x, par_, tau, t0h = (S.sym("x", dae["x"].numel()), S.sym("par", dae["p"].numel()),
+                                 S.sym("tau"), S.sym("t0h", 2))
+            f = ca.Function("f", [dae["x"], dae["t"], dae["p"]], [dae["ode"]])
+            ode = t0h[1] * f(x, t0h[0] + t0h[1] * tau, par_)
+            self._int[key] = _cvodes({"x": x, "t": tau, "p": ca.vertcat(par_, t0h), "ode": ode},
+                                     n, tol, SIM_ATOL / SIM_RTOL * tol, SIM_MAX_STEPS)
+        out = self._int[key](x0=x0, p=np.concatenate([par, [t0, h]]))
+        return np.asarray(out["xf"]).T
+
+    def post(self, xs, ts, par):
+        """(q, u_f'', contact forces, vec(g_q)) at states xs (one row each) at times ts, as
+        numpy columns; RuntimeError where Newton finds no q."""
+        n = len(ts)
+        out = self.rhs()["post"].map(n)(np.asarray(xs).T, np.asarray(ts, float), np.tile(np.reshape(par, (-1, 1)), n))
+        return tuple(np.asarray(a) for a in out)
+
+    def parameters(self, Q, U, Ud, ts, P):
+        """The parameters at each state (columns), the loads' expressions evaluated."""
+        n = len(ts)
+        return np.asarray(self.f_params.map(n)(Q, U, Ud, np.asarray(ts, float), P))
+
+    def mass(self, q, u, ud, t, p):
+        """The reduced mass matrix M(u) at a solved state."""
+        return np.asarray(self.f_mass(q, u, ud, t, p, np.zeros(len(self.held))))
+
     def rootfinder(self):
         """q(u, p) by CasADi's Newton from a guess: g = 0 (g_q' g = 0 where g_q is tall)."""
         sym = self.sym
@@ -183,3 +218,40 @@ class Motion:
     def _size(self) -> float:
         m = self.sym.mech
         return max(1.0, m.size()) if hasattr(m, "size") else 1.0
+
+
+def _cvodes(dae, n, tol, atol, steps):
+    """CVODES over tau = 1..n (or the grid's fractions), Adams with functional iteration."""
+    grid = list(range(1, n + 1)) if isinstance(n, int) else list(n)
+    opts = {"reltol": tol, "abstol": atol, "max_num_steps": steps, "show_eval_warnings": False,
+            "linear_multistep_method": "adams", "nonlinear_solver_iteration": "functional"}
+    return ca.integrator("motion", "cvodes", dae, 0, grid, opts)
+
+
+class CycleODE:
+    """One free angle theta as the independent variable over a cycle Theta:
+    y = (t, q, w), dt/dtheta = 1/w, dq/dtheta = q'/w, dw/dtheta = theta''/w, with
+    theta = theta0 + Theta tau, tau in [0, 1] (kincas/analysis/steady.py shoots on it)."""
+
+    def __init__(self, mo: Motion):
+        sym, nq = mo.sym, mo.sym.nq
+        y, tau, par = ca.SX.sym("y", nq + 2), ca.SX.sym("tau"), ca.SX.sym("par", sym.np + 2)
+        p, theta = par[:sym.np], par[sym.np] + par[sym.np + 1] * tau
+        t, q, w = y[0], y[1:nq + 1], y[nq + 1]
+        u, ud = ca.SX.zeros(sym.nu), ca.SX.zeros(sym.nu)
+        u[mo.free[0]], ud[mo.free[0]] = theta, w
+        acc, _ = mo.f_acc(q, u, ud, t, p, ca.SX(0, 1))
+        dy = ca.vertcat(1 / w, mo.f_qdot(q, u, p, ud) / w, acc / w) * par[sym.np + 1]
+        self.f_slope = ca.Function("slope", [y, tau, par], [dy])
+        self.dae, self._int = {"x": y, "t": tau, "p": par, "ode": dy}, {}
+
+    def run(self, y0, par, n: int, tol: float, upto: float = 1.0) -> np.ndarray:
+        """y at tau = upto k / n, k = 1..n, from y0 at tau = 0 (one row each)."""
+        if (n, tol) not in self._int:
+            self._int[(n, tol)] = _cvodes(self.dae, [k / n for k in range(1, n + 1)], tol, tol * 1e-2, 20000)
+        pp = np.array(par, float)
+        pp[-1] *= upto  # a part of the cycle: theta = theta0 + (upto Theta) tau
+        return np.asarray(self._int[(n, tol)](x0=y0, p=pp)["xf"]).T
+
+    def slope(self, y, tau, par) -> np.ndarray:
+        return np.asarray(self.f_slope(y, tau, par)).ravel()

@@ -13,7 +13,8 @@ expressions.py: numbers, `+ - * / ^`, sin cos ... hypot) with, in addition:
   ends), whose derivative is exact piecewise;
 - `min(a, b, ...)`, `max(a, b, ...)` of values (not the `[optimize]` extremes over a range).
 
-The expression becomes a CasADi expression in (q, u, u', t, p), so the equations of motion
+Parsing and checking need no CasADi (scenes are read without it); the expression becomes a
+CasADi expression in (q, u, u', t, p), so the equations of motion
 stay one graph and their derivatives are exact.
 
 >>> e = LoadExpression("T0 * (1 - crank.omega / w0) + interp(crank.angle % 720, g.a, g.f)",
@@ -26,11 +27,10 @@ from __future__ import annotations
 import ast
 import math
 
-import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
-from ..synthesis.expressions import BINARY, UNARY, quantity_name
+from .expressions_sym import BINARY, UNARY, quantity_name
 
 FUNCTIONS = UNARY | BINARY | {"interp", "min", "max"}
 _OPS = (ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Pow, ast.Mod)
@@ -106,6 +106,7 @@ class LoadExpression:
         return self._eval(self.tree, leaf, time, angle)
 
     def _eval(self, node, leaf, time, k):
+        import casadi as ca  # here only: a scene's expressions are checked without CasADi
         ev = lambda a: self._eval(a, leaf, time, k)  # noqa: E731
         if isinstance(node, ast.Constant):
             return ca.SX(float(node.value))
