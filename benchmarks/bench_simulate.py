@@ -37,8 +37,8 @@ from kincas.cli.simulate import arguments_of  # noqa: E402
 SCENE = ROOT / "examples" / "simulate_engine.toml"
 ANG = [0, 15, 30, 60, 90, 120, 150, 180, 360, 540, 600, 660, 690, 720]
 GAS = [8000, 25000, 20000, 10000, 5000, 2500, 1200, 0, 0, 0, 300, 1500, 4000, 8000]
-R, L, A_CG, M_ROD, J_ROD, M_PISTON, J_CRANK = 0.05, 0.18, 0.06, 1.2, 0.004, 0.8, 0.02 + 0.3
-TM, W0 = 53.25, 18000.0
+R, L, A_CG, M_ROD, J_ROD, M_PISTON, J_CRANK = 50, 180, 60, 0.0012, 4, 0.0008, 20 + 300  # mm, t
+TM, W0 = 53250.0, 18000.0  # N mm, deg/s
 
 
 def best(f, n=3):

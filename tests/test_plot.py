@@ -21,7 +21,8 @@ from kincas.views.plot import draw, geometry, new_figure  # noqa: E402
 from kincas.cli.scene import load  # noqa: E402
 
 SIZE, DPI = (4.0, 3.0), 80
-EXAMPLE_FILES = sorted(EXAMPLES.glob("*.toml"))
+# (loads written as expressions of the state are solved only by kincas simulate: test_simulate.py)
+EXAMPLE_FILES = [p for p in sorted(EXAMPLES.glob("*.toml")) if p.stem not in ("simulate_engine", "simulate_press")]
 
 
 # --- helpers: render, find pixels ---

@@ -150,13 +150,13 @@ def test_cam_follower_leaves_a_weak_spring(tmp_path, capsys):
     assert doc["values"]["contact(cam)"][n - 1] > 0
     assert all(v is None for v in doc["values"]["contact(cam)"][n:])
     # the tappet's own equation of motion, vertically: N n_y + spring - m g = m a_y, with n
-    # from the cam's centre to the roller's and the spring k (d - d0) on T = F + (0, 0.02)
+    # from the cam's centre to the roller's and the spring k (d - d0) on T = F + (0, 20)
     th = np.radians(doc["inputs"]["cam.angle"][:n])
     Fy, ay, N = (np.array(doc["values"][k][:n]) for k in ("F.y", "F.ay", "contact(cam)"))
-    cx, cy = 0.01 * np.cos(th), 0.01 * np.sin(th)
+    cx, cy = 10 * np.cos(th), 10 * np.sin(th)  # mm, t, N
     ny = (Fy - cy) / np.hypot(0 - cx, Fy - cy)
-    d = 0.1 - (Fy + 0.02)
-    assert np.max(np.abs(N * ny + 200 * (d - 0.06) - 0.5 * G - 0.5 * ay)) < 1e-9 * 20
+    d = 100 - (Fy + 20)
+    assert np.max(np.abs(N * ny + 0.2 * (d - 60) - 0.0005 * 9810 - 0.0005 * ay)) < 1e-9 * 20
 
 
 def test_cli_simulate_pendulum_json_and_csv(tmp_path, capsys):
