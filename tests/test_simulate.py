@@ -166,8 +166,9 @@ def test_cli_simulate_pendulum_json_and_csv(tmp_path, capsys):
     assert status == 0
     assert set(doc) >= {"inputs", "values", "events"} and doc["events"] == []
     assert len(doc["inputs"]["t"]) == 201 and doc["inputs"]["crank.angle"][0] == pytest.approx(30)
-    assert max(abs(x) for x in doc["values"]["effort(crank.angle)"]) < 1e-9
-    assert out.read_text().count("\n") >= 201
+    assert max(abs(x) for x in doc["values"]["effort(crank.angle)"]) < 1e-9 * 9810 * 0.0045 * 400
+    text = out.read_text()
+    assert text.count("\n") >= 201 and text.startswith("t [s],crank.angle [deg],crank.omega [deg/s],")
 
 
 def test_scene_errors_name_the_field(tmp_path):

@@ -132,7 +132,9 @@ class Simulation(Result):
         rates = {"t": np.ones(n), **self.rates}
         accs = {"t": np.zeros(n), **self.accelerations}
         q = self.q if self.q is not None else np.full((n, 0), np.nan)
-        return Sweep(ins, rates, accs, self.status.copy(), [None] * n, dict(self.values), q,
+        values = {rate_name(k): v for k, v in self.rates.items()}  # the rates: columns too
+        values.update(self.values)
+        return Sweep(ins, rates, accs, self.status.copy(), [None] * n, values, q,
                      np.zeros(n), np.zeros(n, int), [], 1.0, [], {})
 
 
