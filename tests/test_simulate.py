@@ -241,3 +241,37 @@ def test_steady_state_is_periodic_in_an_independent_time_integration(capsys):
     assert st["w_mean"] == pytest.approx(720 / st["period"], rel=1e-12)
     assert 0 <= st["w_max"] - w.max() < 1e-5 * w.max() and 0 <= w.min() - st["w_min"] < 1e-5 * w.max()
     assert st["fluctuation"] == pytest.approx((st["w_max"] - st["w_min"]) / st["w_mean"], rel=1e-12)
+
+
+def _double_pendulum():
+    return kincas.Mechanism(ground={"O": (0, 0)}, gravity=(0, -G),
+                            links=[kincas.Link.bar("a", "O", "A", 1.0, mass=1.0, inertia=0.1),
+                                   kincas.Link.bar("b", "A", "B", 0.8, mass=0.5, inertia=0.05)],
+                            inputs=[kincas.Input.angle("a"), kincas.Input.angle("b")])
+
+
+def test_two_free_inputs_conserve_energy():
+    """A double pendulum (no loop unknowns at all): both angles free, M a 2 x 2 matrix."""
+    r = simulate(_double_pendulum(), 3.0, 301, initial={"a.angle": 1.0, "b.angle": 2.0}, tolerance=1e-12,
+                 report=["A.vx", "A.vy", "B.vx", "B.vy", "A.y", "B.y", "a.omega", "b.omega"])
+    v = r.values
+    T = (0.5 * 1.0 * ((v["A.vx"] / 2) ** 2 + (v["A.vy"] / 2) ** 2) + 0.5 * 0.1 * v["a.omega"] ** 2
+         + 0.5 * 0.5 * (((v["A.vx"] + v["B.vx"]) / 2) ** 2 + ((v["A.vy"] + v["B.vy"]) / 2) ** 2)
+         + 0.5 * 0.05 * v["b.omega"] ** 2)
+    E = T + G * (1.0 * v["A.y"] / 2 + 0.5 * (v["A.y"] + v["B.y"]) / 2)
+    assert r.ok and np.ptp(E) < 1e-9 * np.ptp(T)
+
+
+def test_a_held_input_drives_a_free_one():
+    """The upper arm turned at a constant rate, the lower one free: kincas's kinetostatics of
+    the simulated motion needs no effort on the free angle (its accelerations from the rates'
+    central differences agree with the simulation's)."""
+    r = simulate(_double_pendulum(), 1.0, 1001, free=["b.angle"], initial={"a.angle": 0.3, "b.angle": -1.0},
+                 rates={"a.angle": 2.0}, tolerance=1e-12)
+    assert r.ok and np.allclose(r.inputs["a.angle"], 0.3 + 2.0 * r.time, rtol=0, atol=1e-12)
+    w, a, h = r.rates["b.angle"], r.accelerations["b.angle"], r.time[1] - r.time[0]
+    assert np.max(np.abs((w[2:] - w[:-2]) / (2 * h) - a[1:-1])) < 1e-4 * np.max(np.abs(a))
+    sw = kincas.sweep(_double_pendulum(), {k: r.inputs[k] for k in ("a.angle", "b.angle")},
+                      rates={k: r.rates[k] for k in ("a.angle", "b.angle")},
+                      accelerations={"a.angle": 0.0, "b.angle": a}, report=["effort(b.angle)"])
+    assert np.max(np.abs(sw["effort(b.angle)"])) < 1e-9 * G * 0.5 * 0.8

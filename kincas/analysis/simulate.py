@@ -260,13 +260,16 @@ class _Setup:
         the first event, located by bisection."""
         n, k, size = len(times), 0, 16
         h = times[1] - times[0]
-        sign = self._events(X[:1], times[:1], par, None)[1]
+        try:
+            sign = self._events(X[:1], times[:1], par, None)[1]
+        except RuntimeError:
+            sign = None
         while k < n - 1:
             size = min(size, n - 1 - k)
             try:
                 xs = self.motion.integrate(X[k], par, times[k], h, size, tol)
                 bad, last = self._events(xs, times[k + 1:k + 1 + size], par, sign)
-            except RuntimeError:
+            except RuntimeError:  # the integrator, or Newton at an output state
                 xs, bad, last = None, (0, "the integration failed"), sign
                 if size > 1:
                     size //= 2
@@ -282,12 +285,10 @@ class _Setup:
 
     def _events(self, xs, ts, par, sign):
         """((index, reason) of the first state of `xs` where the motion must stop, or None;
-        the sign of det g_q at the last state). Passing a limit of a free input (a dead
+        the sign of det g_q at the last state; RuntimeError where Newton finds no q, which the
+        march treats as a failed integration). Passing a limit of a free input (a dead
         centre), q moves to the other assembly: det g_q changes sign, as in a sweep."""
-        try:
-            q, acc, C, J = self.motion.post(xs, ts, par)
-        except RuntimeError:  # Newton did not converge on a state: singular there
-            return (0, self._singular_reason()), sign
+        q, acc, C, J = self.motion.post(xs, ts, par)  # RuntimeError where Newton finds no q
         nq, n = self.model.nq, len(ts)
         bad = np.zeros(n, bool)
         why = np.full(n, "", dtype=object)
@@ -326,7 +327,7 @@ class _Setup:
                 xm = self.motion.integrate(x, par, t_lo, mid - t_lo, 1, tol)[0]
                 bad, s_mid = self._events(xm[None, :], np.array([mid]), par, sign)
             except RuntimeError:
-                bad = (0, reason)
+                bad = (0, reason)  # (the event's own reason, if a state says it, wins below)
             if bad is None:
                 x, t_lo, sign = xm, mid, s_mid
             else:
@@ -364,7 +365,7 @@ class _Setup:
         sim = Simulation(times, {k: U[:, j] for j, k in enumerate(keys)},
                          {k: Ud[:, j] for j, k in enumerate(keys)},
                          {k: Udd[:, j] for j, k in enumerate(keys)}, values, status, events, Q,
-                         {"free": list(mo.free and self.free), "parameters": P})
+                         {"free": list(self.free), "parameters": P})
         for k in values:  # reported angles wrapped, as a sweep reports them
             if k.endswith((".angle", ".phi")) and not k.startswith("d("):
                 from ..results import wrap_angle
