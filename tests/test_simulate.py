@@ -275,3 +275,14 @@ def test_a_held_input_drives_a_free_one():
                       rates={k: r.rates[k] for k in ("a.angle", "b.angle")},
                       accelerations={"a.angle": 0.0, "b.angle": a}, report=["effort(b.angle)"])
     assert np.max(np.abs(sw["effort(b.angle)"])) < 1e-9 * G * 0.5 * 0.8
+
+
+def test_a_loads_expression_is_refused_where_it_was_written(tmp_path, capsys):
+    text = open("examples/simulate_engine.toml").read()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace('torque = "-Tm * crank.omega / w0"', 'torque = "-Tm * crank.alpha"'))
+    assert main(["simulate", str(bad)]) == 2
+    assert "[[loads]] 2: torque: 'crank.alpha': a load may depend on positions and velocities" in capsys.readouterr().err
+    bad.write_text(text.replace('torque = "-Tm * crank.omega / w0"', 'torque = "-Tx * crank.omega"'))
+    assert main(["simulate", str(bad)]) == 2
+    assert "[[loads]] 2: torque: unknown name 'Tx' (parameters: ['r', 'l', 'Tm', 'w0']" in capsys.readouterr().err

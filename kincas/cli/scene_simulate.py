@@ -64,6 +64,7 @@ def read(reader, doc: dict, mechanism_links, inputs) -> dict:
     from ..core.motion_loads import LoadExpression, data_lists
     from ..errors import ModelError
     out = {"free": list(reader.free), "expressions": {k: t for k, (t, _) in reader.expressions.items()},
+           "where": {k: w for k, (_, w) in reader.expressions.items()},
            "data": {}, "duration": None, "steps": None, "flywheel": None, "tolerance": None}
     try:
         out["data"] = data_lists(doc.get("data", {}))
@@ -122,9 +123,11 @@ def arguments_of(sc) -> dict:
     if sim.get("duration") is None:
         raise SceneError("[simulate]: missing (duration = T, steps = N)")
     st = sc.study
+    from ..core.motion_loads import LoadExpression  # each named where the scene wrote it
+    expressions = {k: LoadExpression(t, sim["where"][k], sim["data"]) for k, t in sim["expressions"].items()}
     kw = dict(free=sim["free"], initial={k: float(v[0]) for k, v in st.inputs.items()},
               rates=dict(st.rates), accelerations=dict(st.accelerations),
-              expressions=sim["expressions"], data=sim["data"], flywheel=sim["flywheel"],
+              expressions=expressions, data=sim["data"], flywheel=sim["flywheel"],
               angle=math.pi / 180 if st.deg else 1.0)
     if sim.get("tolerance"):
         kw["tolerance"] = sim["tolerance"]

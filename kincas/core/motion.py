@@ -115,7 +115,7 @@ class Motion:
                 return v / k if is_angular(name, sym.mech) else v
             if name in hidden or name not in sym.pnames:
                 raise ModelError(f"{where}: unknown name {name!r} (parameters: "
-                                 f"{[n for n in sym.pnames if n not in hidden]}, quantities, t, pi)")
+                                 f"{[n for n in sym.pnames if n not in hidden and not n.startswith('_')]}, quantities, t, pi)")
             return u[driven[name]] if name in driven else p[sym.pnames.index(name)]
 
         out = ca.SX(p)
