@@ -26,7 +26,7 @@ import numpy as np
 from ..core.motion import Motion
 from ..core.motion_loads import LoadExpression
 from ..core.numeric import model_of
-from ..core.tolerances import EVENT_TIME, SIM_ATOL, SIM_MAX_STEPS, SIM_RTOL, SIM_SINGULAR
+from ..core.tolerances import EVENT_TIME, SIM_ATOL, SIM_CLASSIFY, SIM_MAX_STEPS, SIM_RTOL, SIM_SINGULAR
 from ..errors import ModelError
 from ..model.mechanism import Link, Mechanism
 from ..result_base import Result
@@ -288,7 +288,7 @@ class _Setup:
         the sign of det g_q at the last state; RuntimeError where Newton finds no q, which the
         march treats as a failed integration). Passing a limit of a free input (a dead
         centre), q moves to the other assembly: det g_q changes sign, as in a sweep."""
-        q, acc, C, J = self.motion.post(xs, ts, par)  # RuntimeError where Newton finds no q
+        q, acc, C, J, _ = self.motion.post(xs, ts, par)  # RuntimeError where Newton finds no q
         nq, n = self.model.nq, len(ts)
         bad = np.zeros(n, bool)
         why = np.full(n, "", dtype=object)
@@ -318,6 +318,28 @@ class _Setup:
         free = ", ".join(self.free)
         return f"a singular position or a limit of {free} (g_q singular)"
 
+    def _kind(self, x, t, par) -> str:
+        """At the last state before a singular position: a limit of the free inputs when
+        (g_q | g_u) keeps its rank there (the inputs cannot go further: a dead centre), a
+        singular position (a change point) when it loses rank with g_q."""
+        try:
+            _, _, _, J, Ju = self.motion.post(x[None, :], np.array([t]), par)
+        except RuntimeError:
+            return self._singular_reason()
+        nq, free, L = self.model.nq, ", ".join(self.free), self.m.size()
+        if not nq:
+            return self._singular_reason()
+        Jq = J[:, 0].reshape(-1, nq, order="F")
+        # columns O(1) at any size: an angle's column is a length (over L), a length's a ratio
+        col = [1 / L if k.endswith(".angle") else 1.0 for k in self.free]
+        A = np.hstack([Jq * self.model.column_scale(L), Ju[:, 0].reshape(Jq.shape[0], -1, order="F") * col])
+        # near a limit g_q's smallest singular value goes like the square root of the distance
+        # and (g_q | g_u)'s stays finite; near a change point both go like the distance
+        sq, sa = (np.linalg.svd(B, compute_uv=False) for B in (A[:, :nq], A))
+        if sa[min(A.shape) - 1] > SIM_CLASSIFY * sq[-1]:
+            return f"a limit of {free} (g_q singular: it can go no further this way)"
+        return f"a singular position (g_q and (g_q | g_u) singular: a change point of {free})"
+
     def _locate(self, x, t_lo, t_hi, par, tol, reason, sign):
         """The event's time, by bisection between a good state at t_lo and a bad one at t_hi."""
         span = t_hi - t_lo
@@ -332,6 +354,8 @@ class _Setup:
                 x, t_lo, sign = xm, mid, s_mid
             else:
                 t_hi, reason = mid, bad[1] if reason == "the integration failed" else reason
+        if reason == self._singular_reason():
+            reason = self._kind(x, t_lo, par)
         return {"time": float(t_lo), "reason": reason, "kind": "stop"}
 
     # --- the outputs ---
@@ -349,7 +373,7 @@ class _Setup:
         idx = np.flatnonzero(ok)
         P = np.tile(par[:len(m.parameters)][:, None], n)
         if idx.size:
-            q, acc, _, _ = mo.post(X[idx], times[idx], par)
+            q, acc, _, _, _ = mo.post(X[idx], times[idx], par)
             Q[idx] = q.T
             Udd[np.ix_(idx, mo.free)] = acc.T
             P[:, idx] = mo.parameters(q, U[idx].T, Ud[idx].T, times[idx], P[:, idx])

@@ -136,7 +136,7 @@ class Motion:
     def rhs(self):
         """The ODE x' = f(x, t; par) for CasADi's integrators, x = (q~, u_f, u_f'), par =
         (p, c0, c1, c2) with the held inputs u_h = c0 + c1 t + c2 t^2 / 2: an MX dict
-        {"x", "t", "p", "ode"} and, under "post", (q, u_f'', contact forces, vec(g_q)) there."""
+        {"x", "t", "p", "ode"} and, under "post", (q, u_f'', contact forces, vec(g_q), vec(g_u_f))."""
         if self._rhs is None:
             sym, nq, nf, nh = self.sym, self.sym.nq, len(self.free), len(self.held)
             x, t = ca.MX.sym("x", nq + 2 * nf), ca.MX.sym("t")
@@ -149,8 +149,8 @@ class Motion:
                 u[self.held], ud[self.held] = c0 + c1 * t + c2 * t ** 2 / 2, c1 + c2 * t
             qs = self.rootfinder()(x[:nq], ca.vertcat(u, p))
             acc, C = self.f_acc(qs, u, ud, t, p, c2)
-            J = ca.Function("jq", [sym.q, sym.u, sym.p], [ca.densify(sym.Jq)])(qs, u, p)
-            post = ca.Function("post", [x, t, par], [qs, acc, C, ca.vec(J)])
+            J, Ju = ca.Function("jq", [sym.q, sym.u, sym.p], [ca.densify(sym.Jq), ca.densify(sym.Ju[:, self.free])])(qs, u, p)
+            post = ca.Function("post", [x, t, par], [qs, acc, C, ca.vec(J), ca.vec(Ju)])
             if self.exact:  # q solved at every evaluation of the ODE
                 ode = ca.vertcat(self.f_qdot(qs, u, p, ud), x[nq + nf:], acc)
                 self._rhs = {"x": x, "t": t, "p": par, "ode": ode, "post": post}
@@ -187,7 +187,7 @@ class Motion:
         return np.asarray(out["xf"]).T
 
     def post(self, xs, ts, par):
-        """(q, u_f'', contact forces, vec(g_q)) at states xs (one row each) at times ts, as
+        """(q, u_f'', contact forces, vec(g_q), vec(g_u) of the free inputs) at states xs (one row each) at times ts, as
         numpy columns; RuntimeError where Newton finds no q."""
         n = len(ts)
         out = self.rhs()["post"].map(n)(np.asarray(xs).T, np.asarray(ts, float), np.tile(np.reshape(par, (-1, 1)), n))

@@ -81,3 +81,4 @@ SIM_ATOL = 1e-12  # its absolute tolerance, times the state's scale (the size, o
 SIM_SINGULAR = 1e-4  # smallest scaled singular value of g_q (over the largest) at which the motion stops: a limit (delta u ~ 1e-8 of the size) ahead
 EVENT_TIME = 1e-12  # events are located to this times the duration
 SIM_MAX_STEPS = 5000  # integrator steps per output interval at most: more means a singular position ahead
+SIM_CLASSIFY = 30.0  # where the motion stopped, (g_q | g_u)'s smallest scaled singular value over g_q's above this: a limit
