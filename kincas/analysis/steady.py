@@ -26,6 +26,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..core.motion import CycleODE
+from ..core.tolerances import CYCLE_MATCH
 from .simulate import _Setup
 
 SAMPLES = 720  # samples of a cycle where the extremes of the speed are first looked for
@@ -63,7 +64,7 @@ def cycle_of(setup: _Setup, key: str) -> float:
         periods += [c * setup.angle for x, c in e.periods if x in (f"{obj}.angle", key)]
     turn = 2 * math.pi
     for k in range(1, 25):
-        if all(abs(k * turn / c - round(k * turn / c)) < 1e-9 for c in periods):
+        if all(abs(k * turn / c - round(k * turn / c)) < CYCLE_MATCH for c in periods):
             return k * turn
     raise ModelError(f"--steady: no common cycle of one turn and the loads' periods "
                      f"{[math.degrees(c) for c in periods]} deg")

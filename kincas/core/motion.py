@@ -248,7 +248,9 @@ class CycleODE:
     def run(self, y0, par, n: int, tol: float, upto: float = 1.0) -> np.ndarray:
         """y at tau = upto k / n, k = 1..n, from y0 at tau = 0 (one row each)."""
         if (n, tol) not in self._int:
-            self._int[(n, tol)] = _cvodes(self.dae, [k / n for k in range(1, n + 1)], tol, tol * 1e-2, 20000)
+            from .tolerances import SIM_ATOL, SIM_MAX_STEPS, SIM_RTOL
+            self._int[(n, tol)] = _cvodes(self.dae, [k / n for k in range(1, n + 1)], tol,
+                                          SIM_ATOL / SIM_RTOL * tol, 4 * SIM_MAX_STEPS)
         pp = np.array(par, float)
         pp[-1] *= upto  # a part of the cycle: theta = theta0 + (upto Theta) tau
         return np.asarray(self._int[(n, tol)](x0=y0, p=pp)["xf"]).T

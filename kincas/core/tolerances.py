@@ -82,3 +82,4 @@ SIM_SINGULAR = 1e-4  # smallest scaled singular value of g_q (over the largest) 
 EVENT_TIME = 1e-12  # events are located to this times the duration
 SIM_MAX_STEPS = 5000  # integrator steps per output interval at most: more means a singular position ahead
 SIM_CLASSIFY = 30.0  # where the motion stopped, (g_q | g_u)'s smallest scaled singular value over g_q's above this: a limit
+CYCLE_MATCH = 1e-9  # k turns over a load's period c is a whole number when it misses one by less than this
