@@ -50,6 +50,6 @@ __all__ = ["Mechanism", "Link", "Slide", "Input", "Param", "Load", "solve", "swe
            "SpatialMechanism", "Body", "Joint", "SpatialSlide",
            "SweepMethod", "Fast", "Careful",
            "sweep_designs", "study", "model_of",
-           "sensitivities", "analyse", "optimize", "modes", "find_modes", "input_range",
+           "sensitivities", "analyse", "optimize", "modes", "find_modes", "input_range", "simulate",
            "Pose", "Sweep", "KincasError", "ModelError", "SceneError", "widget"]
 __version__ = "0.1.0"

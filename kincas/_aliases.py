@@ -73,7 +73,7 @@ def install() -> None:
 FUNCTIONS = {"sensitivities": "analysis.sensitivity", "analyse": "analysis.tolerance",
              "find_modes": "analysis.modes", "input_range": "analysis.singular",
              "sweep_designs": "analysis.designs", "study": "synthesis.study",
-             "widget": "views.live.widget"}
+             "widget": "views.live.widget", "simulate": "analysis.simulate"}
 
 
 def attribute(name: str):

@@ -67,7 +67,7 @@ TYPES = {"Result": "result_base", "Pose": "results", "Sweep": "results",
          "DesignSweep": "analysis.designs", "Study": "synthesis.study",
          "Sensitivities": "analysis.sensitivity", "ToleranceAnalysis": "analysis.tolerance",
          "Optimization": "synthesis.optimize", "Multistart": "synthesis.multistart",
-         "Modes": "frames", "Range": "analysis.singular"}
+         "Modes": "frames", "Range": "analysis.singular", "Simulation": "analysis.simulate"}
 # their names in kincas 0.1, served one more release with a DeprecationWarning
 RENAMED = {"StudyResult": "Study", "ToleranceResult": "ToleranceAnalysis",
            "OptimizeResult": "Optimization", "MultistartResult": "Multistart"}

@@ -81,6 +81,8 @@ def unit_label(units: dict, mech, name: str, extra=None) -> str:
     if kind == "sens":  # Q's unit per the parameter's: mm/mm, deg/mm
         uq, up = unit_label(units, mech, obj, extra), param_unit(units, mech, attr)
         return f"{uq or '1'}/{up}" if up else (f"{uq} per {attr}" if uq else "")
+    if name == "t" and (mech is None or name not in mech.param_values):  # a simulation's time
+        return T
     if mech is not None and name in mech.param_values:  # a driven parameter: a length, or an angle
         return param_unit(units, mech, name)
     other = extra(name, L) if extra is not None else None

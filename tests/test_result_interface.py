@@ -46,6 +46,11 @@ EXAMPLES = {
     # certified where msolve is installed (kincas[certify]), else the multistart
     "modes": lambda: kincas.modes(four_bar(), {"crank.angle": 0.5}, certify=_certify_available()),
     "input_range": lambda: kincas.input_range(four_bar(), {"crank.angle": 0.5}),
+    # a wheel of inertia 1 under a torque of 2: its angle is t^2
+    "simulate": lambda: kincas.simulate(kincas.Mechanism(
+        parameters={"a": 2.0, "T": 2.0}, ground={"O": (0, 0)}, loads=[kincas.Load.torque("crank", "T")],
+        links=[kincas.Link.bar("crank", "O", "A", "a", inertia=1.0)], inputs=[kincas.Input.angle("crank")]),
+        1.0, 3, report=["A.x", "A.y"]),
 }
 
 
@@ -121,6 +126,12 @@ def test_result_round_trips(name):
     if name == "find_modes":  # a four-bar's link angles, in degrees on request
         assert np.allclose(r.to_pandas(angle="deg")["rocker.angle"], np.degrees(df["rocker.angle"]), rtol=1e-15)
         assert len(df) == 2 and ds.sizes["mode"] == 2 and r[0] is list(r)[0]  # still a list
+    if name == "simulate":  # along the dimension `time`: A = a (cos t^2, sin t^2)
+        ts = np.array([0.0, 0.5, 1.0])
+        assert np.allclose(df["A.x"].to_numpy(), 2 * np.cos(ts ** 2), rtol=0, atol=1e-9)
+        assert np.allclose(ds["A.y"].values, 2 * np.sin(ts ** 2), rtol=0, atol=1e-9)
+        assert ds["A.x"].dims == ("time",) and df.index.name == "time"
+        assert np.allclose(r.to_pandas(angle="deg")["crank.omega"], np.degrees(2 * ts), rtol=1e-9)
     if name == "input_range":
         assert r.full_turn and len(df) == 0 and ds.attrs["full_turn"] == 1
 

@@ -32,6 +32,8 @@ COMMANDS = {
     "tolerance": ("kincas.cli.tolerance", "spread of the outputs from parameter tolerances"),
     "study": ("kincas.cli.study", "many designs at once, one row each, as [study] says"),
     "cam": ("kincas.cli.cam", "design a disc cam as [cam_design] says"),
+    "simulate": ("kincas.cli.simulate", "motion of the free inputs under the loads ([simulate]); --steady"),
+    "flywheel": ("kincas.cli.flywheel", "smallest flywheel keeping the speed fluctuation below --fluctuation"),
     "app": ("kincas.cli.serve", "the mechanism in a live page on this machine (kincas[app])"),
 }
 SOLVE_HELP = "positions, speeds, forces over the scene's inputs"
@@ -46,6 +48,9 @@ EXAMPLES = {
     "optimize": ["kincas optimize examples/forces_vtwin.toml"],
     "tolerance": ["kincas tolerance examples/fairbairn.toml"],
     "study": ["kincas study examples/study_fourbar.toml --csv designs.csv"],
+    "simulate": ["kincas simulate examples/simulate_pendulum_fourbar.toml",
+                 "kincas simulate examples/simulate_press.toml --steady"],
+    "flywheel": ["kincas flywheel examples/simulate_engine.toml --fluctuation 0.02"],
     "app": ["kincas app examples/fourbar_coupler.toml --port 8765"],
     "cam": ["kincas cam my_cam.toml --out profile.toml   (a scene with [cam_design]: docs/scene-format.md)"],
 }

@@ -40,7 +40,7 @@ from .scene_study import StudyReader
 LARGEST = 1e100  # beyond it, squared lengths overflow double precision
 SECTIONS = {"title", "space", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
             "output", "optimize", "tolerance", "gravity", "loads", "study", "gears", "racks",
-            "cams", "cam_design"}
+            "cams", "cam_design", "simulate", "data"}
 
 
 @dataclass
@@ -59,6 +59,8 @@ class Study:
     raw: dict = field(default_factory=dict, repr=False)  # the parsed TOML, for extensions
     # parameter -> (lo, hi), from `{ value = v, range = [lo, hi] }` in [parameters]
     ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
+    # free inputs, loads' expressions, [data], [simulate] (kincas/cli/scene_simulate.py)
+    simulation: dict = field(default_factory=dict)
 
     @property
     def deg(self) -> bool:
@@ -80,6 +82,7 @@ class Scene:
         `user_values(sweep)` give the numbers in the scene's units, as `kincas solve` prints."""
         from ..analysis.sweeps import sweep  # casadi stays out of scene parsing
         st = self.study
+        self.refuse_expressions("kincas solve")
         if any(st.jerks.values()):
             kw.setdefault("jerks", st.jerks)
         sw = sweep(self.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
@@ -95,6 +98,14 @@ class Scene:
         deg = [k for k in sw.inputs if k.endswith(".angle")] + [k for k in sw.values if is_angular(k, self.mechanism)]
         return {"units": dict(self.study.units), "degrees": deg if self.study.deg else [],
                 "labels": {k: quantity_unit(self, k) for k in [*sw.inputs, *sw.values]}}
+
+    def refuse_expressions(self, what: str) -> None:
+        """Loads written as expressions of the state are only evaluated along a motion."""
+        exprs = self.study.simulation.get("expressions")
+        if exprs:
+            raise SceneError(f"[[loads]]: {len(exprs)} load component(s) are expressions of the "
+                             f"state and time ({next(iter(exprs.values()))!r}): {what} takes numbers "
+                             f"or parameters; `kincas simulate` evaluates expressions")
 
     def refuse_jerks(self, texts, where: str) -> None:
         """Only `kincas solve` passes the inputs' `jerk` on; elsewhere they would be taken as 0,
@@ -203,6 +214,8 @@ class _Reader(StudyReader):
         self.jerks: dict[str, float] = {}
         self.bad_params = set()  # reported once, where declared; not again where used
         self.ranges: dict[str, tuple[float, float]] = {}  # [parameters] ranges, for sliders
+        self.free: list[str] = []  # inputs moved by the forces
+        self.expressions: dict[str, tuple[str, str]] = {}  # hidden parameter -> (text, where)
 
     def err(self, msg: str):
         self.problems.append(msg)
@@ -278,6 +291,8 @@ class _Reader(StudyReader):
         inputs, values, rates, accs, written = self.inputs()
         from . import scene_loads
         grav, loads = scene_loads.gravity(self, doc), scene_loads.read_loads(self)
+        from . import scene_simulate
+        simulation = scene_simulate.read(self, doc, {lk.name for lk in links if lk}, inputs)
         guess = {k: self.xy(f"[guess] {k}", v) for k, v in self.table("guess").items()}
         report, sens = self.output()
         if not self.doc.get("links"):
@@ -298,7 +313,7 @@ class _Reader(StudyReader):
         study = Study(title=title if isinstance(title, str) else "", units=self.units,
                       inputs=values, rates=rates, accelerations=accs, report=report,
                       sensitivity=sens, written=written, raw=doc, jerks=self.jerks,
-                      ranges=self.ranges)
+                      ranges=self.ranges, simulation=simulation)
         return Scene(m, study)
 
     def ranged(self, name: str, v):

@@ -32,6 +32,7 @@ converted to radians. Problems are reported through the reader, naming section a
 from __future__ import annotations
 
 from ..model.loads import Load
+from .scene_simulate import component  # a component may be an expression of the state
 
 LINK_FIELDS = {"mass", "inertia", "cg"}
 _KINDS = {"point": ("force",), "link": ("torque",), "spring": ("stiffness", "free_length")}
@@ -73,12 +74,17 @@ def read_loads(reader) -> list[Load]:
             if not isinstance(t["point"], str):
                 reader.err(f"{where}: point: expected a point's name")
                 continue
-            out.append(Load.force(t["point"], reader.xy(f"{where}: force", t["force"])))
+            f = t["force"]
+            if not isinstance(f, list) or len(f) != 2:
+                reader.err(f"{where}: force: expected [x, y], got {f!r}")
+                continue
+            out.append(Load.force(t["point"], (component(reader, where, i + 1, "force_x", f[0]),
+                                               component(reader, where, i + 1, "force_y", f[1]))))
         elif kind == "link":
             if not isinstance(t["link"], str):
                 reader.err(f"{where}: link: expected a link's name")
                 continue
-            out.append(Load.torque(t["link"], reader.num(f"{where}: torque", t["torque"])))
+            out.append(Load.torque(t["link"], component(reader, where, i + 1, "torque", t["torque"])))
         else:
             pts = t["spring"]
             if not (isinstance(pts, list) and len(pts) == 2 and all(isinstance(p, str) for p in pts)):

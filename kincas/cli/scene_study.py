@@ -49,7 +49,7 @@ class StudyReader:
         kinds_allowed = self.INPUT_KINDS
         for i, t in enumerate(self.array("inputs")):
             where = f"[[inputs]] {i + 1}"
-            self.fields(where, t, {*kinds_allowed, "value", "sweep", "rate", "acceleration", "jerk"})
+            self.fields(where, t, {*kinds_allowed, "value", "sweep", "rate", "acceleration", "jerk", "free"})
             kinds = [k for k in kinds_allowed if k in t]
             if len(kinds) != 1:
                 self.err(f"{where}: give exactly one of {', '.join(kinds_allowed[:-1])} or {kinds_allowed[-1]}")
@@ -85,6 +85,10 @@ class StudyReader:
                 b = self.value(f"{where}: sweep.to", sw["to"])
                 vals = np.linspace(a, b, n)
                 steps.add(n)
+            if t.get("free", False) not in (True, False):
+                self.err(f"{where}: free: expected true or false, got {t['free']!r}")
+            elif t.get("free", False):
+                self.free.append(inp.key)  # moved by the forces (kincas simulate)
             inputs.append(inp)
             written[inp.key] = vals
             values[inp.key] = vals * k

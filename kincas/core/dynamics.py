@@ -51,6 +51,7 @@ from ..model.mechanism import GROUND
 _EFFORT = re.compile(r"^effort\((?P<key>[^()]+)\)$")
 _REACTION = re.compile(r"^reaction\(\s*(?P<a>[^,()]+?)\s*(?:,\s*(?P<b>[^,()]+?)\s*)?\)\.(?P<attr>x|y)$")
 _SHAKING = {"shaking.x": 0, "shaking.y": 1, "shaking.moment": 2}
+_CONTACT = re.compile(r"^contact\((?P<cam>[^()]+)\)$")
 
 
 # --- names ---
@@ -69,6 +70,13 @@ def check(sym, name: str):
         return [] if m["key"] in sym.ukeys else [f"no input {m['key']!r} (inputs: {sym.ukeys})"]
     if name in _SHAKING:
         return []
+    m = _CONTACT.match(name)
+    if m:
+        cams = {c.name: c for c in sym.mech.cams}
+        if m["cam"] not in cams:
+            return [f"no cam named {m['cam']!r} (cams: {sorted(cams)})"]
+        return [] if cams[m["cam"]].follower[0] in ("knife", "roller") else [
+            "contact(CAM) is given for knife-edge and roller followers"]
     m = _REACTION.match(name)
     if not m:
         return None
@@ -149,19 +157,53 @@ def expression(sym, name: str, t):
         return t.cache["efforts"][sym.ukeys.index(m["key"])]
     if name in _SHAKING:
         return _shaking(sym, t)[_SHAKING[name]]
+    m = _CONTACT.match(name)
+    if m:
+        return _contact(sym, t, m["cam"])
     m = _REACTION.match(name)
     return _reaction(sym, t, m["a"], m["b"], m["attr"])
 
 
 def _efforts(sym, t):
     """Q (one per input) by virtual work, with dr/du = r_z (T; I)."""
-    Z = ca.vertcat(-sym.lsolve(sym.Ju), ca.SX.eye(sym.nu))
+    Q = generalised(sym, t, ca.vertcat(-sym.lsolve(sym.Ju), ca.SX.eye(sym.nu)))
+    return [Q[k] for k in range(sym.nu)]
 
-    def du(e):  # d e / d u along the constraints: a row of nu entries
+
+def _contact(sym, t, cam):
+    """The normal force of a cam on its (knife-edge or roller) follower, positive when it
+    pushes: the generalised force of the virtual motion that parts them. The cam's rows of g
+    read F - (P + rho N) = 0; relaxed to eps N (inputs held), the follower leaves the profile
+    by eps along the outward normal N, dz = (g_q^-1 e, 0) with e = N on those rows, and the
+    contact force f does the work f eps. So f is the effort that motion needs."""
+    rows = _cam_rows(sym)[cam]
+    nx, ny = sym.cams[cam]["normal"]
+    e = ca.SX.zeros(sym.ng)
+    e[rows[0]], e[rows[1]] = nx, ny
+    return generalised(sym, t, ca.vertcat(sym.lsolve(e), ca.SX.zeros(sym.nu)))[0]
+
+
+def _cam_rows(sym):
+    """The two rows of g of each knife-edge or roller cam (they follow the slides' rows and
+    the relative inputs', gears' and racks' equations, in declaration order)."""
+    m = sym.mech
+    n = sym.ng - sum(i.kind == "slide" for i in m.inputs) - 2 * len(m.cams)
+    out = {}
+    for c in m.cams:
+        out[c.name] = (n, n + 1)
+        n += 2
+    return out
+
+
+def generalised(sym, t, Z):
+    """Q = the generalised forces (a row, one per column of Z) the motion needs along the
+    virtual motions dz = Z dv of z = (q, u): by virtual work with d'Alembert's inertia forces,
+    gravity, the loads and the springs; an input's effort is Q along dz = (T; I) du."""
+    def du(e):  # d e / d v along the directions: a row of Z's columns
         return ca.mtimes(ca.jacobian(e, t.z), Z)
 
     gx, gy = _gravity(sym)
-    Q = ca.SX.zeros(1, sym.nu)
+    Q = ca.SX.zeros(1, Z.size2())
     for _, m, J, (x, y), th, _ in _masses(sym):
         Q += m * (t.d(x, 2) - gx) * du(x) + m * (t.d(y, 2) - gy) * du(y) + J * t.d(th, 2) * du(th)
     for lk in sym.mech.loads:
@@ -174,7 +216,7 @@ def _efforts(sym, t):
         else:
             (x, y), (fx, fy) = sym.points[lk.at], (sym.val(lk.value[0]), sym.val(lk.value[1]))
             Q -= fx * du(x) + fy * du(y)
-    return [Q[k] for k in range(sym.nu)]
+    return Q
 
 
 def _shaking(sym, t):

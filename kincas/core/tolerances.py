@@ -101,3 +101,14 @@ CERTIFY_SLACK = 1e-12  # a refined float point lies in its box when within this 
 CERTIFY_TIMEOUT = 120.0  # seconds msolve may take before the certificate is given up
 CERTIFY_SPLIT = 1e-2  # roots a multiple root splits into are counted within this (scaled) distance of it, at most
 CERTIFY_NUDGE = 1e-7  # input change (rad, or times the size) that splits coinciding assemblies to count them
+
+# --- forward dynamics (kincas/core/motion.py, kincas/analysis/simulate.py) ---
+ROOT_ABSTOL = 1e-12  # CasADi's Newton for q(u) inside the equations of motion: residual over the size
+ROOT_STEPTOL = 1e-13  # ... or a step (radians, lengths) below this
+SIM_RTOL = 1e-10  # the integrator's relative tolerance unless [simulate] tolerance says
+SIM_ATOL = 1e-12  # its absolute tolerance, times the state's scale (the size, or 1 rad)
+SIM_SINGULAR = 1e-4  # smallest scaled singular value of g_q (over the largest) at which the motion stops: a limit (delta u ~ 1e-8 of the size) ahead
+EVENT_TIME = 1e-12  # events are located to this times the duration
+SIM_MAX_STEPS = 5000  # integrator steps per output interval at most: more means a singular position ahead
+SIM_CLASSIFY = 30.0  # where the motion stopped, (g_q | g_u)'s smallest scaled singular value over g_q's above this: a limit
+CYCLE_MATCH = 1e-9  # k turns over a load's period c is a whole number when it misses one by less than this

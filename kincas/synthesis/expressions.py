@@ -36,10 +36,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.expressions_sym import CONST, SAMPLE, TOTAL  # noqa: F401  (the kinds, shared)
+from ..core.expressions_sym import BINARY, UNARY, quantity_name  # noqa: F401  (shared with the loads' expressions)
 from ..errors import ModelError
 
-UNARY = {"sin", "cos", "tan", "asin", "acos", "atan", "sqrt", "exp", "log", "abs"}
-BINARY = {"atan2", "hypot"}
 AGGREGATE = {"sum", "mean", "max", "min"}
 FORCES = {"effort", "reaction"}  # quantity names written as calls (kincas/core/dynamics.py)
 
@@ -134,24 +133,6 @@ def _walk(node, out: Expr, data: set, inside: bool):
     else:
         raise ModelError(f"{where}: {ast.unparse(node)!r} is not allowed in an expression "
                          f"(numbers, names, + - * / ^ and functions only)")
-
-
-def quantity_name(node) -> str | None:
-    """'P.x' for the tree of `P.x`, 'effort(crank.angle)' for `effort(crank.angle)`,
-    'reaction(B, rod).x' for `reaction(B, rod).x`; None for anything else."""
-    if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
-        return f"{node.value.id}.{node.attr}"
-    call = node.value if isinstance(node, ast.Attribute) else node
-    if not (isinstance(call, ast.Call) and isinstance(call.func, ast.Name) and not call.keywords):
-        return None
-    f, args = call.func.id, call.args
-    if f == "effort" and isinstance(node, ast.Call) and len(args) == 1:
-        inner = args[0].id if isinstance(args[0], ast.Name) else quantity_name(args[0])
-        return None if inner is None else f"effort({inner})"
-    if f == "reaction" and isinstance(node, ast.Attribute) and 1 <= len(args) <= 2 \
-            and all(isinstance(a, ast.Name) for a in args):
-        return f"reaction({', '.join(a.id for a in args)}).{node.attr}"
-    return None
 
 
 # --- evaluation ---

@@ -31,7 +31,7 @@ def _force_unit(name: str, L: str, force: str = "force") -> str | None:
     if m:
         angular = m["key"].endswith(".angle")
         return f"{force}·{L}" if angular and L else force
-    if name.startswith("reaction(") or name in ("shaking.x", "shaking.y"):
+    if name.startswith(("reaction(", "contact(")) or name in ("shaking.x", "shaking.y"):
         return force
     if name == "shaking.moment":
         return f"{force}·{L}" if L else force

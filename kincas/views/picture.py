@@ -175,7 +175,8 @@ def dense_paths(m: Mechanism, sweep: Sweep, points: list[str], per_step: int) ->
     if n < 2 or not points:
         return {p: geometry(m, sweep).point(p) for p in points}
     t = np.linspace(0.0, n - 1.0, (n - 1) * (per_step + 1) + 1)
-    fine = {k: np.interp(t, np.arange(n), np.asarray(v, float)) for k, v in sweep.inputs.items()}
+    keys = {i.key for i in m.inputs}  # (a simulation's sweep also has the time `t`)
+    fine = {k: np.interp(t, np.arange(n), np.asarray(v, float)) for k, v in sweep.inputs.items() if k in keys}
     i0 = int(np.flatnonzero(sweep.ok)[0]) if sweep.ok.any() else 0
     geo0 = geometry(m, sweep)
     guess = {p: tuple(geo0.point(p)[i0]) for p in m.moving_points} if sweep.ok.any() else None
