@@ -1,4 +1,5 @@
-"""kincas: kinematics of planar closed-chain mechanisms, solved as a whole with CasADi.
+"""kincas: kinematics and motion of closed-chain mechanisms, planar and spatial, solved as a
+whole with CasADi.
 
 Declare a mechanism (ground points, links, slides, inputs), then solve poses or sweeps:
 positions by Newton with the exact Jacobian, velocities and accelerations from the same
