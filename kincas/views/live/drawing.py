@@ -57,13 +57,6 @@ def drawing(m: Mechanism, sw: Sweep, handles: dict) -> dict:
     """Names, points per pose, bodies, guides, joint curves, loads; `draggable` lists the ground
     points (they move the ground) and the moving points (they move the input)."""
     n = len(sw)
-    if not sw.ok.any():  # nothing to draw (the page keeps showing the last solved sweep)
-        from ..poses import geometry
-        names = list(geometry(m, sw).names)
-        return {"names": names, "xy": [[None] * len(names)] * n, "r": 0.0, "box": [[0, 0], [1, 1]],
-                "ground": [names.index(g) for g in m.ground_points],
-                "moving": [names.index(p) for p in m.moving_points if p in names],
-                "bodies": [], "guides": [], "joints": None, "loads": [], "forces": [], "centres": {}}
     pic = picture(m, sw, paths=[])
     joints = None
     if m.gears or m.racks or m.cams:  # coarse curves per pose (the page stays small)
