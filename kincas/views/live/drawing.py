@@ -57,7 +57,9 @@ def drawing(m: Mechanism, sw: Sweep, handles: dict) -> dict:
     """Names, points per pose, bodies, guides, joint curves, loads; `draggable` lists the ground
     points (they move the ground) and the moving points (they move the input)."""
     n = len(sw)
-    pic = picture(m, sw, paths=[])
+    from ..poses import is_spatial
+    space = is_spatial(m)  # a spatial mechanism's points stay in space: the page turns them
+    pic = picture(m, sw, paths=[], world=space)
     joints = None
     if m.gears or m.racks or m.cams:  # coarse curves per pose (the page stays small)
         colours = {b.name: b.colour for b in pic.bodies}
@@ -71,9 +73,17 @@ def drawing(m: Mechanism, sw: Sweep, handles: dict) -> dict:
         "guides": [{"name": g.name, "point": g.point, "ground": g.ground, "colour": g.colour,
                     "lo": g.lo, "hi": g.hi, "through": _list(g.through), "direction": _list(g.direction)}
                    for g in pic.guides],
-        "joints": joints, "loads": _loads(m, pic), "forces": forces(m, sw, pic.names),
-        "centres": instant_centres(m, sw, pic.names, pic.xy),
+        "joints": None if space else joints, "space": space, **(_camera() if space else {}),
+        "loads": [] if space else _loads(m, pic), "forces": [] if space else forces(m, sw, pic.names),
+        "centres": {} if space else instant_centres(m, sw, pic.names, pic.xy),
     }
+
+
+def _camera() -> dict:
+    """The camera a spatial mechanism opens in (isometric, turning about z; views/html3d.py)."""
+    from ..html3d import camera
+    c = camera("iso")
+    return {"camera": c["camera"], "up": c["up"]}
 
 
 def forces(m: Mechanism, sw: Sweep, names: list[str]) -> list[dict]:
