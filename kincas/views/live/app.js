@@ -280,7 +280,7 @@ function kincasApp(root, transport) {
         ctx.lineCap = "round"; line(pts, b.colour, 7); ctx.lineCap = "butt";
       }
     }
-    if ($(".k-forces").checked) { drawLoads(D, xy); drawForces(D, xy, i); }
+    if ($(".k-forces").checked) { drawLoads(D, xy, i); drawForces(D, xy, i); }
     if ($(".k-centres").checked) drawCentres(st, i);
     for (let k = 0; k < D.names.length; k++) {  // joints and points, with their names
       const p = xy[k]; if (!fin(p)) continue;
@@ -304,8 +304,8 @@ function kincasApp(root, transport) {
     ctx.fillText("drag to turn, wheel to zoom, double-click: isometric (points are not dragged in 3D)", 80, mech.height - 10);
   }
 
-  function drawLoads(D, xy) {
-    const forces = D.loads.filter(l => l.kind === "force");
+  function drawLoads(D, xy, i) {
+    const forces = D.loads.filter(l => l.kind === "force" || l.kind === "weight");
     const most = Math.max(1e-300, ...forces.map(l => Math.hypot(l.vector[0], l.vector[1])));
     const L = 0.12 * Math.min(mech.width, mech.height);
     for (const l of D.loads) {
@@ -320,6 +320,9 @@ function kincasApp(root, transport) {
           pts.push([a[0] + s * dx - side * dy / len, a[1] + s * dy + side * dx / len]);
         }
         pts.push(b); line(pts, "#8e44ad", 1.5);
+      } else if (l.kind === "weight" && fin(l.at[i])) {  // m g at the centre of gravity
+        arrow(l.at[i], [L * l.vector[0] / most, L * l.vector[1] / most], "#c0392b",
+              l.label + " " + fmt(Math.hypot(l.vector[0], l.vector[1]), 3));
       } else if (l.kind === "torque" && fin(xy[l.point])) {
         torque(xy[l.point], l.value, "#c0392b", fmt(l.value, 3));
       }
@@ -335,13 +338,13 @@ function kincasApp(root, transport) {
     ctx.font = "11px sans-serif"; ctx.fillText(label, X(p) + r + 3, Y(p) - r);
   }
   function drawForces(D, xy, i) {  // reported reactions (arrows) and input efforts (arcs)
-    const reactions = D.forces.filter(f => f.kind === "reaction");
+    const reactions = D.forces.filter(f => f.kind === "reaction" || f.kind === "effort-arrow");
     let most = 1e-300;
     for (const f of reactions) for (const v of f.vectors) if (fin(v)) most = Math.max(most, Math.hypot(v[0], v[1]));
     const L = 0.12 * Math.min(mech.width, mech.height);
     for (const f of D.forces) {
       const p = xy[f.point]; if (!fin(p)) continue;
-      if (f.kind === "reaction" && fin(f.vectors[i])) {
+      if ((f.kind === "reaction" || f.kind === "effort-arrow") && fin(f.vectors[i])) {
         const v = f.vectors[i];
         arrow(p, [L * v[0] / most, L * v[1] / most], "#2c7fb8", f.label + " " + fmt(Math.hypot(v[0], v[1]), 3));
       } else if (f.kind === "effort" && f.values[i] !== null) {

@@ -74,7 +74,7 @@ def drawing(m: Mechanism, sw: Sweep, handles: dict) -> dict:
                     "lo": g.lo, "hi": g.hi, "through": _list(g.through), "direction": _list(g.direction)}
                    for g in pic.guides],
         "joints": None if space else joints, "space": space, **(_camera() if space else {}),
-        "loads": [] if space else _loads(m, pic), "forces": [] if space else forces(m, sw, pic.names),
+        "loads": [] if space else _loads(m, sw, pic), "forces": [] if space else forces(m, sw, pic.names),
         "centres": {} if space else instant_centres(m, sw, pic.names, pic.xy),
     }
 
@@ -89,8 +89,10 @@ def _camera() -> dict:
 def forces(m: Mechanism, sw: Sweep, names: list[str]) -> list[dict]:
     """The reported reactions at pins, as arrows per pose ({point, label, vectors}), and the
     reported efforts of angle inputs, as torques per pose ({point, label, values}) at the
-    driven link's first point. A slide's reaction acts at the slide's point."""
+    driven link's first point, of parameter inputs that drive an actuator's length, as arrows
+    along it at its far end (kind "effort-arrow"). A slide's reaction acts at the slide's point."""
     from ...core.dynamics import _EFFORT, _REACTION
+    from ..forces import actuator
     out, v = [], sw.values
     for name in v:
         r = _REACTION.match(name)
@@ -107,13 +109,26 @@ def forces(m: Mechanism, sw: Sweep, names: list[str]) -> list[dict]:
             if lk is not None and lk.point_names[0] in names:
                 out.append({"kind": "effort", "point": names.index(lk.point_names[0]), "label": name,
                             "values": _list(v[name])})
+        inp = next((i for i in m.inputs if e and i.key == e["key"] and i.kind == "parameter"), None)
+        ends = actuator(m, inp.target) if inp is not None else None
+        if ends is not None and all(p in names for p in ends):
+            from ..poses import geometry
+            p, q = (geometry(m, sw).point(e) for e in ends)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                u = (q - p) / np.hypot(*(q - p).T)[:, None]
+            out.append({"kind": "effort-arrow", "point": names.index(ends[1]), "label": name,
+                        "vectors": _list(np.asarray(v[name], float)[:, None] * u)})
     return out
 
 
-def _loads(m: Mechanism, pic) -> list[dict]:
+def _loads(m: Mechanism, sw: Sweep, pic) -> list[dict]:
     """Each force load as {point, vector} and each spring as {points}; torques as {link,
-    value} (the page draws an arc about the link's first point)."""
-    out = []
+    value} (the page draws an arc about the link's first point); each link's weight as
+    {at: per pose [x, y], vector} (views/forces.weights)."""
+    from ..forces import weights
+    from ..poses import geometry
+    out = [{"kind": "weight", "label": w.label, "at": _list(w.at), "vector": _list(w.vec[0])}
+           for w in weights(m, geometry(m, sw))]
     for ld in m.loads:
         if ld.kind == "force" and ld.at in pic.names:
             out.append({"kind": "force", "point": pic.names.index(ld.at),
