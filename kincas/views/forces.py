@@ -1,6 +1,6 @@
 """Forces and instant centres over a sweep, format-free, for every picture (PNG, GIF, SVG,
 DXF, HTML) to draw: springs as zigzags between their two points (always drawn), and when
-asked, arrows for the loads, the springs' pulls, the inputs' efforts and the joints'
+asked, arrows for the loads, the links' weights, the springs' pulls, the inputs' efforts and the joints'
 reactions, and a cross at each moving link's instant centre.
 
 Every value is a quantity kincas already computes at the solved poses, through the compiled
