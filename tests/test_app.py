@@ -315,3 +315,26 @@ def test_an_edit_that_cannot_be_made_in_place_rewrites_the_whole_scene():
     assert tomllib.loads(out) == new  # the array over several lines: written afresh
     same = edited(text, old, {"parameters": {"r": 2}, "ground": {"A": [0, 0]}})
     assert same.startswith("[parameters]  # sizes\nr = 2  # crank\n")  # in place, comments kept
+
+
+def test_weights_and_an_actuators_effort_are_drawn_in_the_app():
+    """Gravity weights m g at each cg (views/forces.weights) and a parameter input's effort as
+    an arrow along its actuator, equal to the reported effort times the unit vector G -> P."""
+    text = (ROOT / "examples" / "actuator_bellcrank.toml").read_text(encoding="utf-8")
+    text = text.replace('actuator  = { points = ["G", "P"], length = "stroke" }',
+                        'actuator  = { points = ["G", "P"], length = "stroke", mass = 2 }')
+    text = text.replace("[parameters]", 'gravity = [0, -9810]\n\n[parameters]')
+    text = text.replace('report = ["P.x",', 'report = ["effort(stroke)", "P.x",')
+    sc = loads(text)
+    with TestClient(application(Session(sc, "a.toml", text))) as c:
+        st = c.get("/api/state").json()
+    d = st["drawing"]
+    (w,) = [x for x in d["loads"] if x["kind"] == "weight"]
+    assert w["vector"] == [0, -2 * 9810]
+    g, p = points(st, "G"), points(st, "P")
+    np.testing.assert_allclose(np.array(w["at"], float), (g + p) / 2, atol=1e-9)  # a bar's middle
+    (e,) = [x for x in d["forces"] if x["kind"] == "effort-arrow"]
+    assert d["names"][e["point"]] == "P"
+    u = (p - g) / np.linalg.norm(p - g, axis=1)[:, None]
+    np.testing.assert_allclose(np.array(e["vectors"], float), column(st, "effort(stroke)")[:, None] * u,
+                               rtol=1e-9, atol=1e-9)

@@ -211,3 +211,29 @@ def test_the_widget_script_renders_as_an_es_module(page):
     assert float(cell.get_attribute("data-value")) == printed(d, "P.x")
     assert not w.find_element("css selector", "a.k-download").is_displayed()  # no scene file there
     assert not severe(d)
+
+
+def test_a_spatial_scene_loads_in_3d_and_a_drag_turns_the_view(browser):
+    """The RSSR page loads without console errors; a mouse drag on the mechanism turns the
+    camera (data-camera) and keeps it orthonormal, and re-solves nothing (points are not dragged)."""
+    from selenium.webdriver import ActionChains
+    proc, url, _ = serve(ROOT / "examples" / "space_rssr.toml")
+    try:
+        browser.get_log("browser")
+        browser.get(url)
+        v0 = settle(browser)
+        assert not severe(browser) and browser.find_element("id", "errors").text == ""
+        app = browser.find_element("id", "kincas-app")
+        cam0 = np.array(json.loads(app.get_attribute("data-camera")))
+        np.testing.assert_allclose(cam0[2], np.ones(3) / math.sqrt(3), atol=1e-9)  # isometric
+        canvas = browser.find_element("css selector", "canvas.k-mech")
+        ActionChains(browser).move_to_element(canvas).click_and_hold().move_by_offset(40, 0) \
+            .move_by_offset(40, 10).release().perform()
+        cam1 = np.array(json.loads(app.get_attribute("data-camera")))
+        assert np.abs(cam1 - cam0).max() > 0.1
+        np.testing.assert_allclose(cam1 @ cam1.T, np.eye(3), atol=1e-9)
+        assert np.isclose(np.linalg.det(cam1), 1)
+        assert int(app.get_attribute("data-version")) == v0 and not severe(browser)
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)

@@ -1,6 +1,6 @@
 """Forces and instant centres over a sweep, format-free, for every picture (PNG, GIF, SVG,
 DXF, HTML) to draw: springs as zigzags between their two points (always drawn), and when
-asked, arrows for the loads, the springs' pulls, the inputs' efforts and the joints'
+asked, arrows for the loads, the links' weights, the springs' pulls, the inputs' efforts and the joints'
 reactions, and a cross at each moving link's instant centre.
 
 Every value is a quantity kincas already computes at the solved poses, through the compiled
@@ -120,6 +120,51 @@ def planar_overlay(m: Mechanism, sweep: Sweep, geo, forces: bool = False, centre
     return overlay(m, sweep, forces=forces, centres=centres, extent=extent, geo=geo)
 
 
+def weights(m: Mechanism, geo) -> list[Arrow]:
+    """Each link's weight m g as an arrow at its centre of gravity (none without gravity).
+
+    The cg is given in the link's frame (default: the mean of its points, which is where the
+    mean of its points is in the world too). In the world, at each pose, the frame is the one
+    that carries the link's first two points, local p0, p1, onto their world positions P0, P1:
+    turned by the angle theta = atan2(P1 - P0) - atan2(p1 - p0), so cg_world = P0 + R(theta)
+    (cg - p0)."""
+    g = np.array([_number(m, c) for c in m.gravity], float)
+    out = []
+    if not g.any():
+        return out
+    for lk in m.links:
+        mass = _number(m, lk.inertial.mass)
+        if mass == 0:
+            continue
+        world = np.stack([geo.point(p) for p in lk.point_names], axis=1)  # N x K x 2
+        if lk.inertial.cg is None:
+            at = world.mean(axis=1)
+        else:
+            local = np.array([[_number(m, c) for c in xy] for _, xy in lk.points], float)
+            cg = np.array([_number(m, c) for c in lk.inertial.cg], float)
+            if len(local) < 2:
+                at = world[:, 0] + cg - local[0]
+            else:
+                dw, dl = world[:, 1] - world[:, 0], local[1] - local[0]
+                th = np.arctan2(dw[:, 1], dw[:, 0]) - np.arctan2(dl[1], dl[0])
+                c, s, v = np.cos(th), np.sin(th), cg - local[0]
+                at = world[:, 0] + np.stack([c * v[0] - s * v[1], s * v[0] + c * v[1]], axis=1)
+        out.append(Arrow(f"weight of {lk.name}", "load", at, np.tile(mass * g, (len(at), 1))))
+    return out
+
+
+def actuator(m: Mechanism, parameter: str) -> tuple[str, str] | None:
+    """The ends (P, Q) of the two-point link whose length is `parameter` (a linear actuator
+    driven by a parameter input), None when no link's length is it."""
+    for lk in m.links:
+        if lk.two_point:
+            (p, _), (q, (length, _)) = lk.points
+            if length == parameter or (isinstance(length, Param) and length.name == parameter
+                                       and length.scale == 1):
+                return p, q
+    return None
+
+
 def zigzag(a, b, r: float, turns: int = 6) -> np.ndarray:
     """A spring's zigzag from a to b (K x 2): straight ends, `turns` teeth of width 1.5 r."""
     a, b = np.asarray(a, float), np.asarray(b, float)
@@ -156,6 +201,7 @@ def overlay(m: Mechanism, sweep: Sweep, *, forces: bool = True, centres: bool = 
                 pts = [p for p in m.link(ld.at).point_names]
                 at = np.nanmean(np.stack([point(p) for p in pts]), axis=0)
                 ov.torques.append(Torque(f"torque on {ld.at}", "load", at, np.full(n, _number(m, ld.value))))
+        ov.arrows += weights(m, geo)
         for label, a, b in springs(m):
             ld = next(x for x in m.loads if x.kind == "spring" and x.points == (a, b))
             k, d0 = _number(m, ld.stiffness), _number(m, ld.free_length)
@@ -173,6 +219,8 @@ def overlay(m: Mechanism, sweep: Sweep, *, forces: bool = True, centres: bool = 
                 todo.append(("torque", key, pivot, [key]))
             elif inp.kind == "slide":
                 todo.append(("along", key, m.slide(inp.target), [key]))
+            elif inp.kind == "parameter" and (ends := actuator(m, inp.target)) is not None:
+                todo.append(("actuator", key, ends, [key]))
         for p in list(m.ground_points) + list(m.moving_points):
             at = bodies_at(m, p)
             if len(at) >= 2:
@@ -196,6 +244,11 @@ def overlay(m: Mechanism, sweep: Sweep, *, forces: bool = True, centres: bool = 
         elif kind == "along":
             through, d, s = geo.slides[where.name]
             ov.arrows.append(Arrow(label, "effort", point(where.point), cols[0][:, None] * d))
+        elif kind == "actuator":  # along the actuator, on its far end (pushing it out when > 0)
+            p, q = (point(e) for e in where)
+            d = q - p
+            u = d / np.where(np.hypot(*d.T) > 0, np.hypot(*d.T), np.nan)[:, None]
+            ov.arrows.append(Arrow(label, "effort", q, cols[0][:, None] * u))
         elif kind == "arrow":
             ov.arrows.append(Arrow(label, "reaction" if label.startswith("reaction") else "load",
                                    point(where), np.stack(cols, axis=1)))

@@ -19,7 +19,11 @@ farthest first. For a test, the page keeps in its DOM `data-camera` (the rows, J
 """
 from __future__ import annotations
 
+from importlib import resources
+
 from .projection import UP_AXIS, VIEWS, axes
+
+ORBIT_JS = resources.files(__package__).joinpath("orbit.js").read_text(encoding="utf-8")
 
 
 def camera(view: str) -> dict:
@@ -30,8 +34,9 @@ def camera(view: str) -> dict:
             "views": {v: axes(v).tolist() for v in VIEWS}, "ups": dict(UP_AXIS)}
 
 
-# Replaces the planar page's `drawMechanism` (views/html.py: _HEAD + this + _TAIL).
-MECHANISM_3D = r"""// a spatial mechanism, orthographic, turned with the mouse
+# Replaces the planar page's `drawMechanism` (views/html.py: _HEAD + this + _TAIL); the camera's
+# turning is views/orbit.js, shared with the live page of `kincas app`.
+MECHANISM_3D = ORBIT_JS + r"""// a spatial mechanism, orthographic, turned with the mouse
 const bx = D.box;
 let W = mech.width, H = mech.height;
 const C0 = [0, 1, 2].map(j => (bx[0][j] + bx[1][j]) / 2);
@@ -47,7 +52,7 @@ for (const g of D.guides) g.through.forEach((t, i) => {
     RAD = Math.max(RAD, Math.hypot(t[0] + s * d[0] - C0[0], t[1] + s * d[1] - C0[1], t[2] + s * d[2] - C0[2]));
 });
 RAD = RAD > 0 ? RAD + 5 * D.r : 1;
-const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const dot = kDot;
 let cam = D.camera.map(r => r.slice()), up = D.up, zoom = 1, panX = 0, panY = 0;
 let S = 0, OX = 0, OY = 0, R = 0;  // scale, origin, the picture's unit of size (pixels)
 function frame() {  // world -> canvas of the current camera, published for tests
@@ -66,27 +71,7 @@ function layout() {  // the canvas fills its stage; set again when the window ch
 }
 // a world point: canvas x, canvas y, depth (larger: farther from the viewer)
 const P = p => [OX + S * dot(cam[0], p), OY - S * dot(cam[1], p), -dot(cam[2], p)];
-function rotate(v, k, a) {  // v turned by a about the unit axis k (Rodrigues)
-  const c = Math.cos(a), s = Math.sin(a), kv = dot(k, v);
-  const x = [k[1] * v[2] - k[2] * v[1], k[2] * v[0] - k[0] * v[2], k[0] * v[1] - k[1] * v[0]];
-  return [0, 1, 2].map(j => v[j] * c + x[j] * s + k[j] * kv * (1 - c));
-}
-function orthonormal() {  // Gram-Schmidt against rounding drift; toward = right x up
-  const n = v => { const l = Math.hypot(v[0], v[1], v[2]); return v.map(x => x / l); };
-  const r = n(cam[0]), u0 = cam[1], ru = dot(r, u0);
-  const u = n([0, 1, 2].map(j => u0[j] - ru * r[j]));
-  cam = [r, u, [r[1] * u[2] - r[2] * u[1], r[2] * u[0] - r[0] * u[2], r[0] * u[1] - r[1] * u[0]]];
-}
-function orbit(dx, dy) {
-  // about the world's up axis: every camera row turns the other way (the mechanism turns)
-  const k = [0, 0, 0]; k[up] = 1;
-  cam = cam.map(row => rotate(row, k, -0.01 * dx));
-  // about the screen's horizontal: up and toward turn in their plane
-  const b = 0.01 * dy, c = Math.cos(b), s = Math.sin(b), u = cam[1], t = cam[2];
-  cam[1] = [0, 1, 2].map(j => c * u[j] + s * t[j]);
-  cam[2] = [0, 1, 2].map(j => -s * u[j] + c * t[j]);
-  orthonormal();
-}
+const orbit = (dx, dy) => { cam = kOrbit(cam, up, dx, dy); };  // views/orbit.js
 function line(pts, colour, width, dash) {
   ctx.beginPath(); ctx.setLineDash(dash || []); ctx.strokeStyle = colour; ctx.lineWidth = width;
   let pen = false;

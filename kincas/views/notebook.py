@@ -26,7 +26,11 @@ import numpy as np
 
 
 def first_inputs(m) -> dict[str, float]:
-    """The input values the mechanism's ground points and guess imply (see the module)."""
+    """The input values the mechanism's ground points and guess imply (see the module); a
+    spatial mechanism's are those of its drawn pose (its joints' coordinates 0)."""
+    from .poses import is_spatial
+    if is_spatial(m):
+        return {i.key: m.parameter(i.target) if i.kind == "parameter" else 0.0 for i in m.inputs}
     known = {**{g: (m.value(x), m.value(y)) for g, (x, y) in m.ground},
              **{p: (m.value(x), m.value(y)) for p, (x, y) in m.guess}}
     out = {}

@@ -125,7 +125,9 @@ def picture(m: Mechanism, sweep: Sweep, paths=None, dense: int | dict = 0, view:
             ring = [idx[k] for k in hull]
             x, y = p0[hull].T
             area = 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
-            if len(ring) < 3 or not area > (0.5 * r) ** 2:  # collinear: a bar between the farthest
+            if not np.isfinite(p0).all():  # no pose solved: no outline to take, a bar of its first two
+                ring = idx[:2]
+            elif len(ring) < 3 or not area > (0.5 * r) ** 2:  # collinear: a bar between the farthest
                 far = np.hypot(*(p0 - p0[0]).T)
                 ring = [idx[0], idx[int(np.nanargmax(far))]]
         bodies.append(Body(lk.name, ring, colour[lk.name], lk.name in driven))

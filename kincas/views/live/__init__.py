@@ -13,7 +13,12 @@ ASSETS = ("page.html", "app.js", "app.css")
 
 
 def asset(name: str) -> str:
-    """The text of one of the page's files (`ASSETS`)."""
+    """The text of one of the page's files (`ASSETS`); `app.js` starts with the camera that turns
+    a spatial mechanism with the mouse (views/orbit.js, shared with the spatial `--html` page)."""
     if name not in ASSETS:
         raise KeyError(name)
-    return resources.files(__name__).joinpath(name).read_text(encoding="utf-8")
+    text = resources.files(__name__).joinpath(name).read_text(encoding="utf-8")
+    if name == "app.js":
+        from ..html3d import ORBIT_JS
+        text = ORBIT_JS + text
+    return text

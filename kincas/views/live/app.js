@@ -6,6 +6,10 @@
 // The element's dataset keeps what a test may read: data-version (the state shown),
 // data-pose (the pose shown), data-busy ("1" while a request is out or waiting),
 // data-transform "sx ox oy" (world (x, y) is drawn at canvas pixel (ox + sx x, oy - sx y)).
+// A spatial mechanism (drawing.space) is drawn turned by a camera (views/orbit.js, inlined
+// before this file): its points relative to the box's centre c, projected on the camera's
+// rows, (x, y) = (right . (p - c), up . (p - c)), are drawn as a planar one's; data-camera
+// keeps the rows (JSON). The mouse turns it (drag) and zooms (wheel); its points are not dragged.
 "use strict";
 
 // requests over HTTP to the server that served the page
@@ -60,6 +64,7 @@ function kincasApp(root, transport) {
   const poseSlider = $(".k-pose"), controls = $(".k-controls"), message = $(".k-message");
   let S = null, good = null, pose = 0, view = null, timer = null;
   let busy = false, pending = null, dragging = null, error = "";
+  let cam = null, camUp = 2, turning = null, flatCache = null;  // a spatial mechanism's camera
   const INK = "#222222";
 
   // --- requests: one at a time; edits made meanwhile are merged and sent when it returns ---
@@ -96,6 +101,10 @@ function kincasApp(root, transport) {
     buildControls(st);
     poseSlider.max = Math.max(st.poses - 1, 0);
     poseSlider.disabled = st.poses < 2;
+    if (st.drawing.space && !cam) {
+      cam = st.drawing.camera.map(r => r.slice()); camUp = st.drawing.up;
+      root.dataset.camera = JSON.stringify(cam);
+    }
     if (first || (!dragging && !fits(st))) fit();
     showMessage();
     root.dataset.version = st.version;
@@ -155,7 +164,25 @@ function kincasApp(root, transport) {
   }
 
   // --- the view: world -> canvas, equal scales ---
-  function box() { return (S && S.ok.some(v => v) ? S : good || S).drawing.box; }
+  function boxOf(D) {  // in 3D: the sphere about the box's centre, the same at every angle
+    if (!D.space) return D.box;
+    const b = D.box, R = 0.5 * Math.hypot(b[1][0] - b[0][0], b[1][1] - b[0][1], b[1][2] - b[0][2]);
+    return [[-R, -R], [R, R]];
+  }
+  function flat(D) {  // a spatial drawing as seen by the camera now (a planar one as it is)
+    if (!D.space) return D;
+    const key = JSON.stringify(cam);
+    if (flatCache && flatCache[0] === D && flatCache[1] === key) return flatCache[2];
+    const b = D.box, c = [0, 1, 2].map(j => (b[0][j] + b[1][j]) / 2);
+    const on = p => (p === null || p === undefined || p.some(v => v === null)) ? null
+      : [kDot(cam[0], p) - kDot(cam[0], c), kDot(cam[1], p) - kDot(cam[1], c)];
+    const dir = d => (d === null || d === undefined || d.some(v => v === null)) ? null : [kDot(cam[0], d), kDot(cam[1], d)];
+    const out = { ...D, xy: D.xy.map(q => q.map(on)),
+      guides: D.guides.map(g => ({ ...g, through: g.through.map(on), direction: g.direction.map(dir) })) };
+    flatCache = [D, key, out];
+    return out;
+  }
+  function box() { return boxOf((S && S.ok.some(v => v) ? S : good || S).drawing); }
   function fit() {
     const b = box(), W = mech.width, H = mech.height;
     const sx = Math.min(W / (b[1][0] - b[0][0] || 1), H / (b[1][1] - b[0][1] || 1));
@@ -164,7 +191,7 @@ function kincasApp(root, transport) {
   }
   function fits(st) {
     if (!view || !st.ok.some(v => v)) return true;
-    const b = st.drawing.box, W = mech.width, H = mech.height;
+    const b = boxOf(st.drawing), W = mech.width, H = mech.height;
     return X(b[0]) >= -W * 0.05 && X(b[1]) <= W * 1.05 && Y(b[1]) >= -H * 0.05 && Y(b[0]) <= H * 1.05;
   }
   const X = p => view.ox + view.sx * p[0], Y = p => view.oy - view.sx * p[1];
@@ -207,7 +234,7 @@ function kincasApp(root, transport) {
     ctx.fillStyle = "white"; ctx.fillRect(0, 0, W, H);
     let st = S, i = pose;
     if (!S.ok.some(v => v) && good) { st = good; i = Math.min(pose, good.poses - 1); ctx.globalAlpha = 0.3; }
-    const D = st.drawing, xy = D.xy[i];
+    const D = flat(st.drawing), xy = D.xy[i];
     const owner = {};
     for (const b of D.bodies) for (const k of b.ring) if (!(k in owner)) owner[k] = b.colour;
     if ($(".k-paths").checked) for (const k of D.moving) line(D.xy.map(q => q[k]), owner[k] || INK, 1, [5, 4]);
@@ -253,7 +280,7 @@ function kincasApp(root, transport) {
         ctx.lineCap = "round"; line(pts, b.colour, 7); ctx.lineCap = "butt";
       }
     }
-    if ($(".k-forces").checked) { drawLoads(D, xy); drawForces(D, xy, i); }
+    if ($(".k-forces").checked) { drawLoads(D, xy, i); drawForces(D, xy, i); }
     if ($(".k-centres").checked) drawCentres(st, i);
     for (let k = 0; k < D.names.length; k++) {  // joints and points, with their names
       const p = xy[k]; if (!fin(p)) continue;
@@ -263,10 +290,22 @@ function kincasApp(root, transport) {
       ctx.fillStyle = INK; ctx.font = "11px sans-serif"; ctx.fillText(D.names[k], X(p) + 7, Y(p) - 7);
     }
     ctx.globalAlpha = 1;
+    if (D.space) triad();
+  }
+  function triad() {  // the world axes, lower left, and how to turn the view
+    const o = [38, mech.height - 38], col = ["#d62728", "#2ca02c", "#1f77b4"];
+    ctx.font = "11px sans-serif";
+    for (let j = 0; j < 3; j++) {
+      ctx.beginPath(); ctx.moveTo(o[0], o[1]); ctx.lineTo(o[0] + 26 * cam[0][j], o[1] - 26 * cam[1][j]);
+      ctx.strokeStyle = col[j]; ctx.lineWidth = 2; ctx.stroke();
+      ctx.fillStyle = col[j]; ctx.fillText("xyz"[j], o[0] + 34 * cam[0][j] - 3, o[1] - 34 * cam[1][j] + 4);
+    }
+    ctx.fillStyle = "#666";
+    ctx.fillText("drag to turn, wheel to zoom, double-click: isometric (points are not dragged in 3D)", 80, mech.height - 10);
   }
 
-  function drawLoads(D, xy) {
-    const forces = D.loads.filter(l => l.kind === "force");
+  function drawLoads(D, xy, i) {
+    const forces = D.loads.filter(l => l.kind === "force" || l.kind === "weight");
     const most = Math.max(1e-300, ...forces.map(l => Math.hypot(l.vector[0], l.vector[1])));
     const L = 0.12 * Math.min(mech.width, mech.height);
     for (const l of D.loads) {
@@ -281,6 +320,9 @@ function kincasApp(root, transport) {
           pts.push([a[0] + s * dx - side * dy / len, a[1] + s * dy + side * dx / len]);
         }
         pts.push(b); line(pts, "#8e44ad", 1.5);
+      } else if (l.kind === "weight" && fin(l.at[i])) {  // m g at the centre of gravity
+        arrow(l.at[i], [L * l.vector[0] / most, L * l.vector[1] / most], "#c0392b",
+              l.label + " " + fmt(Math.hypot(l.vector[0], l.vector[1]), 3));
       } else if (l.kind === "torque" && fin(xy[l.point])) {
         torque(xy[l.point], l.value, "#c0392b", fmt(l.value, 3));
       }
@@ -296,13 +338,13 @@ function kincasApp(root, transport) {
     ctx.font = "11px sans-serif"; ctx.fillText(label, X(p) + r + 3, Y(p) - r);
   }
   function drawForces(D, xy, i) {  // reported reactions (arrows) and input efforts (arcs)
-    const reactions = D.forces.filter(f => f.kind === "reaction");
+    const reactions = D.forces.filter(f => f.kind === "reaction" || f.kind === "effort-arrow");
     let most = 1e-300;
     for (const f of reactions) for (const v of f.vectors) if (fin(v)) most = Math.max(most, Math.hypot(v[0], v[1]));
     const L = 0.12 * Math.min(mech.width, mech.height);
     for (const f of D.forces) {
       const p = xy[f.point]; if (!fin(p)) continue;
-      if (f.kind === "reaction" && fin(f.vectors[i])) {
+      if ((f.kind === "reaction" || f.kind === "effort-arrow") && fin(f.vectors[i])) {
         const v = f.vectors[i];
         arrow(p, [L * v[0] / most, L * v[1] / most], "#2c7fb8", f.label + " " + fmt(Math.hypot(v[0], v[1]), 3));
       } else if (f.kind === "effort" && f.values[i] !== null) {
@@ -433,6 +475,7 @@ function kincasApp(root, transport) {
     if (!S || !view) return null;
     const st = S.ok[pose] ? S : null;
     if (!st) return null;
+    if (st.drawing.space) return null;  // in 3D the mouse turns the view (docs/app.md)
     const [cx, cy] = canvasPoint(e), D = st.drawing, xy = D.xy[pose];
     let best = null;
     for (const k of D.ground.concat(D.moving)) {
@@ -443,19 +486,40 @@ function kincasApp(root, transport) {
     return best;
   }
   mech.addEventListener("pointerdown", e => {
+    if (cam) {  // a spatial mechanism: the drag turns it
+      turning = [e.clientX, e.clientY];
+      if (mech.setPointerCapture && e.pointerId !== undefined) { try { mech.setPointerCapture(e.pointerId); } catch (_) { /* synthetic */ } }
+      e.preventDefault(); return;
+    }
     const hit = nearest(e); if (!hit) return;
     dragging = hit; mech.classList.add("k-dragging");
     if (mech.setPointerCapture && e.pointerId !== undefined) { try { mech.setPointerCapture(e.pointerId); } catch (_) { /* synthetic */ } }
     e.preventDefault(); draw();
   });
   mech.addEventListener("pointermove", e => {
+    if (turning) {
+      cam = kOrbit(cam, camUp, e.clientX - turning[0], e.clientY - turning[1]);
+      turning = [e.clientX, e.clientY]; root.dataset.camera = JSON.stringify(cam); draw(); return;
+    }
     if (!dragging) { mech.classList.toggle("k-over", !!nearest(e)); return; }
     const [cx, cy] = canvasPoint(e);
     send("drag", { point: dragging.name, x: (cx - view.ox) / view.sx, y: (view.oy - cy) / view.sx });
   });
-  const drop = () => { if (!dragging) return; dragging = null; mech.classList.remove("k-dragging"); draw(); };
+  const drop = () => { turning = null; if (!dragging) return; dragging = null; mech.classList.remove("k-dragging"); draw(); };
   mech.addEventListener("pointerup", drop);
   mech.addEventListener("pointercancel", drop);
+
+  mech.addEventListener("wheel", e => {  // zoom a spatial mechanism about the canvas's centre
+    if (!cam || !view) return;
+    e.preventDefault();
+    const f = Math.min(1.5, Math.max(0.67, Math.exp(-0.0015 * e.deltaY))), W = mech.width, H = mech.height;
+    view = { sx: view.sx * f, ox: W / 2 + f * (view.ox - W / 2), oy: H / 2 + f * (view.oy - H / 2) };
+    root.dataset.transform = view.sx + " " + view.ox + " " + view.oy; draw();
+  }, { passive: false });
+  mech.addEventListener("dblclick", () => {
+    if (!cam || !S) return;
+    cam = S.drawing.camera.map(r => r.slice()); root.dataset.camera = JSON.stringify(cam); fit(); draw();
+  });
 
   // --- the pose, the animation, the toggles ---
   poseSlider.addEventListener("input", () => { pose = +poseSlider.value; draw(); });

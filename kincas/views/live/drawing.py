@@ -57,14 +57,9 @@ def drawing(m: Mechanism, sw: Sweep, handles: dict) -> dict:
     """Names, points per pose, bodies, guides, joint curves, loads; `draggable` lists the ground
     points (they move the ground) and the moving points (they move the input)."""
     n = len(sw)
-    if not sw.ok.any():  # nothing to draw (the page keeps showing the last solved sweep)
-        from ..poses import geometry
-        names = list(geometry(m, sw).names)
-        return {"names": names, "xy": [[None] * len(names)] * n, "r": 0.0, "box": [[0, 0], [1, 1]],
-                "ground": [names.index(g) for g in m.ground_points],
-                "moving": [names.index(p) for p in m.moving_points if p in names],
-                "bodies": [], "guides": [], "joints": None, "loads": [], "forces": [], "centres": {}}
-    pic = picture(m, sw, paths=[])
+    from ..poses import is_spatial
+    space = is_spatial(m)  # a spatial mechanism's points stay in space: the page turns them
+    pic = picture(m, sw, paths=[], world=space)
     joints = None
     if m.gears or m.racks or m.cams:  # coarse curves per pose (the page stays small)
         colours = {b.name: b.colour for b in pic.bodies}
@@ -78,16 +73,26 @@ def drawing(m: Mechanism, sw: Sweep, handles: dict) -> dict:
         "guides": [{"name": g.name, "point": g.point, "ground": g.ground, "colour": g.colour,
                     "lo": g.lo, "hi": g.hi, "through": _list(g.through), "direction": _list(g.direction)}
                    for g in pic.guides],
-        "joints": joints, "loads": _loads(m, pic), "forces": forces(m, sw, pic.names),
-        "centres": instant_centres(m, sw, pic.names, pic.xy),
+        "joints": None if space else joints, "space": space, **(_camera() if space else {}),
+        "loads": [] if space else _loads(m, sw, pic), "forces": [] if space else forces(m, sw, pic.names),
+        "centres": {} if space else instant_centres(m, sw, pic.names, pic.xy),
     }
+
+
+def _camera() -> dict:
+    """The camera a spatial mechanism opens in (isometric, turning about z; views/html3d.py)."""
+    from ..html3d import camera
+    c = camera("iso")
+    return {"camera": c["camera"], "up": c["up"]}
 
 
 def forces(m: Mechanism, sw: Sweep, names: list[str]) -> list[dict]:
     """The reported reactions at pins, as arrows per pose ({point, label, vectors}), and the
     reported efforts of angle inputs, as torques per pose ({point, label, values}) at the
-    driven link's first point. A slide's reaction acts at the slide's point."""
+    driven link's first point, of parameter inputs that drive an actuator's length, as arrows
+    along it at its far end (kind "effort-arrow"). A slide's reaction acts at the slide's point."""
     from ...core.dynamics import _EFFORT, _REACTION
+    from ..forces import actuator
     out, v = [], sw.values
     for name in v:
         r = _REACTION.match(name)
@@ -104,13 +109,26 @@ def forces(m: Mechanism, sw: Sweep, names: list[str]) -> list[dict]:
             if lk is not None and lk.point_names[0] in names:
                 out.append({"kind": "effort", "point": names.index(lk.point_names[0]), "label": name,
                             "values": _list(v[name])})
+        inp = next((i for i in m.inputs if e and i.key == e["key"] and i.kind == "parameter"), None)
+        ends = actuator(m, inp.target) if inp is not None else None
+        if ends is not None and all(p in names for p in ends):
+            from ..poses import geometry
+            p, q = (geometry(m, sw).point(e) for e in ends)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                u = (q - p) / np.hypot(*(q - p).T)[:, None]
+            out.append({"kind": "effort-arrow", "point": names.index(ends[1]), "label": name,
+                        "vectors": _list(np.asarray(v[name], float)[:, None] * u)})
     return out
 
 
-def _loads(m: Mechanism, pic) -> list[dict]:
+def _loads(m: Mechanism, sw: Sweep, pic) -> list[dict]:
     """Each force load as {point, vector} and each spring as {points}; torques as {link,
-    value} (the page draws an arc about the link's first point)."""
-    out = []
+    value} (the page draws an arc about the link's first point); each link's weight as
+    {at: per pose [x, y], vector} (views/forces.weights)."""
+    from ..forces import weights
+    from ..poses import geometry
+    out = [{"kind": "weight", "label": w.label, "at": _list(w.at), "vector": _list(w.vec[0])}
+           for w in weights(m, geometry(m, sw))]
     for ld in m.loads:
         if ld.kind == "force" and ld.at in pic.names:
             out.append({"kind": "force", "point": pic.names.index(ld.at),

@@ -53,6 +53,9 @@ class _Handle:
 def _lift(m: Mechanism) -> tuple[Mechanism, dict]:
     """The mechanism with each numeric ground coordinate made a hidden parameter, and for each
     ground point its two handles (x, y)."""
+    from ..poses import is_spatial
+    if is_spatial(m):  # a spatial mechanism's ground is not dragged (docs/app.md): nothing lifted
+        return m, {}
     params = dict(m.param_values)
     ground, handles = {}, {}
     for g, xy in m.ground:
@@ -119,7 +122,7 @@ class Live:
         for inp in self.m.inputs:
             v = np.asarray(sc.study.inputs[inp.key], float)
             swept = bool(len(v) > 1 and np.ptp(v) > 0)
-            ang = inp.kind == "angle"
+            ang = inp.kind == "angle" or (inp.kind == "joint" and inp.key.endswith(".angle"))
             half = math.pi if ang else size
             lo, hi = float(v[0]) - half, float(v[0]) + half
             if inp.kind == "parameter" and inp.target in self.ranges:
@@ -127,7 +130,7 @@ class Live:
             written = getattr(sc.study, "written", {}).get(inp.key)
             user = float(written[0]) if written is not None and not swept else None
             self.inputs.append(_Input(inp.key, inp.kind, v, swept, ang, lo, hi, user))
-        self.guess0 = {p: (self.m.value(x), self.m.value(y)) for p, (x, y) in self.m.guess} or None
+        self.guess0 = {p: tuple(map(self.m.value, xy)) for p, xy in self.m.guess} or None
         self.solve()
 
     # --- what can change ---
@@ -140,7 +143,7 @@ class Live:
     @property
     def ground(self) -> dict[str, tuple[float, float]]:
         """Each ground point where it is now."""
-        return {g: (self.m.value(x), self.m.value(y)) for g, (x, y) in self.m.ground}
+        return {g: tuple(map(self.m.value, xy)) for g, xy in self.m.ground}
 
     def fixed(self) -> dict[str, float]:
         """The fixed inputs' values now, in the scene's units."""
@@ -173,6 +176,9 @@ class Live:
         nearest (x, y)."""
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in (x, y)):
             raise ValueError(f"drag: expected finite coordinates, got {(x, y)!r}")
+        from ..poses import is_spatial
+        if is_spatial(self.m):
+            raise ValueError("drag: points of a spatial mechanism are not dragged (in 3D the mouse turns the view)")
         if point in self.handles:
             values = {}
             for h, c in zip(self.handles[point], (x, y)):
@@ -298,7 +304,10 @@ class Live:
     def _motion_names(self) -> list[str]:
         """The velocities the instant centres need: each moving link's angular velocity and
         the velocity of one of its points."""
+        from ..poses import is_spatial
         out = []
+        if is_spatial(self.m):  # no instant centres in space (a spatial body has an axis, not a point)
+            return out
         for lk in self.m.links:
             pts = [p for p in lk.point_names if p in self.m.moving_points or p in dict(self.m.ground)]
             if pts:

@@ -39,7 +39,8 @@ class Setting:
             inputs, swept = {}, False
             for inp in m.inputs:
                 v = first[inp.key]
-                if inp.kind == "angle" and not swept:
+                turns = inp.kind == "angle" or (inp.kind == "joint" and inp.key.endswith(".angle"))
+                if turns and not swept:
                     inputs[inp.key], swept = v + np.linspace(0, 2 * np.pi, STEPS), True
                 else:
                     inputs[inp.key] = np.array([v])
