@@ -72,3 +72,15 @@ def test_the_widget_shows_a_spatial_mechanism():
     assert "kOrbit" in w._esm
     st = w.live.state()
     assert st["drawing"]["space"] and np.array(st["drawing"]["xy"], float).shape[2] == 3
+
+
+def test_a_fixed_joint_input_edited_in_the_page_is_written_back_to_the_toml():
+    """A spatial scene's fixed input on a joint (`joint = "A"`) edited by its slider is saved
+    in the downloaded scene: the exported TOML solves the new crank angle, not the old one."""
+    text = RSSR.read_text(encoding="utf-8").replace("sweep = { from = 0, to = 360, steps = 361 }", "value = 30")
+    sess = Session(loads(text), "rssr.toml", text)
+    (key,) = sess.live.fixed()
+    sess.request("change", {"inputs": {key: 75}})
+    again = loads(sess.toml())
+    (k2,) = again.study.inputs
+    np.testing.assert_allclose(np.degrees(np.asarray(again.study.inputs[k2], float)), [75.0], atol=1e-9)

@@ -84,9 +84,13 @@ class Session:
                 if isinstance(old, list) and len(old) == 2:
                     ground[g] = [c if isinstance(c, str) else number(new, c) for c, new in zip(old, xy)]
             fixed = live.fixed()
-            for t in doc.get("inputs", []):
+            entries = doc.get("inputs", [])
+            # the scene's [[inputs]] in order are the mechanism's inputs (a spatial `joint = "A"`
+            # is keyed by its coordinate, `A.angle`, which only the mechanism knows)
+            keys = [i.key for i in self.scene.mechanism.inputs]
+            for n, t in enumerate(entries):
                 kind = next((k for k in ("angle", "parameter", "slide") if k in t), None)
-                key = Input(kind, t[kind]).key if kind else None
+                key = keys[n] if len(keys) == len(entries) else (Input(kind, t[kind]).key if kind else None)
                 if key in fixed and "value" in t:
                     t["value"] = number(fixed[key], t["value"])
             if self.text is None:
