@@ -119,12 +119,12 @@ def test_rssr_free_input_needs_no_effort_along_the_motion():
     """The integrator's accelerations are the rates' central differences (to O(h^4)), and with them
     kincas.sweep's kinetostatics at the simulated states needs no effort on A.angle."""
     sc = _rssr()
-    sim = kincas.simulate(sc.mechanism, 0.2, 2001, initial={"A.angle": math.radians(30)}, tolerance=1e-12)
+    sim = kincas.simulate(sc.mechanism, 0.1, 501, initial={"A.angle": math.radians(30)}, tolerance=1e-12)
     assert sim.ok
     th, w, h = sim.inputs["A.angle"], sim.rates["A.angle"], sim.time[1] - sim.time[0]
     acc = sim.accelerations["A.angle"]
     fd = (-w[4:] + 8 * w[3:-1] - 8 * w[1:-3] + w[:-4]) / (12 * h)  # five points: O(h^4)
-    assert np.max(np.abs(fd - acc[2:-2])) < 1e-5 * np.max(np.abs(acc))  # 2e-6 at the fast passage
+    assert np.max(np.abs(fd - acc[2:-2])) < 1e-5 * np.max(np.abs(acc))  
     sw = kincas.sweep(sc.mechanism, {"A.angle": th}, rates={"A.angle": w},
                       accelerations={"A.angle": acc}, report=["effort(A.angle)"])
     scale = GMM * (ROCKER_M * 30 + COUPLER_M * 60)  # the rocker's and coupler's weight about D (N mm)
