@@ -392,3 +392,26 @@ def test_a_duration_with_its_unit(tmp_path, capsys):
     bad.write_text(text.replace("duration = 2.0", 'duration = "2 fortnights"'))
     assert main(["simulate", str(bad)]) == 2
     assert "[simulate] duration: '2 fortnights': expected a time" in capsys.readouterr().err
+
+
+def test_textbook_flywheel_two_stroke_engine(capsys):
+    """The classic exercise of examples/simulate_flywheel_textbook.toml (Khurmi & Gupta, "Theory of
+    Machines", turning moment and flywheel chapter; numbers stated in full there): T = 1000 +
+    300 sin 2θ − 500 cos 2θ N m at 250 rpm, flywheel 400 kg at k = 0.4 m. Energy method, by
+    hand: ΔE = √(300² + 500²) = 583.1 J (the work of T − T_mean between two crossings),
+    Cs = ΔE / (I ω²) = 1.33 % with I = 64 kg m², and I = ΔE / (Cs ω²) = 85.07 kg m² for Cs = 1 %.
+    The energy method is first order in Cs (and the load here varies with the speed by ±Cs/2):
+    agreement to 1e-3 of the textbook's values."""
+    dE = math.hypot(300, 500)
+    w = 250 * 2 * math.pi / 60
+    assert round(dE, 1) == 583.1 and round(100 * dE / (64 * w ** 2), 2) == 1.33  # the textbook's rounding
+    assert main(["simulate", "examples/simulate_flywheel_textbook.toml", "--steady", "--json"]) == 0
+    st = json.loads(capsys.readouterr().out)
+    assert st["w_mean"] == pytest.approx(math.degrees(w), rel=1e-4)  # the scene in deg/s, t mm^2
+    assert st["fluctuation"] == pytest.approx(dE / (64 * w ** 2), rel=1e-3)
+    assert main(["flywheel", "examples/simulate_flywheel_textbook.toml", "--fluctuation", "0.01", "--json"]) == 0
+    fw = json.loads(capsys.readouterr().out)
+    I_book = dE / (0.01 * w ** 2)
+    assert abs(I_book - 85.07) < 0.01
+    assert 64 + fw["inertia"] / 1000 == pytest.approx(I_book, rel=1e-3)   # added on the crank's own 64
+    assert fw["estimate"] / 1000 == pytest.approx(I_book, rel=1e-3) and fw["fluctuation"] <= 0.01
