@@ -309,3 +309,109 @@ def test_a_parallelogram_stops_at_its_change_point_in_time():
     # q may cross onto the other branch within an integrator step, so the bisection, which
     # locates a dead centre to 1e-12, is only as sure as the output step here (docs/simulate.md)
     assert abs(t_pi - e["time"]) < 0.01 and np.all(r.status[r.time > t_pi + 0.01] == "not reached")
+
+
+# --- rates written with their own unit (scene-format.md "Units that read as people write them") ---
+
+def test_a_free_inputs_rate_string_is_converted(tmp_path, capsys):
+    """`rate = "3000 rpm"` on the engine's free crank is 3000 * 360 / 60 = 18000 deg/s, the
+    number the example writes: the same motion to the last digit."""
+    text = open("examples/simulate_engine.toml").read()
+    assert "rate = 18000 " in text
+    rpm = tmp_path / "rpm.toml"
+    rpm.write_text(text.replace("rate = 18000 ", 'rate = "3000 rpm" ').replace("duration = 2.0", "duration = 0.05"))
+    num = tmp_path / "num.toml"
+    num.write_text(text.replace("rate = 18000 ", f"rate = {3000 * 360 / 60} ").replace("duration = 2.0", "duration = 0.05"))
+    assert load(str(rpm)).study.rates["crank.angle"] == pytest.approx(3000 * 2 * math.pi / 60, rel=1e-15)
+    out = []
+    for f in (rpm, num):
+        assert main(["simulate", str(f), "--json"]) == 0
+        out.append(json.loads(capsys.readouterr().out))
+    assert out[0]["values"] == out[1]["values"] and out[0]["inputs"] == out[1]["inputs"]
+    assert out[0]["values"]["crank.omega"][0] == pytest.approx(18000, rel=1e-12)
+
+
+def test_a_held_inputs_rate_and_acceleration_strings_drive_it(tmp_path):
+    """A held input of a simulation turned at "60 rpm" (2 pi rad/s) speeding up at
+    "90 deg/s^2" in a radian scene: u = u0 + 2 pi t + (pi / 2) t^2 / 2."""
+    from kincas.cli.simulate import run_scene
+    sc = load_text(tmp_path, '''
+units = { length = "m", angle = "rad", time = "s" }
+gravity = [0, -9.81]
+[ground]
+O = [0, 0]
+[links]
+a = { points = ["O", "A"], length = 0.4, mass = 1.0, inertia = 0.1 }
+b = { points = ["A", "B"], length = 0.3, mass = 0.5, inertia = 0.05 }
+[[inputs]]
+angle = "a"
+value = 0.3
+rate = "60 rpm"
+acceleration = "90 deg/s^2"
+[[inputs]]
+angle = "b"
+free = true
+value = -1.0
+rate = "-30 deg/s"
+[simulate]
+duration = 0.5
+steps = 6
+''')
+    r = run_scene(sc)
+    t = r.time
+    assert r.ok and np.allclose(r.inputs["a.angle"], 0.3 + 2 * math.pi * t + (math.pi / 2) * t ** 2 / 2, rtol=0, atol=1e-12)
+    assert r.rates["b.angle"][0] == pytest.approx(-math.pi / 6, rel=1e-15)
+
+
+def test_a_rate_with_a_bad_unit_is_one_line_naming_the_field(tmp_path, capsys):
+    text = open("examples/simulate_engine.toml").read()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace("rate = 18000 ", 'rate = "3000 furlongs" '))
+    assert main(["simulate", str(bad)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert any(line.startswith("[[inputs]]") and "rate" in line and "furlongs" in line for line in err), err
+    bad.write_text(text.replace("rate = 18000 ", 'rate = "3000 m/s" '))  # a speed for an angle
+    assert main(["flywheel", str(bad), "--fluctuation", "0.02"]) == 2
+    err = capsys.readouterr().err
+    assert "rate" in err and "m/s" in err, err
+
+
+def load_text(tmp_path, text):
+    f = tmp_path / "scene.toml"
+    f.write_text(text)
+    return load(str(f))
+
+
+def test_a_duration_with_its_unit(tmp_path, capsys):
+    """`duration = "500 ms"` in a scene timed in seconds is 0.5 s; a unit that is no time is
+    one line naming [simulate] duration."""
+    text = open("examples/simulate_engine.toml").read()
+    assert load_text(tmp_path, text.replace("duration = 2.0", 'duration = "500 ms"')).study.simulation["duration"] == 0.5
+    assert load_text(tmp_path, text.replace("duration = 2.0", 'duration = "0.01 min"')).study.simulation["duration"] == pytest.approx(0.6, rel=1e-15)
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace("duration = 2.0", 'duration = "2 fortnights"'))
+    assert main(["simulate", str(bad)]) == 2
+    assert "[simulate] duration: '2 fortnights': expected a time" in capsys.readouterr().err
+
+
+def test_textbook_flywheel_two_stroke_engine(capsys):
+    """The classic exercise of examples/simulate_flywheel_textbook.toml (Khurmi & Gupta, "Theory of
+    Machines", turning moment and flywheel chapter; numbers stated in full there): T = 1000 +
+    300 sin 2θ − 500 cos 2θ N m at 250 rpm, flywheel 400 kg at k = 0.4 m. Energy method, by
+    hand: ΔE = √(300² + 500²) = 583.1 J (the work of T − T_mean between two crossings),
+    Cs = ΔE / (I ω²) = 1.33 % with I = 64 kg m², and I = ΔE / (Cs ω²) = 85.07 kg m² for Cs = 1 %.
+    The energy method is first order in Cs (and the load here varies with the speed by ±Cs/2):
+    agreement to 1e-3 of the textbook's values."""
+    dE = math.hypot(300, 500)
+    w = 250 * 2 * math.pi / 60
+    assert round(dE, 1) == 583.1 and round(100 * dE / (64 * w ** 2), 2) == 1.33  # the textbook's rounding
+    assert main(["simulate", "examples/simulate_flywheel_textbook.toml", "--steady", "--json"]) == 0
+    st = json.loads(capsys.readouterr().out)
+    assert st["w_mean"] == pytest.approx(math.degrees(w), rel=1e-4)  # the scene in deg/s, t mm^2
+    assert st["fluctuation"] == pytest.approx(dE / (64 * w ** 2), rel=1e-3)
+    assert main(["flywheel", "examples/simulate_flywheel_textbook.toml", "--fluctuation", "0.01", "--json"]) == 0
+    fw = json.loads(capsys.readouterr().out)
+    I_book = dE / (0.01 * w ** 2)
+    assert abs(I_book - 85.07) < 0.01
+    assert 64 + fw["inertia"] / 1000 == pytest.approx(I_book, rel=1e-3)   # added on the crank's own 64
+    assert fw["estimate"] / 1000 == pytest.approx(I_book, rel=1e-3) and fw["fluctuation"] <= 0.01

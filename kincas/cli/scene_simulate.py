@@ -83,10 +83,12 @@ def read(reader, doc: dict, mechanism_links, inputs) -> dict:
         return out
     reader.fields("[simulate]", sim, FIELDS)
     d = sim.get("duration")
+    if isinstance(d, str):
+        d = _time(reader, d)
     if d is None:
         reader.err("[simulate] duration: missing (the time to integrate)")
     elif isinstance(d, bool) or not isinstance(d, (int, float)) or not math.isfinite(d) or d <= 0:
-        reader.err(f"[simulate] duration: expected a number > 0, got {d!r}")
+        reader.err(f"[simulate] duration: expected a number > 0 (or a time such as '2 s'), got {d!r}")
     else:
         out["duration"] = float(d)
     n = sim.get("steps", 101)
@@ -112,6 +114,23 @@ def read(reader, doc: dict, mechanism_links, inputs) -> dict:
                 reader.err(f"[simulate] flywheel: inertia: must not be negative, got {J}")
             out["flywheel"] = (fw["link"], J)
     return out
+
+
+def _time(reader, text: str):
+    """`duration = "500 ms"`: a time with its own unit (s, ms, min, h), in the scene's time
+    unit; the text itself (refused below, naming the field) when it does not read."""
+    from ..units import TIMES
+    num, _, unit = text.strip().partition(" ")
+    scene = reader.units.get("time", "s")
+    try:
+        v = float(num)
+    except ValueError:
+        return text
+    if unit.strip() not in TIMES or scene not in TIMES:
+        reader.err(f"[simulate] duration: {text!r}: expected a time such as '2 s' or '500 ms' "
+                   f"(units {sorted(TIMES)})")
+        return 1.0
+    return v * TIMES[unit.strip()] / TIMES[scene]
 
 
 def arguments_of(sc) -> dict:

@@ -35,7 +35,7 @@ from ..model.space_parts import JOINT_TYPES, Body, Joint, SpatialSlide
 SPACE_SECTIONS = {"title", "space", "units", "parameters", "ground", "links", "joints", "slides",
                   "inputs", "guess", "output", "optimize", "tolerance", "study"}
 PLANAR_ONLY = {"gears": "gears", "racks": "racks", "cams": "cams", "cam_design": "cam design"}
-SPACE_SECTIONS |= {"gravity", "loads"}
+SPACE_SECTIONS |= {"gravity", "loads", "simulate", "data"}  # motion under forces (docs/simulate.md)
 
 
 INPUT_KINDS = ("joint", "parameter", "slide")
@@ -95,6 +95,8 @@ class _Space:
         inputs, values, rates, accs, written = self.inputs()
         gravity = self.xyz("gravity", doc["gravity"]) if "gravity" in doc else (0.0, 0.0, 0.0)
         loads = self.loads()
+        from . import scene_simulate
+        simulation = scene_simulate.read(self.r, doc, {b.name for b in bodies}, inputs)
         guess = {k: self.xyz(f"[guess] {k}", v) for k, v in self.table("guess").items()}
         report, sens = self.output()
         if not bodies and not self.problems:
@@ -118,7 +120,8 @@ class _Space:
         self.check_quantities(m, report, sens)
         study = Study(title=title if isinstance(title, str) else "", units=self.units,
                       inputs=values, rates=rates, accelerations=accs, report=report,
-                      sensitivity=sens, written=written, raw=doc, jerks=self.jerks)
+                      sensitivity=sens, written=written, raw=doc, jerks=self.jerks,
+                      ranges=self.ranges, simulation=simulation)
         return Scene(m, study)
 
     def link(self, name, t):
@@ -189,8 +192,17 @@ class _Space:
             else:
                 field = kinds[kind][0]
                 out.append(Load("force" if kind == "point" else "torque", at=t[kind],
-                                value=self.xyz(f"{where}: {field}", t[field])))
+                                value=self.components(where, i + 1, field, t[field])))
         return out
+
+    def components(self, where, index, field, v):
+        """[x, y, z] of a load: numbers, parameters or expressions of the state (a hidden
+        parameter each, evaluated along a motion: kincas/cli/scene_simulate.py)."""
+        from .scene_simulate import component
+        if not isinstance(v, list) or len(v) != 3:
+            self.err(f"{where}: {field}: expected [x, y, z], got {v!r}")
+            return (0.0, 0.0, 0.0)
+        return tuple(component(self.r, where, index, f"{field}_{c}", x) for c, x in zip("xyz", v))
 
     def joint(self, i, t):
         where = f"[[joints]] {t.get('name', t.get('point', i + 1))}"
