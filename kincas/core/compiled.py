@@ -60,7 +60,10 @@ class Backend:
         it is loaded, and `Library.load` never loads a half-written file. Code generation is
         done here, in the caller's thread; nothing happens if compiling is off, failed,
         done or under way. The thread is not a daemon: a process ending meanwhile waits for
-        the compiler, and the next process finds the library cached."""
+        the compiler, and the next process finds the library cached. (A daemon thread would
+        be frozen at exit mid-compile: nothing half-written is ever loaded, the rename never
+        happens and the file lock goes with the process, but the compiler, in a session of
+        its own, runs on orphaned and its temporary folder stays in the cache.)"""
         if self._thread is not None or self.lib is not None or self.failed or self.compile is not None \
                 or compiling_disabled():
             return

@@ -169,9 +169,10 @@ class GroupFunctions:
             co.append(mc[1])
             sg.append(ms[0])
             sig.append(ms[1])
-        y = report_function(q, u, p, ud, udd) if report_function is not None else ca.MX(0, 1)
         step = ca.vertcat(*dxs) if nq else ca.MX(0, 1)
         T = ca.vertcat(*Ts) if nq else ca.MX(0, nu)
+        # q' = (dq/du) u' from the tangent just computed: no solve through the chain again
+        y = report_function(q, u, p, ud, udd, ca.mtimes(T, ud)) if report_function is not None else ca.MX(0, 1)
         change = ca.mmax(ca.vertcat(0, *ch))
         corr = ca.mmax(ca.vertcat(*co)) if co else ca.MX(0)  # per group, as the flat kernel
         sigma = ca.mmin(ca.vertcat(*sig)) if sig else ca.MX(1)

@@ -30,6 +30,7 @@ import casadi as ca
 
 from .group_kernel import GroupFunctions, _max_abs
 from .structure import Structure
+from ..model.names import parse_quantity
 from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size
 from .tolerances import ACCEPT, CORRECTION, JAC_CHANGE, KERNEL_NEAR, MAX_EVALS, TOL  # noqa: F401
 
@@ -67,17 +68,20 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
     lam = ca.if_else(ca.dot(dup, dup) > 0, ca.dot(du, dup) / ca.dot(dup, dup), 0)
     pred = q + ca.mtimes(T0, du) + 0.5 * lam * ca.mtimes(T0 - T1, du)
     p, L, ud, udd = ca.SX.sym("p", sym.np), ca.SX.sym("L"), ca.SX.sym("ud", nu), ca.SX.sym("udd", nu)
-    if report:
-        qf = sym.quantity_function(list(report), lsolve=lambda b: block_solve(sym.Jq, b, blocks))
-        y = ca.densify(qf(q, u, p, ud, udd))
-    else:
-        y = ca.SX(0, 1)
+    # the reported quantities take q' = (dq/du) u' from the tangent kF computes anyway: one
+    # linear solve through the chain fewer per pose. Not with a sensitivity d(Q)/d(p): it
+    # differentiates Q with q' written in (q, u, p), which a q' given as input is not.
+    tangent = not any(parse_quantity(n)[0] == "sens" for n in report)
+    qf = sym.quantity_function(list(report), lsolve=lambda b: block_solve(sym.Jq, b, blocks),
+                               velocity=tangent) if report else None
+    given = (lambda a, qd: qf(*a, qd)) if tangent else (lambda a, qd: qf(*a))
     d, o = ca.densify, {"cse": True}  # cse: one sin and cos per angle, shared by everything
     kL = (structure or Structure(sym)).length_function()
     kP = ca.Function("kP", [q, T0, u0, u, T1, u1], [d(pred)], o)
     if grouped or (grouped is None and len(blocks) >= GROUPS_APART):
         # one small function per kind of group, the quantities apart
-        kY = ca.Function("kY", [q, u, p, ud, udd], [y], o) if report else None
+        qd = ca.SX.sym("qd", nq)
+        kY = ca.Function("kY", [q, u, p, ud, udd, qd], [ca.densify(given((q, u, p, ud, udd), qd))], o) if report else None
         return [kP, *GroupFunctions(sym, blocks).kernel(kY), kL]
     Lb = ca.SX.sym("Lb", len(blocks))  # each group's length
     is_length = ca.DM(sym.is_length.astype(float))
@@ -88,6 +92,7 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
     step = solve(Jq, g)
     rs = ca.vertcat(_max_abs(g / Lg), _max_abs(step / D))
     T = -solve(Jq, Ju)
+    y = ca.densify(given((q, u, p, ud, udd), ca.mtimes(T, ud))) if report else ca.SX(0, 1)
     change = block_change(J0, Jq, D, blocks)
     signs, sigma = block_measures(Jq, cs, blocks)
     return [kP,

@@ -206,8 +206,12 @@ class Symbolic:
                            f"or d(Q)/d(p) with declared names)")
         return out
 
-    def quantity_function(self, names: list[str], jerk: bool = False, lsolve=None) -> ca.Function:
+    def quantity_function(self, names: list[str], jerk: bool = False, lsolve=None,
+                          velocity: bool = False) -> ca.Function:
         """f(q, u, p, u', u'') -> the named quantities (only what they need is built).
+
+        With `velocity=True` the function takes q' = dq/du u' as its last argument instead of
+        solving g_q q' = -g_u u' itself (the fast kernel has the tangent dq/du already).
 
         With `jerk=True` the function takes the inputs' jerks u''' as a sixth argument;
         otherwise they are zero (the default of every input's `jerk`). `lsolve(b)`, if given,
@@ -233,8 +237,9 @@ class Symbolic:
         out = ca.vertcat(*raw) if raw else ca.SX(0, 1)
         orders = 3 if ca.depends_on(out, qddd_s) else self._needs(out, qd_s, qdd_s)
         lsolve = lsolve or self.lsolve
+        qd_in = ca.SX.sym("qd_in", self.nq) if velocity else None
         if orders >= 1:  # only build the linear solves that the report needs
-            qd = ca.densify(-lsolve(ca.mtimes(self.Ju, ud)))  # dense even with no input
+            qd = qd_in if velocity else ca.densify(-lsolve(ca.mtimes(self.Ju, ud)))  # dense even with no input
             qdd = ca.SX.zeros(self.nq)
             if orders >= 2:
                 gam = ca.jtimes(ca.jtimes(self.g, z, zd), z, zd)
@@ -258,7 +263,7 @@ class Symbolic:
                     miss = ca.mmax(ca.fabs(ca.mtimes(self.Jq, dq_dp[:, j]) + gp[:, j]))
                     rows[i] = ca.if_else(miss > JAMMED * (1 + ca.mmax(ca.fabs(gp[:, j]))), np.nan, rows[i])
         out = ca.vertcat(*rows) if rows else ca.SX(0, 1)
-        args = [self.q, self.u, self.p, ud, udd] + ([uddd] if jerk else [])
+        args = [self.q, self.u, self.p, ud, udd] + ([uddd] if jerk else []) + ([qd_in] if velocity else [])
         return ca.Function("quantities", args, [out])
 
     def _expr(self, name, t):
