@@ -122,3 +122,17 @@ def test_scene_forces_read_as_the_python_declaration(capsys, tmp_path):
     sw = kincas.sweep(rssr_loaded(), {"A.angle": np.radians([0, 30, 60, 90])}, rates={"A.angle": math.pi / 180},
                       report=["effort(A.angle)"])
     assert np.allclose(out["values"]["effort(A.angle)"], sw["effort(A.angle)"], rtol=1e-12)
+
+
+def test_a_reaction_in_a_spatial_scene_is_refused_in_one_line_naming_it(tmp_path):
+    """The contract makes reaction(...) optional in 3D, refused with a clear message if not built."""
+    import re
+    import subprocess
+    import sys
+    from conftest import ROOT
+    text = (ROOT / "examples" / "space_rssr.toml").read_text(encoding="utf-8")
+    f = tmp_path / "r.toml"
+    f.write_text(re.sub(r"report = \[", 'report = ["reaction(A)", ', text, count=1), encoding="utf-8")
+    p = subprocess.run([sys.executable, "-m", "kincas", "solve", str(f)], capture_output=True, text=True, cwd=ROOT)
+    assert p.returncode == 2 and "Traceback" not in p.stderr
+    assert "reaction(A)" in p.stderr and "not built for spatial scenes" in p.stderr
