@@ -110,7 +110,7 @@ class Problem(Checks, SampledNLP):
         self.D = np.stack(list(self.data.values())) if self.data else np.zeros((0, K))
         Q0, ok = sw0.q.copy(), sw0.ok
         solved = np.flatnonzero(ok)
-        guess = {k: (m.value(x), m.value(y)) for k, (x, y) in m.guess}
+        guess = {k: tuple(m.value(c) for c in xy) for k, xy in m.guess}  # 2 or 3 coordinates
         for k in np.flatnonzero(~ok):  # start where it did not assemble from a neighbour
             Q0[k] = (Q0[solved[np.argmin(np.abs(solved - k))]] if len(solved)
                      else model.initial_q(self.U[k], self.p0, guess, self.L))
