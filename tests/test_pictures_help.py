@@ -53,3 +53,18 @@ def test_a_mass_parameter_is_labelled_in_mass_units():
     sc = loads(text)
     assert _param_unit(sc, "mc") == "t"
     assert _param_unit(sc, "r") == "mm"
+
+
+def test_every_help_example_parses_with_its_commands_options():
+    """Each command's help example is a command line its parser accepts (the study example
+    once gave --csv, which `kincas study` does not have) and names a shipped example file."""
+    import shlex
+    from kincas.cli.app import EXAMPLES, _parser
+    from conftest import ROOT
+    for name, lines in EXAMPLES.items():
+        for line in lines:
+            argv = shlex.split(line.split("   (")[0])[1:]
+            ap = _parser(argv)
+            ap.parse_args(argv)  # argparse exits (SystemExit) on an unknown option
+            scene = next(a for a in argv[1:] if a.endswith(".toml"))
+            assert scene.startswith("my_") or (ROOT / scene).exists(), (name, line)

@@ -47,7 +47,7 @@ EXAMPLES = {
     "modes": ["kincas modes examples/sixbar.toml"],
     "optimize": ["kincas optimize examples/forces_vtwin.toml"],
     "tolerance": ["kincas tolerance examples/fairbairn.toml"],
-    "study": ["kincas study examples/study_fourbar.toml --csv designs.csv"],
+    "study": ["kincas study examples/study_fourbar.toml --out designs.csv"],
     "simulate": ["kincas simulate examples/simulate_pendulum_fourbar.toml",
                  "kincas simulate examples/simulate_press.toml --steady"],
     "flywheel": ["kincas flywheel examples/simulate_engine.toml --fluctuation 0.02"],
@@ -75,7 +75,7 @@ def _example(name: str) -> str:
 def _parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
     def raw(prog):  # descriptions and examples as written; a command's help beside its name
         return _Help(prog, max_help_position=28)
-    ap = argparse.ArgumentParser(prog="kincas", description="Kinematics of planar closed-chain mechanisms.",
+    ap = argparse.ArgumentParser(prog="kincas", description="Kinematics and motion of closed-chain mechanisms, planar and spatial.",
                                  formatter_class=raw,
                                  epilog="examples:\n  kincas solve examples/fourbar_coupler.toml --plot fourbar.png\n"
                                         "  kincas solve --help       (each command's options)")
