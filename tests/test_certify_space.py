@@ -180,3 +180,11 @@ def test_stewart_dietmaier_40():
         poses.append(np.ravel([md.points[f"P{k + 1}"] for k in range(6)]))
     gaps = [np.abs(p - q).max() for i, p in enumerate(poses) for q in poses[i + 1:]]
     assert min(gaps) > 1e-6  # 40 distinct assemblies
+
+
+@needs_msolve
+def test_overconstrained_with_inexact_geometry_refused(capsys):
+    """The example spherical four-bar's axes meet at O only to float rounding: as exact
+    rationals it is rigid, so its count would not be the mechanism's: refused, exit 2."""
+    code, out, err = run_cli(capsys, "modes", EXAMPLES / "space_spherical_fourbar.toml", "--certify")
+    assert code == 2 and "overconstrained" in err and len(err.strip().splitlines()) == 1

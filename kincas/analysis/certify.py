@@ -127,6 +127,8 @@ def certify_modes(m: Mechanism, inputs=None, *, threads: int = 1,
     """
     u = _input_vector(m, inputs)
     S = _closure(m, u)
+    if _spatial(m):
+        _check_mobile(m, u, threads, timeout)
     kind, boxes, value = _solve(S, threads, timeout)
     u_r = np.array([S.at.get(i.key, float(v)) for i, v in zip(m.inputs, u)])
     m_r = _rounded_lines(m, S)
@@ -204,6 +206,24 @@ def _closure(m, u):
         from ..core.polynomial_space import closure_space
         return closure_space(m, u)
     return closure(m, u)
+
+
+def _check_mobile(m, u, threads, timeout):
+    """An overconstrained spatial mechanism moves only thanks to special geometry that the
+    scene's floats, taken as exact rationals, may have lost (axes meeting at a point to
+    1e-16 only): then the exact system is rigid, and its count would not be the
+    mechanism's. Without its joint inputs the exact system must keep a motion (positive
+    dimension), else the certified search is refused (`NotPolynomial`, one line)."""
+    from ..core.polynomial_space import closure_space, overconstrained
+    from ..core.polynomial_planar import NotPolynomial
+    if not overconstrained(m) or not any(i.kind in ("joint", "slide") for i in m.inputs):
+        return
+    kind, _, _ = _solve(closure_space(m, u, driven_joints=False), threads, timeout)
+    if kind != "positive":
+        raise NotPolynomial(
+            "the mechanism is overconstrained (it moves thanks to special geometry) and with the "
+            "scene's numbers taken as exact rationals it does not move: give its axes and points "
+            "exactly (e.g. axes as small integers, points on them), or use the multistart search")
 
 
 def _rounded_lines(m: Mechanism, S) -> Mechanism:

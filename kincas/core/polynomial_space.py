@@ -41,7 +41,7 @@ from fractions import Fraction
 
 import numpy as np
 
-from ..errors import ModelError
+from .polynomial_planar import NotPolynomial
 from ..model.mobility import GROUND
 from ..model.space_parts import ON_SECOND
 from .polynomial import Poly, PolySystem, exact, unit
@@ -156,10 +156,18 @@ def matrix(e) -> np.ndarray:
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
-def closure_space(m, u) -> PolySystem:
+def overconstrained(m) -> bool:
+    """More equations than unknowns less inputs: the mechanism moves only thanks to special
+    geometry (a spherical four-bar's axes meeting at one point, Bennett's linkage)."""
+    nq, ng = m.counts()
+    return nq - ng < len(m.inputs)
+
+
+def closure_space(m, u, driven_joints=True) -> PolySystem:
     """The closure equations of the spatial mechanism `m` at inputs `u` as a `PolySystem`
     (module text), with `to_unknowns` / `from_unknowns` mapping a solution to kincas's
-    unknowns and back."""
+    unknowns and back. `driven_joints=False` leaves out the joint and slide inputs'
+    equations (the mechanism free to move: an overconstrained one must keep a motion)."""
     driven = {i.target: float(v) for i, v in zip(m.inputs, u) if i.kind == "parameter"}
     m = m.with_parameters(**driven) if driven else m
     S = PolySystem()
@@ -202,7 +210,8 @@ def closure_space(m, u) -> PolySystem:
             P, Q = (points[n] for n in b.point_names)
             d = [P[i] - Q[i] for i in range(3)]
             S.equations.append(_dot(d, d) - exact(m.value(b.length)) ** 2)
-    inputs = {i.target: float(v) for i, v in zip(m.inputs, u) if i.kind in ("joint", "slide")}
+    inputs = {i.target: float(v) for i, v in zip(m.inputs, u)
+              if i.kind in ("joint", "slide") and driven_joints}
     for j in m.joints:
         S.equations += _joint(S, m, j, frames, points, rel, inputs)
     for sl in m.slides:
@@ -253,13 +262,13 @@ def _joint(S, m, j, frames, points, rel, inputs) -> list:
         return eqs
     if j.type == "universal":
         if any(k.startswith(name + ".angle") for k in inputs):
-            raise ModelError(f"[[inputs]] {name}: the certified search does not take a universal "
+            raise NotPolynomial(f"[[inputs]] {name}: the certified search does not take a universal "
                              f"joint's angle as an input in this version")
         a0, a1 = (_axis(S, ax, f"[[joints]] {name}: axes", False)[0] for ax in j.axes)
         return [_dot(_apply(R1, a0), _apply(R2, a1))]
     angle_in, s_in = f"{name}.angle" in inputs, f"{name}.s" in inputs
     if any(k.startswith(name + ".s") and k != f"{name}.s" for k in inputs):
-        raise ModelError(f"[[inputs]] {name}: the certified search does not take a planar "
+        raise NotPolynomial(f"[[inputs]] {name}: the certified search does not take a planar "
                          f"joint's s1, s2 as inputs in this version")
     a, _ = _axis(S, j.axis, f"[[joints]] {name}: axis", angle_in or s_in)
     if j.type in ("revolute", "cylindrical", "planar"):
