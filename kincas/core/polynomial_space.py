@@ -23,6 +23,9 @@ axis that is not one (|a|^2 not 1 in the rationals) is taken as the nearest rati
 of the unit sphere (stereographic, denominator at most 2^20), and said. A slide input along
 a direction likewise. A parameter input (a Stewart leg's length) enters exactly.
 
+The scene's numbers enter as the shortest decimals of their floats (`exact`: what the scene
+wrote; small coefficients make msolve several times faster than the floats' dyadic rationals).
+
 A solution maps back to kincas's unknowns: r as it is, e from R (Shepperd's method) with
 qw >= 0 (the first non-zero component positive where qw = 0).
 
@@ -44,8 +47,20 @@ import numpy as np
 from .polynomial_planar import NotPolynomial
 from ..model.mobility import GROUND
 from ..model.space_parts import ON_SECOND
-from .polynomial import Poly, PolySystem, exact, unit
+from .polynomial import Poly, PolySystem, unit
 from .tolerances import CERTIFY_DENOMINATOR
+
+
+def exact(v: float) -> Fraction:
+    """A scene's number as the shortest decimal that rounds to its float (what the scene
+    wrote: 0.645275, not the 53-bit dyadic rational of the float, ~1e-17 away). msolve's
+    work grows with the coefficients' size: Dietmaier's platform took 4 times longer with
+    the dyadic rationals; and a direction written (0.6, 0, 0.8) stays exactly (3, 0, 4) / 5.
+
+    >>> exact(0.1), exact(2.0)
+    (Fraction(1, 10), Fraction(2, 1))
+    """
+    return Fraction(repr(float(v)))
 
 
 def direction(v) -> tuple[list[Fraction], bool]:
