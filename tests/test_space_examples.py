@@ -29,7 +29,7 @@ def wrap_deg(a):
 
 
 def test_every_spatial_example_is_described_and_solves(capsys):
-    assert len(SPACE) == 8
+    assert len(SPACE) == 9  # + space_stewart_40 (Dietmaier: tests/test_certify_space.py)
     for path in SPACE:
         text = path.read_text(encoding="utf-8")
         assert text.startswith("#") and tomllib.loads(text)["space"] == "3d"

@@ -69,7 +69,8 @@ def mode_at(m, model, q, u, p, L, picked=None, pts=None, kind=None, **extra) -> 
     s = model.column_scale(L)  # columns scaled to O(1)
     ang = model.quantities([qn for _, qn in angles], q[None, :], u[None, :], p,
                            np.ones((1, len(u))), np.zeros((1, len(u))))[:, 0]
-    det = np.linalg.det(model.jac(q, u, p) * s) if model.nq else 1.0
+    J = model.jac(q, u, p) * s if model.nq else np.eye(1)
+    det = np.linalg.det(J) if J.shape[0] == J.shape[1] else 0.0  # tall (redundant): no sign
     res = float(np.abs(model.residual(q, u, p)).max(initial=0.0) / L)
     return (kind or Mode)(
         q=np.array(q), unknowns=tuple(model.unknown_names),

@@ -126,7 +126,9 @@ def certify_modes(m: Mechanism, inputs=None, *, threads: int = 1,
     ...     assert found.count == 2 and all(md.multiplicity == 1 for md in found)
     """
     u = _input_vector(m, inputs)
-    S = closure(m, u)
+    S = _closure(m, u)
+    if _spatial(m):
+        _check_mobile(m, u, threads, timeout)
     kind, boxes, value = _solve(S, threads, timeout)
     u_r = np.array([S.at.get(i.key, float(v)) for i, v in zip(m.inputs, u)])
     m_r = _rounded_lines(m, S)
@@ -136,7 +138,7 @@ def certify_modes(m: Mechanism, inputs=None, *, threads: int = 1,
     if kind == "positive":
         return CertifiedModes(rounded=S.rounded, positive_dimension=True, inputs=used)
     model, p = model_of(m_r), np.array([v for _, v in m_r.parameters], dtype=float)
-    guess = {k: (m_r.value(x), m_r.value(y)) for k, (x, y) in m_r.guess}
+    guess = {k: tuple(m_r.value(c) for c in xyz) for k, xyz in m_r.guess}
     first = first_pose(model, u_r, p, L, guess)
     picked = model.points(first.q, u_r, p).T.ravel() if first.ok else None
     scale = np.where(S.length, L, 1.0)
@@ -193,9 +195,42 @@ def _solve(S, threads=1, timeout=CERTIFY_TIMEOUT):
     return kind, boxes, value
 
 
+def _spatial(m) -> bool:
+    from ..model.space import SpatialMechanism
+    return isinstance(m, SpatialMechanism)
+
+
+def _closure(m, u):
+    """The polynomial closure equations: planar, or spatial (kincas/core/polynomial_space.py)."""
+    if _spatial(m):
+        from ..core.polynomial_space import closure_space
+        return closure_space(m, u)
+    return closure(m, u)
+
+
+def _check_mobile(m, u, threads, timeout):
+    """An overconstrained spatial mechanism moves only thanks to special geometry that the
+    scene's floats, taken as exact rationals, may have lost (axes meeting at a point to
+    1e-16 only): then the exact system is rigid, and its count would not be the
+    mechanism's. Without its joint inputs the exact system must keep a motion (positive
+    dimension), else the certified search is refused (`NotPolynomial`, one line)."""
+    from ..core.polynomial_space import closure_space, overconstrained
+    from ..core.polynomial_planar import NotPolynomial
+    if not overconstrained(m) or not any(i.kind in ("joint", "slide") for i in m.inputs):
+        return
+    kind, _, _ = _solve(closure_space(m, u, driven_joints=False), threads, timeout)
+    if kind != "positive":
+        raise NotPolynomial(
+            "the mechanism is overconstrained (it moves thanks to special geometry) and with the "
+            "scene's numbers taken as exact rationals it does not move: give its axes and points "
+            "exactly (e.g. axes as small integers, points on them), or use the multistart search")
+
+
 def _rounded_lines(m: Mechanism, S) -> Mechanism:
     """`m` with each slide's line angle as the equations took it (rounded where said)."""
     from dataclasses import replace
+    if _spatial(m):  # spatial slides have directions, not angles
+        return m
     slides = tuple(replace(sl, angle=S.at[f"slide {sl.name}"]) if f"slide {sl.name}" in S.at
                    and S.at[f"slide {sl.name}"] != m.value(sl.angle) else sl for sl in m.slides)
     return m if slides == m.slides else replace(m, slides=slides)
@@ -204,6 +239,8 @@ def _rounded_lines(m: Mechanism, S) -> Mechanism:
 def _unknowns_at(m, S, x, u) -> np.ndarray:
     """kincas's unknowns q at the variables x: angles by atan2, a relative input's link
     within half a turn of its equation's angle (kincas's equation is not modulo 2 pi)."""
+    if S.to_unknowns is not None:
+        return S.to_unknowns(x)
     q = np.array([math.atan2(x[e[3]], x[e[2]]) if e[1] == "angle" else x[e[2]] for e in S.unknowns])
     names = [e[0] for e in S.unknowns]
     for i, v in zip(m.inputs, u):
@@ -219,6 +256,8 @@ def _unknowns_at(m, S, x, u) -> np.ndarray:
 
 def _variables_at(S, q) -> np.ndarray:
     """The polynomial variables at kincas's unknowns q (the inverse of `_unknowns_at`)."""
+    if S.from_unknowns is not None:
+        return S.from_unknowns(q)
     x = np.zeros(len(S.names))
     for e, v in zip(S.unknowns, q):
         if e[1] == "angle":
@@ -261,7 +300,7 @@ def _split_count(m, u, S, c, scale, L, nearest) -> int:
     for sign in (1, -1):
         v = np.array(u, dtype=float)
         v[0] += sign * step
-        kind, boxes, _ = _solve(closure(m, v))
+        kind, boxes, _ = _solve(_closure(m, v))
         if kind == "finite":
             near = [b for b in boxes
                     if np.abs((np.array([float((a + z) / 2) for a, z in b]) - c) / scale).max() <= radius]

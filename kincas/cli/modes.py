@@ -73,12 +73,12 @@ def _certified(m, at):
     constraint that is not polynomial, or no solver."""
     from ..analysis.certify import certify_modes
     from ..analysis.certify_msolve import SolverFailed, SolverMissing
-    from ..core.polynomial_planar import refusal
+    from ..core.polynomial_planar import NotPolynomial, refusal
     why = refusal(m)
     try:
         if why is None:
             return certify_modes(m, at)
-    except (SolverMissing, SolverFailed) as e:
+    except (SolverMissing, SolverFailed, NotPolynomial) as e:
         why = str(e)
     print(f"kincas: --certify: {why}", file=sys.stderr)
     return None

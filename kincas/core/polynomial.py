@@ -184,6 +184,8 @@ class PolySystem:
     rounded: list[str] = field(default_factory=list)
     length: list[bool] = field(default_factory=list)  # per variable: a length (else a ratio)
     at: dict = field(default_factory=dict)  # the values the equations were written at (rounded ones)
+    to_unknowns: object = None  # x -> kincas's q, when not per unknown as in `unknowns` (spatial: R -> e)
+    from_unknowns: object = None  # q -> x, its inverse
 
     def var(self, name: str, length: bool = False) -> Poly:
         self.names.append(name)

@@ -1,0 +1,190 @@
+"""Every assembly of a spatial mechanism, certified (kincas/core/polynomial_space.py).
+
+The counts are known independently and written here: RSSR 2 (the rocker's circle against
+the coupler's sphere: a cos phi + b sin phi = k), a spherical four-bar 2 (a line, the
+intersection of two planes, through a sphere), the spatial slider-crank 2 (a quadratic in
+the slider's travel), a pose with none (0, exit 3), and Dietmaier's Stewart-Gough platform
+with 40 real assemblies (the published count, P. Dietmaier 1998; each one checked here by its
+six leg lengths). The Stewart test runs msolve on 12 unknowns: a few seconds (marked slow)."""
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+import kincas
+import kincas.cli.scene
+from conftest import EXAMPLES, run_cli
+from kincas import Body, Input, Joint, SpatialMechanism
+from kincas.analysis import certify_msolve
+from kincas.core.polynomial_space import closure_space, matrix, quaternion, unit_vector
+from kincas.core.tolerances import ACCEPT
+
+needs_msolve = pytest.mark.skipif(not certify_msolve.available(),
+                                  reason='msolve not installed (pip install "kincas[certify]")')
+
+
+def certified(m, inputs):
+    found = kincas.modes(m, inputs, certify=True)
+    assert found.certified and found.count == len(found) and not found.rejected
+    for md in found:
+        assert md.residual <= ACCEPT
+    return found
+
+
+def rssr(coupler=125.0):
+    return SpatialMechanism(
+        ground={"A": (0, 0, 0), "D": (100, 40, 30)},
+        bodies=[Body("crank", {"A": (0, 0, 0), "B": (15, 0, 0)}),
+                Body.bar("coupler", "B", "C", coupler),
+                Body("rocker", {"D": (100, 40, 30), "C": (100, 40, 90)})],
+        joints=[Joint("revolute", "A", axis=(0, 0, 1)), Joint("revolute", "D", axis=(1, 0, 0))],
+        inputs=[Input.joint("A")])
+
+
+def rssr_count(u, coupler):
+    """C = D + 60 (0, -sin phi, cos phi); |C - B|^2 = L^2 is a cos phi + b sin phi = k."""
+    B, D = np.array([15 * math.cos(u), 15 * math.sin(u), 0.0]), np.array([100.0, 40, 30])
+    w = D - B  # |w + 60 (0, -s, c)|^2 = L^2
+    a, b, k = 120 * w[2], -120 * w[1], coupler ** 2 - w @ w - 3600
+    return 2 if k * k < a * a + b * b else 0
+
+
+@needs_msolve
+def test_rssr_two_assemblies():
+    assert rssr_count(math.pi / 2, 125.0) == 2
+    found = certified(rssr(), {"A.angle": math.pi / 2})
+    assert found.count == 2 and found.rounded == []
+    for md in found:  # both close the coupler and keep C on the rocker's circle
+        B, C = np.array(md.points["B"]), np.array(md.points["C"])
+        assert abs(np.linalg.norm(C - B) - 125) < 1e-9 and abs(C[0] - 100) < 1e-9
+    assert found[0].points["C"][1] != pytest.approx(found[1].points["C"][1])
+
+
+@needs_msolve
+def test_rssr_rounded_input_and_no_assembly(capsys, tmp_path):
+    found = certified(rssr(), {"A.angle": 0.5})  # tan(0.25) is irrational: rounded, and said
+    assert found.count == rssr_count(0.5, 125.0) == 2 and "A.angle" in found.rounded[0]
+    assert rssr_count(math.pi / 2, 30.0) == 0
+    assert certified(rssr(30.0), {"A.angle": math.pi / 2}).count == 0
+
+
+def test_unit_vector_and_quaternion_map():
+    a, same = unit_vector((0.6, 0.0, 0.8))  # 0.6 is not 3/5 in binary; the direction is
+    assert same and a == (Fraction(3, 5), 0, Fraction(4, 5))
+    a, same = unit_vector((1.0, 2.0, 2.5))
+    assert sum(c * c for c in a) == 1 and not same
+    assert np.allclose([float(c) for c in a], np.array([1, 2, 2.5]) / math.sqrt(11.25), atol=1e-11)
+    a, same = unit_vector((0.0, -3.0, 4.0))
+    assert same and a[1] * 5 == -3
+    rng = np.random.default_rng(1)
+    for _ in range(20):
+        e = rng.normal(size=4)
+        e /= np.linalg.norm(e)
+        q = quaternion(matrix(e))
+        assert q[0] >= 0 and np.allclose(q, e * np.sign(e[0]))
+
+
+def spherical_fourbar():
+    """Exact rational geometry (every axis through O exactly): crank about z carrying
+    B = (60, 0, 80), output about (4, 0, 3)/5 carrying C = (0, 100, 0), the coupler's
+    joints' axes along OB and OC."""
+    return SpatialMechanism(
+        ground={"O": (0, 0, 0)},
+        bodies=[Body("crank", {"O": (0, 0, 0), "B": (60, 0, 80)}),
+                Body("coupler", {"B": (60, 0, 80), "C": (0, 100, 0)}),
+                Body("output", {"O": (0, 0, 0), "C": (0, 100, 0)})],
+        joints=[Joint("revolute", "O", axis=(0, 0, 1), name="input", bodies=("ground", "crank")),
+                Joint("revolute", "O", axis=(4, 0, 3), name="out", bodies=("ground", "output")),
+                Joint("revolute", "B", axis=(3, 0, 4)), Joint("revolute", "C", axis=(0, 1, 0))],
+        inputs=[Input.joint("input")])
+
+
+@needs_msolve
+def test_spherical_fourbar_two_assemblies():
+    u = math.pi / 2
+    # independent: C on the sphere |C| = 100, on the plane a.C = a.C0 (the output's circle),
+    # on the plane B(u).C = B0.C0 (the coupler keeps the angle BOC): a line through a sphere
+    B = np.array([60 * math.cos(u), 60 * math.sin(u), 80.0])
+    a = np.array([0.8, 0, 0.6])
+    n1, n2, d1, d2 = a, B, a @ [0, 100, 0], np.array([60, 0, 80.0]) @ [0, 100, 0]
+    M = np.array([n1, n2])
+    p0 = np.linalg.lstsq(M, [d1, d2], rcond=None)[0]  # the line's point nearest O
+    count = 2 if p0 @ p0 < 100 ** 2 else 0
+    found = certified(spherical_fourbar(), {"input.angle": u})
+    assert count == 2 and found.count == 2 and found.rounded == []
+    for md in found:
+        C = np.array(md.points["C"])
+        assert abs(np.linalg.norm(C) - 100) < 1e-9 and abs(a @ C - d1) < 1e-9 and abs(B @ C - d2) < 1e-8
+
+
+@needs_msolve
+def test_spatial_slider_crank_two_assemblies():
+    sc = kincas.cli.scene.load(EXAMPLES / "space_slider_crank.toml")
+    m, u = sc.mechanism, math.pi
+    j = m.joint("slide")
+    C0 = np.array(dict(m.bodies[2].points)["C"], float)
+    a = np.array(j.axis) / np.linalg.norm(j.axis)
+    B = np.array([40 * math.cos(u), 40 * math.sin(u), 0.0])  # |C0 + s a - B|^2 = 150^2
+    w = C0 - B
+    disc = (a @ w) ** 2 - (w @ w - 150 ** 2)
+    found = certified(m, {"A.angle": u})
+    assert disc > 0 and found.count == 2
+    s = sorted(-(a @ w) + k * math.sqrt(disc) for k in (-1, 1))
+    got = sorted(float((np.array(md.points["C"]) - C0) @ a) for md in found)
+    assert np.allclose(got, s, atol=1e-9)
+
+
+@needs_msolve
+def test_no_assembly_exit_3(capsys, tmp_path):
+    src = (EXAMPLES / "space_rssr.toml").read_text().replace("length = 125", "length = 30")
+    f = tmp_path / "short.toml"
+    f.write_text(src)
+    assert rssr_count(0.0, 30.0) == 0  # the scene's pose: the sweep's first, 0 deg
+    code, out, err = run_cli(capsys, "modes", f, "--certify", "--json")
+    assert code == 3 and out["count"] == 0
+
+
+@needs_msolve
+def test_cli_json_three_coordinates(capsys):
+    code, out, err = run_cli(capsys, "modes", EXAMPLES / "space_rssr.toml", "--certify", "--json")
+    assert code == 0 and out["certified"] and out["count"] == 2
+    for md in out["modes"]:
+        assert all(len(xyz) == 3 for xyz in md["points"].values())
+
+
+DIETMAIER = {  # P. Dietmaier (1998): base A_i, platform P_i (its own frame), leg lengths
+    "A": [(0, 0, 0), (1.107915, 0, 0), (0.549094, 0.756063, 0), (0.735077, -0.223935, 0.525991),
+          (0.514188, -0.526063, -0.368418), (0.590473, 0.094733, -0.205018)],
+    "P": [(0, 0, 0), (0.542805, 0, 0), (0.956919, -0.528915, 0), (0.665885, -0.353482, 1.402538),
+          (0.478359, 1.158742, 0.107672), (-0.137087, -0.235121, 0.353913)],
+    "L": [1, 0.645275, 1.086284, 1.503439, 1.281933, 0.771071]}
+
+
+@pytest.mark.slow
+@needs_msolve
+def test_stewart_dietmaier_40():
+    sc = kincas.cli.scene.load(EXAMPLES / "space_stewart_40.toml")
+    m = sc.mechanism
+    assert [m.value(f"l{k + 1}") for k in range(6)] == DIETMAIER["L"]
+    S = closure_space(m, DIETMAIER["L"])
+    assert len(S.names) == 12 and S.rounded == []
+    found = certified(m, {f"l{k + 1}": v for k, v in enumerate(DIETMAIER["L"])})
+    assert found.count == 40  # the published count: 40, all of the complex ones real
+    poses = []
+    for md in found:  # each: six legs of the given lengths (an independent check)
+        for A, P, L, k in zip(DIETMAIER["A"], DIETMAIER["P"], DIETMAIER["L"], range(6)):
+            assert abs(np.linalg.norm(np.array(md.points[f"P{k + 1}"]) - A) - L) < 1e-9
+        poses.append(np.ravel([md.points[f"P{k + 1}"] for k in range(6)]))
+    gaps = [np.abs(p - q).max() for i, p in enumerate(poses) for q in poses[i + 1:]]
+    assert min(gaps) > 1e-6  # 40 distinct assemblies
+
+
+@needs_msolve
+def test_overconstrained_with_inexact_geometry_refused(capsys):
+    """The example spherical four-bar's axes meet at O only to float rounding: as exact
+    rationals it is rigid, so its count would not be the mechanism's: refused, exit 2."""
+    code, out, err = run_cli(capsys, "modes", EXAMPLES / "space_spherical_fourbar.toml", "--certify")
+    assert code == 2 and "overconstrained" in err and len(err.strip().splitlines()) == 1
