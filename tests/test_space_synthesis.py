@@ -28,3 +28,16 @@ def test_optimize_moves_a_spatial_bar_to_a_local_minimum():
     assert 110 < L < 130.5
     c = cost(L)
     assert cost(L - 0.5) > c and cost(L + 0.5) > c  # a minimum, by independent sweeps
+
+
+def test_modes_of_a_tall_spatial_system_are_found_not_a_crash():
+    """`kincas modes` (multistart) on a redundant spatial chain (double Cardan: 22 equations,
+    21 unknowns) raised casadi's 'A not square'; each mode found closes the loops and the
+    scene's own guess is among them."""
+    from kincas.cli.scene import load
+    sc = load(ROOT / "examples" / "space_double_cardan.toml")
+    inputs = {k: np.asarray(v, float)[:1] for k, v in sc.study.inputs.items()}
+    found = kincas.find_modes(sc.mechanism, inputs, starts=64)
+    assert len(found) >= 1 and any(md.from_guess for md in found)
+    assert all(md.residual < 1e-10 for md in found)
+    assert all(len(xyz) == 3 for md in found for xyz in md.points.values())

@@ -36,7 +36,13 @@ def _step_function(model) -> ca.Function:
     def build():
         sym = model.sym
         eq, qs = ca.SX.sym("eq", sym.ng), ca.SX.sym("qs", sym.nq)
-        dq = -ca.solve(sym.Jq, sym.g)
+        if sym.ng > sym.nq:  # a tall consistent system (redundant joints: Bennett, a double
+            # Cardan): the Gauss-Newton step, each equation over its scale, which is Newton's
+            # step wherever the equations are consistent and g_q has full column rank
+            Js, gs = sym.Jq / ca.repmat(eq, 1, sym.nq), sym.g / eq
+            dq = -ca.solve(ca.mtimes(Js.T, Js), ca.mtimes(Js.T, gs))
+        else:
+            dq = -ca.solve(sym.Jq, sym.g)
         size = ca.mmax(ca.fabs(dq) / qs) if sym.nq else ca.SX(0)
         shrink = ca.fmax(1, size / MAX_STEP)
         r = ca.mmax(ca.fabs(sym.g / eq)) if sym.nq else ca.SX(0)
