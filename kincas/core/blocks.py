@@ -152,7 +152,7 @@ def block_change(J0d, J, D, blocks: list[Block]):
     `diagonal_blocks` of the last pose's g_q) and A of J. Below 1 for every block, each
     A0 + t (A - A0), t in [0, 1], is invertible, hence so is J0 + t (J - J0) (block
     triangular): det g_q keeps its sign between the two. A tall block (m x n) takes
-    A0^+ A = (A0'A0)^-1 A0'A: below 1, A0^+ (A0 + t (A - A0)) = I + t (A0^+ A - I) is
+    A0^+ A = (A0'A0)^-1 A0'A, measured by its induced 1-norm: below 1, A0^+ (A0 + t (A - A0)) = I + t (A0^+ A - I) is
     invertible, so every A0 + t (A - A0) keeps full column rank between the two poses."""
     out, at = [ca.SX(0)], 0
     for blk in blocks:
@@ -161,7 +161,11 @@ def block_change(J0d, J, D, blocks: list[Block]):
         A0 = ca.reshape(J0d[at:at + m * n], m, n)
         at += m * n
         M = (_small_solve(A0, J[r, c]) - ca.DM.eye(n)) * ca.repmat(Db.T, n, 1) / ca.repmat(Db, 1, n)
-        out.append(ca.sum1(ca.sum2(ca.fabs(M))))
+        if m > n:  # tall: the induced 1-norm (largest column sum), below 1 just as well; the
+            # sum of all n^2 entries would grow with n and stop a 21-unknown group every degree
+            out.append(ca.mmax(ca.sum1(ca.fabs(M))))
+        else:
+            out.append(ca.sum1(ca.sum2(ca.fabs(M))))
     return ca.mmax(ca.vertcat(*out))
 
 
