@@ -59,3 +59,31 @@ def test_tall_block_sigma_bounds_the_smallest_singular_value():
         sv = np.linalg.svd(A, compute_uv=False)
         lb = float(rel) * max(1.0, np.linalg.norm(A))  # relative to max(1, ||A||_F)
         assert sv[-1] / np.sqrt(6) * (1 - 1e-9) <= lb <= sv[-1] * (1 + 1e-9)
+
+
+def test_spatial_watch_measure_is_scale_free_and_ignores_equation_factors():
+    # A quaternion's norm equation (2 L e) and a revolute's axis equations carry factors of
+    # their own: a group of two quaternion unknowns of the RSSR measured 0.5 at every pose
+    # (a regular group at the WATCH border). The watch measure scales each block's columns
+    # and rows to unit length: independent of the unknowns' units and of L, above
+    # WATCH for that group at every pose (not watched), 0 where the block is singular.
+    from kincas.analysis.continuation import watch_conditioning
+    from kincas.core.assembly import modes
+    from kincas.core.tolerances import WATCH
+    from test_space import rssr
+    m = rssr()
+    model = kincas.model_of(m)
+    th = np.linspace(0, 2 * np.pi, 13)
+    sw = kincas.sweep(m, {"A.angle": th}, report=["C.x"], method="careful")
+    p = np.array([v for _, v in m.parameters], float)
+    J = np.array([model.jac(q, np.array([t]), p) for q, t in zip(sw.q, th)])
+    w = watch_conditioning(model, J, m.size())
+    quat = [i for i, b in enumerate(model.blocks) if len(b.cols) == 2]
+    assert np.allclose(modes(model, J, m.size())[1][:, quat], 0.5) and (w[:, quat] > WATCH).all()
+    rng = np.random.default_rng(5)
+    Jr = J * rng.uniform(0.1, 10, size=(1, 1, J.shape[2]))  # other units for the unknowns, another L
+    assert np.allclose(watch_conditioning(model, Jr, 7.0), w, rtol=1e-10)
+    b = max(model.blocks, key=lambda b: len(b.cols))
+    Js = J[0].copy()
+    Js[np.ix_(b.rows, [b.cols[-1]])] = Js[np.ix_(b.rows, [b.cols[-2]])]  # a column copied: singular
+    assert watch_conditioning(model, Js[None], m.size())[0, list(model.blocks).index(b)] < 1e-12
