@@ -254,7 +254,7 @@ def watch_conditioning(model: Model, J, L) -> np.ndarray:
     unknowns' units and of L (the columns are normalised); positive factors change no rank, so a singular group still measures 0; a planar group's value is unchanged.
     J is g_q at one pose (ng, nq) or at many (n, ng, nq)."""
     cond = np.array(modes(model, J, L)[1], float)
-    kinds = [k for _, k in getattr(model.sym, "unknowns", ())]
+    kinds = model.unknown_kinds
     if "quaternion" not in kinds:
         return cond
     one = J.ndim == 2
