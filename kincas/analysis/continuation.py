@@ -232,7 +232,7 @@ def _passes_singular(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
     position inside it: then Newton may have landed on the other branch through a change
     point with its mode unchanged (branches cross there), and the step must be cut."""
     from .singular import locate_singular
-    c = np.minimum(modes(model, J0, L)[1], modes(model, sol.J, L)[1])
+    c = np.minimum(watch_conditioning(model, J0, L), watch_conditioning(model, sol.J, L))
     watch = np.flatnonzero(c < WATCH)
     watch = watch[np.argsort(c[watch], kind="stable")]  # the likeliest crossing first: any one decides
     scales = model.scales(u0, p) if watch.size else None  # one pose's: shared by every search
@@ -242,6 +242,33 @@ def _passes_singular(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
         if found is not None and 0 < found[2] < 1:
             return True
     return False
+
+
+def watch_conditioning(model: Model, J, L) -> np.ndarray:
+    """Each group's conditioning as `modes` gives it, except that a group with quaternion
+    unknowns (space) has its block's columns, then its rows, scaled to unit length first: a
+    quaternion's norm equation (2 L e), a revolute's axis equations (a half-angle's 1/2) and
+    a quaternion column against a position's (a lever over the size) carry factors of their
+    own that held a regular group's sigma_min / sigma_max at 0.1-0.5 (an RSSR: every pose
+    watched, a singular position searched at every step). The value is independent of the
+    unknowns' units and of L (the columns are normalised); positive factors change no rank, so a singular group still measures 0; a planar group's value is unchanged.
+    J is g_q at one pose (ng, nq) or at many (n, ng, nq)."""
+    cond = np.array(modes(model, J, L)[1], float)
+    kinds = model.unknown_kinds
+    if "quaternion" not in kinds:
+        return cond
+    one = J.ndim == 2
+    Jn, cn = (J[None] if one else J) * model.column_scale(L), cond[None] if one else cond
+    for i, b in enumerate(model.blocks):
+        if len(b.cols) < 2 or not any(kinds[j] == "quaternion" for j in b.cols):
+            continue
+        B = Jn[:, b.rows][:, :, b.cols]
+        tiny = np.finfo(float).tiny
+        B = B / np.maximum(np.linalg.norm(B, axis=1, keepdims=True), tiny)  # columns, then rows
+        B = B / np.maximum(np.linalg.norm(B, axis=2, keepdims=True), tiny)
+        s = np.linalg.svd(B, compute_uv=False)
+        cn[:, i] = s[:, -1] / np.maximum(s[:, 0], np.finfo(float).tiny)
+    return cn[0] if one else cn
 
 
 def _crossed(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:

@@ -218,9 +218,8 @@ class SweepProblem:
 
     def fast_pass(self, compile=None):
         """The compiled pass (every pose it does not accept on the careful path), or None
-        where there is none worth running: a tall system (redundant joints: g_q not square),
-        a kernel too large to pay for itself on this sweep (unless compile is False)."""
-        fast = self.pm.sweeper(self.model, self.names, compile) if self.model.square else None
+        where there is none worth running: a kernel too large to pay for itself on this sweep (unless compile is False)."""
+        fast = self.pm.sweeper(self.model, self.names, compile)
         if fast is None or not (compile is False or fast.worth_it(self.n)):
             return None
         return fast.sweep(self.U, self.p, self.L, self.careful, Ud=self.Ud, Udd=self.Udd,

@@ -32,8 +32,54 @@ import numpy as np
 # --- symbolic solves and measures over the blocks ---
 
 
+def _cholesky(M):
+    """Lower-triangular L with L L' = M for a symmetric positive definite M (no pivoting:
+    stable for a Gram matrix), written out entry by entry, n^3/6 operations."""
+    n = M.size1()
+    L = [[ca.SX(0)] * n for _ in range(n)]
+    for j in range(n):
+        d = M[j, j] - sum((L[j][k] ** 2 for k in range(j)), ca.SX(0))
+        L[j][j] = ca.sqrt(d)
+        for i in range(j + 1, n):
+            L[i][j] = (M[i, j] - sum((L[i][k] * L[j][k] for k in range(j)), ca.SX(0))) / L[j][j]
+    return L
+
+
+def _tri_solve(L, b, lower: bool):
+    """L x = b (lower) or L' x = b (not lower) for the rows of `_cholesky`."""
+    n, x = len(L), [None] * len(L)
+    order = range(n) if lower else range(n - 1, -1, -1)
+    for i in order:
+        others = range(i) if lower else range(i + 1, n)
+        acc = b[i, :]
+        for k in others:
+            acc = acc - (L[i][k] if lower else L[k][i]) * x[k]
+        x[i] = acc / L[i][i]
+    return ca.vertcat(*x)
+
+
+def _tall_solve(A, b):
+    """The least-squares solution of A x = b for a tall A of full column rank (redundant
+    joints: a consistent system, so it is the exact solution at a root): the normal
+    equations A'A x = A'b by Cholesky (Gauss-Newton's step; the rank rules of
+    kincas/core/redundant.py, not this solve, decide that A has full column rank)."""
+    L = _cholesky(ca.mtimes(A.T, A))
+    return _tri_solve(L, _tri_solve(L, ca.mtimes(A.T, b), True), False)
+
+
+def _tall_sigma(A):
+    """A lower bound of a tall A's smallest singular value: sigma_min(A) = sigma_min(L')
+    for A'A = L L', and 1 / ||L^-1||_2 >= 1 / ||L^-1||_F (within sqrt(n) of it)."""
+    L = _cholesky(ca.mtimes(A.T, A))
+    n = len(L)
+    Linv = _tri_solve(L, ca.SX.eye(n), True)
+    return 1 / ca.sqrt(ca.sumsqr(Linv))
+
+
 def _small_solve(A, b):
     n = A.size1()
+    if n > A.size2():
+        return _tall_solve(A, b)
     if n == 1:
         return b / A[0, 0]
     if n == 2:  # Cramer's rule: forward stable in two dimensions, and few operations
@@ -43,8 +89,9 @@ def _small_solve(A, b):
 
 
 def block_solve(J, b, blocks: list[Block]):
-    """J^-1 b (J square with this block structure, b one or more columns), group by group."""
-    n, k = J.size1(), b.size2()
+    """J^-1 b (J with this block structure, b one or more columns), group by group; a tall J
+    (redundant joints, consistent) its least-squares solution, each tall group by `_tall_solve`."""
+    n, k = J.size2(), b.size2()  # n unknowns (a tall J: more equations)
     x = [None] * n
     for blk in blocks:
         rhs = b[blk.rows.tolist(), :]
@@ -67,6 +114,10 @@ def block_measures(J, cs, blocks: list[Block]):
         c = cs[blk.cols.tolist()] if isinstance(cs, (ca.SX, ca.DM)) else ca.DM(np.asarray(cs)[blk.cols])
         A = J[blk.rows.tolist(), blk.cols.tolist()] * ca.repmat(ca.reshape(c, 1, -1), len(blk.rows), 1)
         n, F = A.size1(), ca.sumsqr(A)
+        if n > A.size2():  # tall (redundant joints): no determinant, so no mode (+1)
+            signs.append(ca.SX(1))
+            sig.append(_tall_sigma(A) / ca.fmax(1, ca.sqrt(F)))
+            continue
         d = ca.det(A) if n > 1 else A[0, 0]
         ad = ca.fabs(d)
         if n <= 2:
@@ -83,27 +134,38 @@ def block_measures(J, cs, blocks: list[Block]):
 def diagonal_blocks(J, blocks) -> ca.SX:
     """The entries of J's diagonal blocks, one block after another (column-major each): all
     of g_q that the branch test needs from the last pose (sum of size^2, not nq^2)."""
-    parts = [ca.vec(J[b.rows.tolist(), b.cols.tolist()]) for b in blocks]
+    parts = [ca.vec(J[b.rows.tolist(), b.cols.tolist()]) for b in blocks]  # (rows x cols each)
     return ca.densify(ca.vertcat(*parts)) if parts else ca.SX(0, 1)
 
 
 def diagonal_size(blocks) -> int:
-    return sum(len(b.cols) ** 2 for b in blocks)
+    return sum(len(b.rows) * len(b.cols) for b in blocks)
+
+
+def is_tall(blocks) -> bool:
+    """Whether a block has more equations than unknowns (redundant joints)."""
+    return any(len(b.rows) > len(b.cols) for b in blocks)
 
 
 def block_change(J0d, J, D, blocks: list[Block]):
     """max over blocks of sum |D^-1 (A0^-1 A - I) D| for the diagonal blocks A0 (given as
     `diagonal_blocks` of the last pose's g_q) and A of J. Below 1 for every block, each
     A0 + t (A - A0), t in [0, 1], is invertible, hence so is J0 + t (J - J0) (block
-    triangular): det g_q keeps its sign between the two."""
+    triangular): det g_q keeps its sign between the two. A tall block (m x n) takes
+    A0^+ A = (A0'A0)^-1 A0'A, measured by its induced 1-norm: below 1, A0^+ (A0 + t (A - A0)) = I + t (A0^+ A - I) is
+    invertible, so every A0 + t (A - A0) keeps full column rank between the two poses."""
     out, at = [ca.SX(0)], 0
     for blk in blocks:
         r, c = blk.rows.tolist(), blk.cols.tolist()
-        n, Db = len(c), D[c]
-        A0 = ca.reshape(J0d[at:at + n * n], n, n)
-        at += n * n
+        n, m, Db = len(c), len(r), D[c]
+        A0 = ca.reshape(J0d[at:at + m * n], m, n)
+        at += m * n
         M = (_small_solve(A0, J[r, c]) - ca.DM.eye(n)) * ca.repmat(Db.T, n, 1) / ca.repmat(Db, 1, n)
-        out.append(ca.sum1(ca.sum2(ca.fabs(M))))
+        if m > n:  # tall: the induced 1-norm (largest column sum), below 1 just as well; the
+            # sum of all n^2 entries would grow with n and stop a 21-unknown group every degree
+            out.append(ca.mmax(ca.sum1(ca.fabs(M))))
+        else:
+            out.append(ca.sum1(ca.sum2(ca.fabs(M))))
     return ca.mmax(ca.vertcat(*out))
 
 
@@ -111,4 +173,5 @@ def numeric_signs(J: np.ndarray, blocks: list[Block]) -> np.ndarray:
     """(N, len(blocks)) signs of the blocks' determinants of N matrices J (N, n, n)."""
     if not blocks:
         return np.ones((J.shape[0], 0))
-    return np.stack([np.sign(np.linalg.det(J[:, b.rows][:, :, b.cols])) for b in blocks], axis=1)
+    return np.stack([np.sign(np.linalg.det(J[:, b.rows][:, :, b.cols])) if len(b.rows) == len(b.cols)
+                     else np.ones(J.shape[0]) for b in blocks], axis=1)  # tall: no mode, +1

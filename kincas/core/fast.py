@@ -311,9 +311,12 @@ def _diagonal_signs(d: np.ndarray, blocks) -> np.ndarray:
     (`diagonal_blocks`: each block's entries column-major, one block after another)."""
     out, at = np.empty(len(blocks)), 0
     for i, b in enumerate(blocks):
-        n = len(b.cols)
-        A = d[at:at + n * n]
-        at += n * n
+        n, m = len(b.cols), len(b.rows)
+        A = d[at:at + m * n]
+        at += m * n
+        if m > n:  # tall (redundant joints): no mode, +1 as the kernel gives it
+            out[i] = 1.0
+            continue
         det = A[0] if n == 1 else A[0] * A[3] - A[1] * A[2] if n == 2 else np.linalg.det(A.reshape(n, n))
         out[i] = np.sign(det)
     return out

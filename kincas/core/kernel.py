@@ -4,7 +4,8 @@ Three functions, every linear solve done Assur group by Assur group (kincas/core
 so their size grows with the number of groups, not with nq^3:
 
 - kP: the prediction from the last solved pose (tangent, second-order term);
-- kN: at q, the Newton step g_q^-1 g and the measures that stop Newton (max |g| / L and the
+- kN: at q, the Newton step g_q^-1 g (Gauss-Newton's (g_q'g_q)^-1 g_q' g for a tall group:
+  redundant joints, kincas/core/blocks.py) and the measures that stop Newton (max |g| / L and the
   step's size in radians or lengths / L, each equation and unknown against its own Assur
   group's length L, as on the careful path): nothing else is evaluated at a Newton iterate;
 - kF: once per pose, at the final q: g_q, the tangent dq/du, the residual, the branch test
@@ -31,7 +32,7 @@ import casadi as ca
 from .group_kernel import GroupFunctions, _max_abs
 from .structure import Structure
 from ..model.names import parse_quantity
-from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size
+from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size, is_tall
 from .tolerances import ACCEPT, CORRECTION, JAC_CHANGE, KERNEL_NEAR, MAX_EVALS, TOL  # noqa: F401
 
 RESIDUAL = ACCEPT  # max |g| / L at an accepted pose, as on the careful path
@@ -78,7 +79,7 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
     d, o = ca.densify, {"cse": True}  # cse: one sin and cos per angle, shared by everything
     kL = (structure or Structure(sym)).length_function()
     kP = ca.Function("kP", [q, T0, u0, u, T1, u1], [d(pred)], o)
-    if grouped or (grouped is None and len(blocks) >= GROUPS_APART):
+    if not is_tall(blocks) and (grouped or (grouped is None and len(blocks) >= GROUPS_APART)):
         # one small function per kind of group, the quantities apart
         qd = ca.SX.sym("qd", nq)
         kY = ca.Function("kY", [q, u, p, ud, udd, qd], [ca.densify(given((q, u, p, ud, udd), qd))], o) if report else None

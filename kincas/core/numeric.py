@@ -339,6 +339,11 @@ class Model(FirstPose):
         return [nm for nm, _ in self.sym.unknowns]
 
     @property
+    def unknown_kinds(self) -> list[str]:
+        """Per unknown, its kind ("angle", "length", or "quaternion" in space)."""
+        return [k for _, k in self.sym.unknowns]
+
+    @property
     def dim(self) -> int:
         """Coordinates of a point: 2, or 3 for a spatial mechanism."""
         return self.sym.dim
