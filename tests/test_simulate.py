@@ -415,3 +415,19 @@ def test_textbook_flywheel_two_stroke_engine(capsys):
     assert abs(I_book - 85.07) < 0.01
     assert 64 + fw["inertia"] / 1000 == pytest.approx(I_book, rel=1e-3)   # added on the crank's own 64
     assert fw["estimate"] / 1000 == pytest.approx(I_book, rel=1e-3) and fw["fluctuation"] <= 0.01
+
+
+def test_flywheel_on_a_massless_machine_is_one_line_not_a_traceback(tmp_path):
+    """`kincas flywheel` starts from no added flywheel; where the machine then has no inertia at
+    all its equations of motion are singular: one line naming [simulate] flywheel, exit 2."""
+    import subprocess
+    import sys
+    from conftest import ROOT
+    text = (ROOT / "examples" / "simulate_flywheel_textbook.toml").read_text(encoding="utf-8")
+    assert "inertia = 64000, " in text
+    f = tmp_path / "fw0.toml"
+    f.write_text(text.replace("inertia = 64000, ", ""), encoding="utf-8")
+    p = subprocess.run([sys.executable, "-m", "kincas", "flywheel", str(f), "--fluctuation", "0.01"],
+                       capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert p.returncode == 2 and "Traceback" not in p.stderr, p.stderr[-500:]
+    assert "[simulate] flywheel" in p.stderr and len(p.stderr.strip().splitlines()) <= 2

@@ -92,7 +92,12 @@ def size_flywheel(machine, target: float) -> dict:
     that doubles from the energy method's estimate), and that estimate."""
     from scipy.optimize import brentq
     cs = lambda J: machine.steady(J)[0].fluctuation - target  # noqa: E731
-    st0, _ = machine.steady(0.0)
+    try:
+        st0, _ = machine.steady(0.0)
+    except RuntimeError:  # CVODES: the free input's reduced inertia is singular without a flywheel
+        raise OutputError("[simulate] flywheel: without an added flywheel the free input has no inertia "
+                          "(the flywheel's link and the links it moves are massless), so the search that "
+                          "starts from no flywheel cannot run: give that link an inertia of its own") from None
     if st0.fluctuation <= target:
         J = 0.0
     else:
