@@ -26,6 +26,7 @@ from ..errors import ModelError
 from . import joints as _joints
 from .checks import NAME_RULE, RESERVED, _check, _guess_problems, _number_check, _parts, check_guess  # noqa: F401
 from .loads import Load
+from .lookups import Lookups
 from .mobility import (GROUND, Structure, _check_mobility, _structure, counted_freedoms,  # noqa: F401
                        mobility_problem, needs_rank_test, solved_unknowns)
 from .parts import Input, Link, Num, Param, Slide, _pair, _table, as_number, as_param, is_number  # noqa: F401
@@ -40,7 +41,7 @@ _rank_decision = None
 
 
 @dataclass(frozen=True)
-class Mechanism:
+class Mechanism(Lookups):
     """A planar mechanism: an immutable value, checked on construction.
 
     Every problem found is gathered into one `ModelError`. Changing anything returns a new
@@ -139,141 +140,6 @@ class Mechanism:
             raise ModelError("[inputs]: the rank test needs kincas.core (import kincas)")
         return _rank_decision(self)
 
-    @property
-    def param_values(self) -> dict[str, float]:
-        """The parameters as a dict: name -> value.
-
-        Examples
-        --------
-        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
-        >>> m.param_values
-        {'r': 2.0}
-        """
-        return dict(self.parameters)
-
-    def parameter(self, name: str) -> float:
-        """A parameter's value.
-
-        Parameters
-        ----------
-        name : str
-
-        Returns
-        -------
-        float
-
-        Examples
-        --------
-        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
-        >>> m.parameter("r")
-        2.0
-        """
-        return self.param_values[name]
-
-    def link(self, name: str) -> Link:
-        """The link of that name.
-
-        Parameters
-        ----------
-        name : str
-
-        Returns
-        -------
-        Link
-
-        Examples
-        --------
-        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
-        >>> m.link("crank").point_names
-        ('O', 'A')
-        """
-        return {lk.name: lk for lk in self.links}[name]
-
-    def slide(self, name: str) -> Slide:
-        """The slide of that name.
-
-        Parameters
-        ----------
-        name : str
-
-        Returns
-        -------
-        Slide
-
-        Examples
-        --------
-        >>> m = Mechanism(ground={"O": (0, 0)},
-        ...     links=[Link.bar("crank", "O", "A", 1), Link.bar("rod", "A", "B", 3)],
-        ...     slides=[Slide("B", "ground", name="guide")], inputs=[Input.angle("crank")])
-        >>> m.slide("guide").point
-        'B'
-        """
-        return {s.name: s for s in self.slides}[name]
-
-    @property
-    def ground_points(self) -> tuple[str, ...]:
-        """The ground points' names, in declaration order.
-
-        Examples
-        --------
-        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
-        >>> m.ground_points
-        ('O',)
-        """
-        return tuple(g for g, _ in self.ground)
-
-    @property
-    def moving_points(self) -> tuple[str, ...]:
-        """Points carried by links and not fixed to the ground, in declaration order.
-
-        Examples
-        --------
-        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
-        >>> m.moving_points
-        ('A',)
-        """
-        seen = dict.fromkeys(p for lk in self.links for p in lk.point_names)
-        return tuple(p for p in seen if p not in dict(self.ground))
-
-    @property
-    def mobility(self) -> int:
-        """Degrees of freedom counted from the structure (unknowns minus equations).
-
-        Examples
-        --------
-        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
-        >>> m.mobility
-        1
-        """
-        return self.structure.mobility
-
-    def value(self, v: Num) -> float:
-        """The number `v`, resolving a parameter reference.
-
-        Parameters
-        ----------
-        v : float, str or Param
-
-        Returns
-        -------
-        float
-
-        Examples
-        --------
-        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
-        >>> m.value("r"), m.value(Param("r", 0.5)), m.value(3)
-        (2.0, 1.0, 3.0)
-        """
-        p = as_param(v)
-        return float(v) if p is None else p.scale * self.param_values[p.name]
-
     def size(self) -> float:
         """The mechanism's characteristic length: the largest distance between two points of
         a link or two ground points (1 if there is none).
@@ -300,32 +166,6 @@ class Mechanism:
         return extent if extent > 0 else 1.0
 
     # --- new values ---
-    def with_parameters(self, **values: float) -> "Mechanism":
-        """A new mechanism with some parameters changed.
-
-        Parameters
-        ----------
-        **values : float
-            New values of existing parameters.
-
-        Returns
-        -------
-        Mechanism
-
-        Examples
-        --------
-        >>> m = Mechanism(parameters={"r": 2.0}, ground={"O": (0, 0)},
-        ...     links=[Link.bar("crank", "O", "A", "r")], inputs=[Input.angle("crank")])
-        >>> m.with_parameters(r=3).size(), m.size()
-        (3.0, 2.0)
-        """
-        problems = [f"[parameters] {k}: no such parameter" for k in values if k not in self.param_values]
-        problems += [f"[parameters] {k}: expected a number, got {v!r}" for k, v in values.items()
-                     if not is_number(v)]
-        if problems:
-            raise ModelError(problems)
-        return replace(self, parameters={**self.param_values, **{k: float(v) for k, v in values.items()}})
-
     def with_guess(self, **points: tuple[float, float]) -> "Mechanism":
         """A new mechanism whose guess (which picks the assembly branch) is updated.
 

@@ -12,17 +12,17 @@ from dataclasses import replace
 
 from ..errors import ModelError
 from .checks import _number_check
+from .lookups import Lookups
 from typing import TYPE_CHECKING
 
-from .parts import Num, as_param, is_number
-from .space_parts import Body, Joint, SpatialSlide, _triple
+from .space_parts import Joint, _triple
 
 if TYPE_CHECKING:
     from .space import SpatialMechanism
 from .values import _table
 
 
-class SpatialLookups:
+class SpatialLookups(Lookups):
     """Lookups and new values of a `SpatialMechanism` (the fields are the dataclass's)."""
 
     @property
@@ -55,62 +55,6 @@ class SpatialLookups:
         from .mechanism import Mechanism
         return Mechanism.redundant.fget(self)
 
-    @property
-    def param_values(self) -> dict[str, float]:
-        """The parameters as a dict.
-
-        Examples
-        --------
-        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
-        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
-        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
-        >>> m.param_values
-        {}
-        """
-        return dict(self.parameters)
-
-    def parameter(self, name: str) -> float:
-        """A parameter's value.
-
-        Parameters
-        ----------
-        name : str
-
-        Returns
-        -------
-        float
-
-        Examples
-        --------
-        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
-        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
-        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
-        >>> m.with_parameters() and SpatialMechanism(parameters={"r": 2.0}).parameter("r")
-        2.0
-        """
-        return self.param_values[name]
-
-    def link(self, name: str) -> Body:
-        """The body of that name.
-
-        Parameters
-        ----------
-        name : str
-
-        Returns
-        -------
-        Body
-
-        Examples
-        --------
-        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
-        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
-        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
-        >>> m.link("arm").point_names
-        ('O', 'P')
-        """
-        return {b.name: b for b in self.bodies}[name]
-
     def joint(self, name: str) -> Joint:
         """The joint of that name.
 
@@ -131,93 +75,6 @@ class SpatialLookups:
         'revolute'
         """
         return {j.name: j for j in self.joints}[name]
-
-    def slide(self, name: str) -> SpatialSlide:
-        """The slide of that name.
-
-        Parameters
-        ----------
-        name : str
-
-        Returns
-        -------
-        SpatialSlide
-
-        Examples
-        --------
-        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
-        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
-        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
-        >>> SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body.bar("b", "O", "P", 1)],
-        ...     slides=[SpatialSlide("P", "ground", (0, 0, 0), direction=(1, 0, 0))], guess={"P": (1, 0, 0)}).slide("P").on_line
-        True
-        """
-        return {s.name: s for s in self.slides}[name]
-
-    @property
-    def ground_points(self) -> tuple[str, ...]:
-        """The ground points' names.
-
-        Examples
-        --------
-        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
-        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
-        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
-        >>> m.ground_points
-        ('O',)
-        """
-        return tuple(g for g, _ in self.ground)
-
-    @property
-    def moving_points(self) -> tuple[str, ...]:
-        """Points carried by bodies and not fixed to the ground, in declaration order.
-
-        Examples
-        --------
-        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
-        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
-        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
-        >>> m.moving_points
-        ('P',)
-        """
-        seen = dict.fromkeys(p for b in self.bodies for p in b.point_names)
-        return tuple(p for p in seen if p not in dict(self.ground))
-
-    @property
-    def mobility(self) -> int:
-        """Degrees of freedom counted (unknowns minus equations).
-
-        Examples
-        --------
-        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
-        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
-        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
-        >>> m.mobility
-        1
-        """
-        return self.structure.mobility
-
-    def value(self, v: Num) -> float:
-        """The number `v`, resolving a parameter reference.
-
-        Parameters
-        ----------
-        v : float, str or Param
-
-        Returns
-        -------
-        float
-
-        Examples
-        --------
-        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
-        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
-        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
-        >>> SpatialMechanism(parameters={"r": 2.0}).value("r")
-        2.0
-        """
-        p = as_param(v)
-        return float(v) if p is None else p.scale * self.param_values[p.name]
 
     def _drawn(self):
         """(point, (x, y, z)) as drawn, for every moving point a rigid body carries."""
@@ -308,31 +165,6 @@ class SpatialLookups:
         if out:
             raise ModelError(out)
         return items
-
-    def with_parameters(self, **values: float) -> "SpatialMechanism":
-        """A new mechanism with some parameters changed.
-
-        Parameters
-        ----------
-        **values : float
-
-        Returns
-        -------
-        SpatialMechanism
-
-        Examples
-        --------
-        >>> from kincas import SpatialMechanism, SpatialSlide, Body, Joint, Input
-        >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
-        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
-        >>> SpatialMechanism(parameters={"r": 2.0}).with_parameters(r=3).parameter("r")
-        3.0
-        """
-        bad = [f"[parameters] {k}: no such parameter" for k in values if k not in self.param_values]
-        bad += [f"[parameters] {k}: expected a number" for k, v in values.items() if not is_number(v)]
-        if bad:
-            raise ModelError(bad)
-        return replace(self, parameters={**self.param_values, **{k: float(v) for k, v in values.items()}})
 
     def with_guess(self, **points) -> "SpatialMechanism":
         """A new mechanism whose guess is updated (point -> (x, y, z)).
