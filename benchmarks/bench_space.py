@@ -1,7 +1,8 @@
 """Spatial mechanisms (issue [16]): speed against the planar core, forward kinematics, errors
-against closed forms, and python-solvespace's 3D solver side by side.
+against closed forms, and the peers (python-solvespace, MuJoCo, pinocchio, Exudyn) side by side.
 
-    python benchmarks/bench_space.py
+    python benchmarks/bench_space.py            # writes benchmarks/results_space.md
+    python benchmarks/bench_space.py --quick    # 40 poses, 2 rounds for the peers; prints only
 
 Measures, warm (models built and kernels compiled by a first run), medians of 5 runs:
 1. an RSSR (crank about z, rocker about x, a coupler bar) swept through 3,600 poses by
@@ -15,9 +16,17 @@ Measures, warm (models built and kernels compiled by a first run), medians of 5 
 3. worst position/angle error against closed forms: the RSSR's rocker angle solved by hand
    (a sin phi + b cos phi = c), the double Cardan (out.angle = in.angle), Bennett's linkage
    (th3 = -th1 in examples/space_bennett.toml), the tall ones through the fast pass;
-4. python-solvespace (3D points, distance constraints) on the same RSSR: C from |C - D| = R,
-   |C - D'| = sqrt(R^2 + 1) (D' = D + x: C in the rocker's plane) and |C - B| = lc, with B
-   dragged to the crank's position, each pose solved from the last; time and error.
+4. peers side by side, in one process, interleaved (each round runs every tool once; medians
+   of the rounds): the RSSR over a full crank turn and Bennett's linkage over 100 deg of
+   input, 360 poses each, through kincas (`sweep(..., compile=True)`, and `solve` pose by
+   pose with the last pose as guess), python-solvespace (RSSR: 3D points and distances, B
+   dragged to the crank's position, each pose from the last), MuJoCo (equality constraints,
+   settled by mj_step; and a Gauss-Newton loop on its own constraint rows), pinocchio (RigidConstraintModel, its proximal inverse-geometry
+   iteration) and Exudyn (kinematic tree, loop constraints, SolveStatic): see
+   peers/space_*.py for how each is driven. Error: the worst distance of every point a tool
+   gives (both ends of a closing joint) from the closed forms of peers/space_cases.py, over
+   the size (lc for the RSSR, a for Bennett); a peer that does not import or fails is a row
+   with its error.
 Writes benchmarks/results_space.md. Not a test: nothing here asserts.
 """
 from __future__ import annotations
@@ -38,8 +47,14 @@ import kincas  # noqa: E402
 from kincas import Body, Input, Joint, SpatialMechanism  # noqa: E402
 from kincas.cli.scene import load  # noqa: E402
 
+sys.path.insert(0, str(HERE))
+from peers import module_available  # noqa: E402
+from peers import space_cases as sc  # noqa: E402
+from peers.space_cases import D, LC, R_CRANK, R_ROCK, rssr_by_hand  # noqa: E402
+
 N = 3600
-R_CRANK, R_ROCK, LC, D = 15.0, 60.0, 125.0, np.array([100.0, 40.0, 30.0])
+QUICK = "--quick" in sys.argv[1:]
+N_PEERS, ROUNDS = (40, 2) if QUICK else (360, 5)
 
 
 def rssr():
@@ -49,17 +64,6 @@ def rssr():
                 Body("rocker", {"D": tuple(D), "C": tuple(D + (0, 0, R_ROCK))})],
         joints=[Joint("revolute", "A", axis=(0, 0, 1)), Joint("revolute", "D", axis=(1, 0, 0))],
         inputs=[Input.joint("A")])
-
-
-def rssr_by_hand(th):
-    """The rocker's angle phi (C = D + R (0, -sin phi, cos phi)) from |B - C| = lc:
-    a sin phi + b cos phi = c, the root on the drawing's branch (phi = 0 at th = 0)."""
-    bx, by = R_CRANK * np.cos(th), R_CRANK * np.sin(th)
-    a, b = -2 * R_ROCK * (D[1] - by), 2 * R_ROCK * D[2]
-    c = LC ** 2 - (D[0] - bx) ** 2 - (D[1] - by) ** 2 - D[2] ** 2 - R_ROCK ** 2
-    roots = [np.arctan2(a, b) + s * np.arccos(c / np.hypot(a, b)) for s in (1, -1)]
-    r0 = [np.angle(np.exp(1j * r[0])) for r in roots]
-    return roots[int(np.argmin(np.abs(r0)))]
 
 
 def fourbar():
@@ -125,11 +129,14 @@ def closed_forms():
     return out
 
 
-def solvespace(th, C_true):
-    try:
-        from python_solvespace import Entity, ResultFlag, SolverSystem
-    except ImportError as e:
-        return None, None, f"not installed ({e})"
+# --- peers side by side: each maker returns run() -> (points (n, k, 3) mm, work, residual) ---
+
+
+def solvespace_rssr(th):
+    """python-solvespace: C from |C - D| = R, |C - D'| = sqrt(R^2 + 1) (D' = D + x: C in the
+    rocker's plane) and |C - B| = lc, B dragged to the crank's position; each pose from the last."""
+    from python_solvespace import Entity, ResultFlag, SolverSystem
+
     def run():
         S = SolverSystem()
         wp = Entity.FREE_IN_3D
@@ -139,14 +146,119 @@ def solvespace(th, C_true):
         S.dragged(b, wp)
         c = S.add_point_3d(*(D + (0, 0, R_ROCK)))
         S.distance(c, d, R_ROCK, wp), S.distance(c, d1, math.sqrt(R_ROCK ** 2 + 1), wp), S.distance(c, b, LC, wp)
-        out = np.full((len(th), 3), np.nan)
+        out = np.full((len(th), 1, 3), np.nan)
         for k, t in enumerate(th):
             S.set_params(b.params, (R_CRANK * math.cos(t), R_CRANK * math.sin(t), 0.0))
             if S.solve() == ResultFlag.OKAY:
-                out[k] = S.params(c.params)
-        return out
-    t, C = timed(run, 3)
-    return t, float(np.nanmax(np.abs(C - C_true)) / LC), "ok" if np.isfinite(C).all() else "some poses failed"
+                out[k, 0] = S.params(c.params)
+        return out, None, None
+    return run
+
+
+def kincas_sweep(m, key, x, names):
+    def run():
+        s = kincas.sweep(m, {key: x}, report=[f"{n}.{c}" for n in names for c in "xyz"], compile=True)
+        return np.stack([np.stack([s[f"{n}.{c}"] for c in "xyz"], 1) for n in names], 1), None, s.info.get("fast pass")
+    return run
+
+
+def kincas_solve(m, key, x, names, guess):
+    """kincas.solve pose by pose, each from the last pose's points."""
+    rep = [f"{n}.{c}" for n in names for c in "xyz"]
+
+    def run():
+        g, out = dict(guess), np.empty((len(x), len(names), 3))
+        for k, t in enumerate(x):
+            p = kincas.solve(m, {key: t}, report=rep, guess=g)
+            out[k] = [[p[f"{n}.{c}"] for c in "xyz"] for n in names]
+            g = {n: tuple(out[k, i]) for i, n in enumerate(names)}
+        return out, None, None
+    return run
+
+
+def contenders(th, u):
+    """{(mechanism, tool): maker of run() or the error that stopped it}."""
+    from peers import space_exudyn, space_mujoco, space_pinocchio
+    bennett = load(ROOT / "examples" / "space_bennett.toml").mechanism
+    kb = bennett.inputs[0].key
+    B0, C0 = (x[0] for x in sc.rssr_points([th[0]]))
+    O2, O3, _ = (x[0] for x in sc.bennett_points([u[0]]))
+    makers = {
+        ("RSSR", "kincas.sweep (compiled)"): lambda: kincas_sweep(rssr(), "A.angle", th, ["C"]),
+        ("RSSR", "kincas.solve, pose by pose"): lambda: kincas_solve(rssr(), "A.angle", th, ["C"], {"C": tuple(C0)}),
+        ("RSSR", "python-solvespace"): lambda: solvespace_rssr(th),
+        ("RSSR", "MuJoCo, mj_step until settled"): lambda: space_mujoco.rssr(th),
+        ("RSSR", "MuJoCo, Gauss-Newton on its efc_J"): lambda: space_mujoco.rssr(th, newton=True),
+        ("RSSR", "pinocchio"): lambda: space_pinocchio.rssr(th),
+        ("RSSR", "Exudyn"): lambda: space_exudyn.rssr(th),
+        ("Bennett", "kincas.sweep (compiled)"): lambda: kincas_sweep(bennett, kb, u, ["O2", "O3"]),
+        ("Bennett", "kincas.solve, pose by pose"): lambda: kincas_solve(bennett, kb, u, ["O2", "O3"],
+                                                                      {"O2": tuple(O2), "O3": tuple(O3)}),
+        ("Bennett", "MuJoCo, mj_step until settled"): lambda: space_mujoco.bennett(u),
+        ("Bennett", "MuJoCo, Gauss-Newton on its efc_J"): lambda: space_mujoco.bennett(u, newton=True),
+        ("Bennett", "pinocchio"): lambda: space_pinocchio.bennett(u),
+        ("Bennett", "Exudyn"): lambda: space_exudyn.bennett(u),
+    }
+    needs = {"python-solvespace": "python_solvespace", "MuJoCo": "mujoco", "pinocchio": "pinocchio", "Exudyn": "exudyn"}
+    out = {}
+    for key, make in makers.items():
+        peer = key[1].split(",")[0]
+        missing = module_available(needs[peer]) if peer in needs else None
+        if missing:
+            out[key] = f"not installed ({missing})"
+            continue
+        try:
+            out[key] = make()
+        except Exception as e:  # a peer that cannot build its model is a row with its error
+            out[key] = f"failed to build: {type(e).__name__}: {e}".splitlines()[0]
+    return out
+
+
+def peers():
+    """Interleaved rounds: every tool once per round, warm (a first run apart); medians."""
+    th = np.linspace(0, 2 * np.pi, N_PEERS)
+    u = np.radians(np.linspace(0, 100, N_PEERS))
+    refs = {"RSSR": (np.repeat(sc.rssr_points(th)[1][:, None], 2, 1), LC),
+            "Bennett": (np.stack(sc.bennett_points(u), 1), sc.A_BEN)}
+    runs = contenders(th, u)
+    times, outs = {k: [] for k in runs}, {}
+    for r in range(ROUNDS + 1):
+        for k, run in runs.items():
+            if isinstance(run, str):
+                continue
+            try:
+                t0 = time.perf_counter()
+                out = run()
+                dt = time.perf_counter() - t0
+            except Exception as e:  # a peer that fails mid-sweep: its error, not a hole in the table
+                runs[k] = f"failed: {type(e).__name__}: {e}".splitlines()[0]
+                continue
+            if r:  # round 0 warms up (kernels compiled, models loaded)
+                times[k].append(dt)
+            outs[k] = out
+    rows = []
+    for (mech, tool), run in runs.items():
+        if isinstance(run, str):
+            rows.append((mech, tool, None, None, run))
+            continue
+        pts, work, res = outs[(mech, tool)]
+        ref, size = refs[mech]
+        err = np.linalg.norm(pts - ref[:, :pts.shape[1]], axis=2) / size
+        solved = np.isfinite(err).all(axis=1)
+        note = [f"{int(solved.sum())}/{len(solved)} poses solved"]
+        if tool.startswith("MuJoCo, mj_step"):
+            note.append(f"mj_step {work.mean():.0f} a pose (max {work.max()}), worst |efc_pos| {res.max():.0e} m")
+        elif tool.startswith("MuJoCo, Gauss"):
+            note.append(f"{work.mean():.1f} iterations a pose (max {work.max()}), worst |efc_pos| {res.max():.0e} m")
+        elif tool == "pinocchio":
+            note.append(f"{work.mean():.1f} iterations a pose (max {work.max()})")
+        elif tool == "Exudyn":
+            note.append(f"SolveStatic said solved at {int(work.sum())}")
+        elif tool.startswith("kincas.sweep"):
+            note.append(f"fast pass: {res}")
+        rows.append((mech, tool, float(np.median(times[(mech, tool)])) / len(solved),
+                     float(np.nanmax(err)) if solved.any() else float("nan"), "; ".join(note)))
+    return rows
 
 
 def main():
@@ -154,9 +266,11 @@ def main():
     t3, t2, f3, f2, err3, th, C = sweeps()
     tst, est, l0 = stewart()
     cf = closed_forms()
-    tss, ess, sss = solvespace(th, C)
+    prow = peers()
+    load_end = os.getloadavg()[0]
     lines = ["# Spatial mechanisms: speed and accuracy (benchmarks/bench_space.py)", "",
-             f"Warm medians; load average {load_avg:.1f} on {os.cpu_count()} cores (other processes share the machine).", "",
+             f"Warm medians; load average {load_avg:.1f} at the start, {load_end:.1f} at the end, on "
+             f"{os.cpu_count()} cores (other processes share the machine).", "",
              "| case | time | per pose | error | notes |", "|---|---|---|---|---|",
              f"| RSSR sweep, {N} poses (kincas.sweep, compiled) | {t3 * 1e3:.1f} ms | {t3 / N * 1e6:.2f} us | {err3:.1e} (C vs by hand, /lc) | fast pass: {f3} |",
              f"| planar four-bar sweep, {N} poses (compiled) | {t2 * 1e3:.1f} ms | {t2 / N * 1e6:.2f} us | | fast pass: {f2} |",
@@ -164,14 +278,30 @@ def main():
              f"| Stewart-Gough FK, one pose (kincas.solve with guess) | {tst * 1e3:.2f} ms | | {est:.1e} (P1 vs sqrt(l^2 - d^2), /l) | legs {l0:.2f} -> {l0 + 2:.2f} mm; target < 1 ms |"]
     for name, (e, f) in cf.items():
         lines.append(f"| {name}, 361 poses | | | {e:.1e} rad | fast pass: {f} |")
-    if tss is None:
-        lines.append(f"| python-solvespace RSSR | | | | {sss} |")
-    else:
-        lines.append(f"| python-solvespace RSSR, {N} poses (3D points, distances) | {tss * 1e3:.1f} ms | {tss / N * 1e6:.2f} us | {ess:.1e} (/lc) | {sss}; {tss / t3:.1f}x kincas's time |")
     lines += ["", "Stewart-Gough call: `kincas.solve(m, {\"l1\": l, ..., \"l6\": l}, guess={\"P1\": (x, y, z), ...})`,",
-              "the guess the platform's points at the pose before (legs 2 mm shorter)."]
+              "the guess the platform's points at the pose before (legs 2 mm shorter).", "",
+              f"## Peers side by side ({N_PEERS} poses each; {ROUNDS} interleaved rounds, medians)", "",
+              "RSSR: crank over a full turn; Bennett: input 0 to 100 deg from the drawing. Error: worst distance of",
+              "any point the tool gives (C on coupler and rocker; O2, O3 and L3's end at O4) from the closed form,",
+              "over lc (RSSR) or a (Bennett). Ratio: per-pose time over kincas.sweep's on the same mechanism.", "",
+              "| mechanism | tool | per pose | x kincas.sweep | worst error (/size) | notes |", "|---|---|---|---|---|---|"]
+    base = {m: t for m, tool, t, e, n in prow if tool.startswith("kincas.sweep") and t}
+    for mech, tool, t, e, note in prow:
+        if t is None:
+            lines.append(f"| {mech} | {tool} | | | | {note} |")
+        else:
+            ratio = f"{t / base[mech]:.1f}x" if base.get(mech) else ""
+            lines.append(f"| {mech} | {tool} | {t * 1e6:.1f} us | {ratio} | {e:.1e} | {note} |")
+    lines += ["", "Not compared: python-solvespace on Bennett (its revolute joints need workplanes; not set up",
+              "here). MuJoCo's loop constraints are soft: \"mj_step until settled\" simulates (gravity off, timestep",
+              "1 ms, equality solref 2 ms) until its own residual is under 1e-12 m; \"Gauss-Newton on its efc_J\" is",
+              "a Python Newton loop on MuJoCo's constraint rows (mj_fwdPosition, mj_integratePos). pinocchio: its",
+              "example's proximal KKT iteration (ContactCholeskyDecomposition), the input held by a 1e12 weight.",
+              "Exudyn: kinematic tree + loop constraints, one SolveStatic a pose (Bennett: ignoreSingularJacobian).",
+              "Every peer loop runs in Python, pose by pose, each pose from the last; kincas.sweep is one call."]
     text = "\n".join(lines) + "\n"
-    (HERE / "results_space.md").write_text(text)
+    if not QUICK:
+        (HERE / "results_space.md").write_text(text)
     print(text)
 
 

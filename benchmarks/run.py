@@ -29,7 +29,7 @@ for _p in (str(HERE), str(ROOT)):
         sys.path.insert(0, _p)
 
 PEER_PACKAGES = {"pylinkage": "pylinkage", "numba": "numba", "python-solvespace": "python_solvespace",
-                 "mechanism": "mechanism"}
+                 "mechanism": "mechanism", "mujoco": "mujoco", "pin": "pinocchio", "exudyn": "exudyn"}
 
 
 # --- setup: peers installed by pip, the machine described ---
@@ -64,7 +64,8 @@ def machine() -> list[str]:
             return "not installed"
     commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
                             capture_output=True, text=True).stdout.strip() or "?"
-    dists = ["kincas", "casadi", "numpy", "scipy", "mpmath", "pylinkage", "numba", "python-solvespace", "mechanism"]
+    dists = ["kincas", "casadi", "numpy", "scipy", "mpmath", "pylinkage", "numba", "python-solvespace", "mechanism",
+             "mujoco", "pin", "exudyn"]
     return [f"{platform.platform()}, {os.cpu_count()} cores, Python {platform.python_version()}, "
             f"kincas commit {commit}", ", ".join(f"{d} {ver(d)}" for d in dists)]
 
