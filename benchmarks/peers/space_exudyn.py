@@ -80,7 +80,8 @@ def _local(joints, i, p):
 
 
 def prepare(exu, SC, mbs, tree, drv, st, inputs, outputs):
-    """run() -> (points (n, len(outputs), 3) in mm, 1 where Exudyn said solved (n,), 0 (n,))."""
+    """run() -> (points (n, len(outputs), 3) in mm, NaN where SolveStatic failed; 1 where it said
+    solved (n,); 0 (n,)). A failed pose leaves the next one to start from the last solved."""
     from exudyn.itemInterface import SensorKinematicTree
     sens = [mbs.AddSensor(SensorKinematicTree(objectNumber=tree, linkNumber=i, localPosition=list(p),
                                               storeInternal=True, outputVariableType=exu.OutputVariableType.Position))
@@ -96,7 +97,13 @@ def prepare(exu, SC, mbs, tree, drv, st, inputs, outputs):
         ok = np.zeros(len(inputs), int)
         for k, t in enumerate(inputs):
             mbs.SetObjectParameter(drv, "offset", float(t))
-            ok[k] = bool(mbs.SolveStatic(st))
+            try:
+                ok[k] = bool(mbs.SolveStatic(st))
+            except exu.SolverError:  # a pose it cannot solve is a failed pose (NaN), not the end
+                ok[k] = False
+            if not ok[k]:
+                pts[k] = np.nan
+                continue
             sd.SetODE2Coordinates(sd.GetODE2Coordinates(), exu.ConfigurationType.Initial)
             pts[k] = [np.asarray(mbs.GetSensorValues(s)) / S for s in sens]
         return pts, ok, np.zeros(len(inputs))
