@@ -30,6 +30,13 @@ S = 1e-3  # mm -> m
 TIMESTEP, SOLREF = 1e-3, "0.002 1"
 
 
+# gravity and contacts off (the bars' capsules meet at the joints), a dense constraint Jacobian
+_HEAD = f"""
+  <option timestep="{TIMESTEP}" gravity="0 0 0" jacobian="dense"><flag contact="disable"/></option>
+  <default><geom type="capsule" size="0.004"/><equality solref="{SOLREF}"/></default>
+"""
+
+
 def _v(p):
     return " ".join(f"{x * S:.17g}" for x in p)
 
@@ -43,10 +50,7 @@ def rssr_xml(th0):
     closes the loop at C; a joint equality drives A."""
     B, C = (x[0] for x in sc.rssr_points([th0]))
     return f"""
-<mujoco model="rssr">
-  <option timestep="{TIMESTEP}" gravity="0 0 0" jacobian="dense"><flag contact="disable"/></option>
-  <default><geom type="capsule" size="0.004"/><equality solref="{SOLREF}"/></default>
-  <worldbody>
+<mujoco model="rssr">{_HEAD}  <worldbody>
     <body name="crank" pos="0 0 0">
       <joint name="A" type="hinge" axis="0 0 1"/>
       <geom fromto="0 0 0 {_v(B)}"/>
@@ -76,10 +80,7 @@ def bennett_xml(u0):
     O, z = sc.bennett_frames(sc.TH10_BEN + u0)
     s = 0.5 * sc.A_BEN  # the second point on the axis of O4
     return f"""
-<mujoco model="bennett">
-  <option timestep="{TIMESTEP}" gravity="0 0 0" jacobian="dense"><flag contact="disable"/></option>
-  <default><geom type="capsule" size="0.004"/><equality solref="{SOLREF}"/></default>
-  <worldbody>
+<mujoco model="bennett">{_HEAD}  <worldbody>
     <body name="L1" pos="{_v(O[0])}">
       <joint name="O1" type="hinge" axis="{_a(z[0])}"/>
       <geom fromto="0 0 0 {_v(O[1] - O[0])}"/>
@@ -104,11 +105,10 @@ def bennett_xml(u0):
 </mujoco>"""
 
 
-def prepare(xml, inputs, sites, tol=1e-12, max_steps=5000, chunk=5):
-    """run() -> (points (n, len(sites), 3) in mm, steps per pose (n,), worst |efc_pos| (n,)).
-
-    Per pose: set the drive's target, mj_step in chunks of `chunk` steps until every equality
-    residual is below `tol` (metres / radians) or `max_steps` steps; state carried over."""
+def _prepare(xml, inputs, sites, pose):
+    """run() -> (points (n, len(sites), 3) in mm, work per pose (n,), worst |efc_pos| (n,)):
+    per input, the drive's target set, then pose(mujoco, m, d) -> (work, residual) closes the
+    loop from the state the last pose left."""
     import mujoco
     m = mujoco.MjModel.from_xml_string(xml)
     d = mujoco.MjData(m)
@@ -119,55 +119,46 @@ def prepare(xml, inputs, sites, tol=1e-12, max_steps=5000, chunk=5):
     def run():
         mujoco.mj_resetData(m, d)
         pts = np.empty((len(inputs), len(sid), 3))
-        steps, res = np.zeros(len(inputs), int), np.zeros(len(inputs))
+        work, res = np.zeros(len(inputs), int), np.zeros(len(inputs))
         for k, t in enumerate(inputs):
             m.eq_data[drive, 0] = t
-            n = 0
-            while True:
-                mujoco.mj_step(m, d, chunk)
-                n += chunk
-                r = float(np.abs(d.efc_pos[:d.ne]).max())
-                if r < tol or n >= max_steps:
-                    break
-            mujoco.mj_kinematics(m, d)  # the positions of the state reached, not of the last step's start
+            work[k], res[k] = pose(mujoco, m, d)
             pts[k] = d.site_xpos[sid] / S
-            steps[k], res[k] = n, r
-        return pts, steps, res
+        return pts, work, res
     return run
+
+
+def prepare(xml, inputs, sites, tol=1e-12, max_steps=5000, chunk=5):
+    """Per pose: mj_step in chunks of `chunk` steps until every equality residual is below
+    `tol` (metres / radians) or `max_steps` steps; work = steps."""
+    def settle(mujoco, m, d):
+        n = 0
+        while True:
+            mujoco.mj_step(m, d, chunk)
+            n += chunk
+            r = float(np.abs(d.efc_pos[:d.ne]).max())
+            if r < tol or n >= max_steps:
+                break
+        mujoco.mj_kinematics(m, d)  # the positions of the state reached, not of the last step's start
+        return n, r
+    return _prepare(xml, inputs, sites, settle)
 
 
 def prepare_newton(xml, inputs, sites, tol=1e-15, max_iter=30):
     """The other way to a closed pose with MuJoCo's own pieces: `mj_fwdPosition` (kinematics
     and the constraint rows: `efc_pos`, the violations, and `efc_J`, their Jacobian) and a
     Gauss-Newton step dq = -pinv(efc_J) efc_pos applied by `mj_integratePos` (the ball joint's
-    quaternion stays on its manifold); the drive's row holds the input. Same return as
-    prepare(), with iterations instead of steps."""
-    import mujoco
-    m = mujoco.MjModel.from_xml_string(xml)
-    d = mujoco.MjData(m)
-    drive = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, "drive")
-    sid = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, s) for s in sites]
-    inputs = np.asarray(inputs, float)
-
-    def run():
-        mujoco.mj_resetData(m, d)
-        pts = np.empty((len(inputs), len(sid), 3))
-        its, res = np.zeros(len(inputs), int), np.zeros(len(inputs))
-        for k, t in enumerate(inputs):
-            m.eq_data[drive, 0] = t
-            for i in range(max_iter + 1):
-                mujoco.mj_fwdPosition(m, d)
-                r = d.efc_pos[:d.ne]
-                worst = float(np.abs(r).max())
-                if worst < tol or i == max_iter:
-                    break
-                J = np.asarray(d.efc_J).reshape(-1, m.nv)[:d.ne]  # dense: nefc x nv, row-major
-                dq = -np.linalg.lstsq(J, r, rcond=None)[0]
-                mujoco.mj_integratePos(m, d.qpos, dq, 1.0)
-            pts[k] = d.site_xpos[sid] / S
-            its[k], res[k] = i, worst
-        return pts, its, res
-    return run
+    quaternion stays on its manifold); the drive's row holds the input. work = iterations."""
+    def newton(mujoco, m, d):
+        for i in range(max_iter + 1):
+            mujoco.mj_fwdPosition(m, d)
+            r = d.efc_pos[:d.ne]
+            worst = float(np.abs(r).max())
+            if worst < tol or i == max_iter:
+                return i, worst
+            J = np.asarray(d.efc_J).reshape(-1, m.nv)[:d.ne]  # dense: nefc x nv, row-major
+            mujoco.mj_integratePos(m, d.qpos, -np.linalg.lstsq(J, r, rcond=None)[0], 1.0)
+    return _prepare(xml, inputs, sites, newton)
 
 
 def rssr(th, newton=False):
