@@ -10,6 +10,8 @@
 // before this file): its points relative to the box's centre c, projected on the camera's
 // rows, (x, y) = (right . (p - c), up . (p - c)), are drawn as a planar one's; data-camera
 // keeps the rows (JSON). The mouse turns it (drag) and zooms (wheel); its points are not dragged.
+// Its loads and weights are projected the same way (an arrow keeps the force's own size), and
+// its bodies are drawn farthest first, by the mean depth -(toward . (p - c)) of their points.
 "use strict";
 
 // requests over HTTP to the server that served the page
@@ -177,7 +179,10 @@ function kincasApp(root, transport) {
     const on = p => (p === null || p === undefined || p.some(v => v === null)) ? null
       : [kDot(cam[0], p) - kDot(cam[0], c), kDot(cam[1], p) - kDot(cam[1], c)];
     const dir = d => (d === null || d === undefined || d.some(v => v === null)) ? null : [kDot(cam[0], d), kDot(cam[1], d)];
-    const out = { ...D, xy: D.xy.map(q => q.map(on)),
+    const far = p => (p === null || p === undefined || p.some(v => v === null)) ? null : kDot(cam[2], c) - kDot(cam[2], p);
+    const load = l => ({ ...l, size: l.vector ? Math.hypot(...l.vector) : undefined,  // the force's own size
+      vector: l.vector ? dir(l.vector) : l.vector, at: l.at ? l.at.map(on) : l.at });
+    const out = { ...D, xy: D.xy.map(q => q.map(on)), depth: D.xy.map(q => q.map(far)), loads: D.loads.map(load),
       guides: D.guides.map(g => ({ ...g, through: g.through.map(on), direction: g.direction.map(dir) })) };
     flatCache = [D, key, out];
     return out;
@@ -207,14 +212,17 @@ function kincasApp(root, transport) {
     }
     ctx.stroke(); ctx.setLineDash([]);
   }
-  function arrow(p, d, colour, label) {  // from p along d (pixels)
+  function arrow(p, d, colour, label, heads) {  // from p along d (pixels); heads 2: a moment
     const x = X(p), y = Y(p), ex = x + d[0], ey = y - d[1], L = Math.hypot(d[0], d[1]);
     if (!(L > 2)) return;
     const ux = d[0] / L, uy = -d[1] / L, h = Math.min(10, L / 2);
     ctx.beginPath(); ctx.strokeStyle = colour; ctx.fillStyle = colour; ctx.lineWidth = 2;
     ctx.moveTo(x, y); ctx.lineTo(ex, ey); ctx.stroke();
-    ctx.beginPath(); ctx.moveTo(ex, ey); ctx.lineTo(ex - h * ux - h * 0.4 * uy, ey - h * uy + h * 0.4 * ux);
-    ctx.lineTo(ex - h * ux + h * 0.4 * uy, ey - h * uy - h * 0.4 * ux); ctx.closePath(); ctx.fill();
+    for (let k = 0; k < (heads || 1); k++) {
+      const tx = ex - k * h * ux, ty = ey - k * h * uy;
+      ctx.beginPath(); ctx.moveTo(tx, ty); ctx.lineTo(tx - h * ux - h * 0.4 * uy, ty - h * uy + h * 0.4 * ux);
+      ctx.lineTo(tx - h * ux + h * 0.4 * uy, ty - h * uy - h * 0.4 * ux); ctx.closePath(); ctx.fill();
+    }
     if (label) { ctx.font = "11px sans-serif"; ctx.fillText(label, ex + 4, ey - 4); }
   }
 
@@ -268,7 +276,12 @@ function kincasApp(root, transport) {
         ctx.beginPath(); ctx.arc(X(p), Y(p), 3, 0, 2 * Math.PI); ctx.fillStyle = c.colour; ctx.fill();
       } else line(c.pts, c.colour, 1.2);
     }
-    const order = D.bodies.filter(b => !b.driven).concat(D.bodies.filter(b => b.driven));
+    let order = D.bodies.filter(b => !b.driven).concat(D.bodies.filter(b => b.driven));
+    if (D.space) {  // painter's order: the farthest body first, by the mean depth of its points
+      const depth = b => { const d = b.ring.map(k => D.depth[i][k]);
+        return d.some(v => v === null) ? -Infinity : d.reduce((a, v) => a + v, 0) / d.length; };
+      order = order.map(b => [depth(b), b]).sort((a, b) => b[0] - a[0]).map(x => x[1]);
+    }
     for (const b of order) {
       const pts = b.ring.map(k => xy[k]);
       if (!pts.every(fin)) continue;
@@ -305,13 +318,17 @@ function kincasApp(root, transport) {
   }
 
   function drawLoads(D, xy, i) {
+    const size = l => l.size !== undefined ? l.size : Math.hypot(l.vector[0], l.vector[1]);
     const forces = D.loads.filter(l => l.kind === "force" || l.kind === "weight");
-    const most = Math.max(1e-300, ...forces.map(l => Math.hypot(l.vector[0], l.vector[1])));
+    const most = Math.max(1e-300, ...forces.map(size));
+    const moments = D.loads.filter(l => l.kind === "moment");
+    const mostM = Math.max(1e-300, ...moments.map(size));
     const L = 0.12 * Math.min(mech.width, mech.height);
     for (const l of D.loads) {
       if (l.kind === "force" && fin(xy[l.point])) {
-        arrow(xy[l.point], [L * l.vector[0] / most, L * l.vector[1] / most], "#c0392b",
-              fmt(Math.hypot(l.vector[0], l.vector[1]), 3));
+        arrow(xy[l.point], [L * l.vector[0] / most, L * l.vector[1] / most], "#c0392b", fmt(size(l), 3));
+      } else if (l.kind === "moment" && fin(xy[l.point])) {  // a torque in space: a double-headed arrow
+        arrow(xy[l.point], [L * l.vector[0] / mostM, L * l.vector[1] / mostM], "#c0392b", fmt(size(l), 3), 2);
       } else if (l.kind === "spring" && fin(xy[l.points[0]]) && fin(xy[l.points[1]])) {
         const a = xy[l.points[0]], b = xy[l.points[1]], n = 12, pts = [a];
         const dx = b[0] - a[0], dy = b[1] - a[1], len = Math.hypot(dx, dy) || 1, w = 6 / view.sx;
@@ -322,7 +339,7 @@ function kincasApp(root, transport) {
         pts.push(b); line(pts, "#8e44ad", 1.5);
       } else if (l.kind === "weight" && fin(l.at[i])) {  // m g at the centre of gravity
         arrow(l.at[i], [L * l.vector[0] / most, L * l.vector[1] / most], "#c0392b",
-              l.label + " " + fmt(Math.hypot(l.vector[0], l.vector[1]), 3));
+              l.label + " " + fmt(size(l), 3));
       } else if (l.kind === "torque" && fin(xy[l.point])) {
         torque(xy[l.point], l.value, "#c0392b", fmt(l.value, 3));
       }
