@@ -7,9 +7,10 @@
 // data-pose (the pose shown), data-busy ("1" while a request is out or waiting),
 // data-transform "sx ox oy" (world (x, y) is drawn at canvas pixel (ox + sx x, oy - sx y)).
 // A spatial mechanism (drawing.space) is drawn turned by a camera (views/orbit.js, inlined
-// before this file): its points relative to the box's centre c, projected on the camera's
-// rows, (x, y) = (right . (p - c), up . (p - c)), are drawn as a planar one's; data-camera
-// keeps the rows (JSON). The mouse turns it (drag) and zooms (wheel); its points are not dragged.
+// before this file, as views/draw.js is: the shapes every page draws, shared with the `--html`
+// pages): its points relative to the box's centre c, projected on the camera's rows,
+// (x, y) = (right . (p - c), up . (p - c)), are drawn as a planar one's; data-camera keeps the
+// rows (JSON). The mouse turns it (drag) and zooms (wheel); its points are not dragged.
 // Its loads and weights are projected the same way (an arrow keeps the force's own size), and
 // its bodies are drawn farthest first, by the mean depth -(toward . (p - c)) of their points.
 "use strict";
@@ -202,16 +203,8 @@ function kincasApp(root, transport) {
   const X = p => view.ox + view.sx * p[0], Y = p => view.oy - view.sx * p[1];
   const fin = p => p !== null && p !== undefined && p[0] !== null && p[1] !== null;
 
-  function line(pts, colour, width, dash) {
-    ctx.beginPath(); ctx.setLineDash(dash || []); ctx.strokeStyle = colour; ctx.lineWidth = width;
-    let pen = false;
-    for (const p of pts) {
-      if (!fin(p)) { pen = false; continue; }
-      if (pen) ctx.lineTo(X(p), Y(p)); else ctx.moveTo(X(p), Y(p));
-      pen = true;
-    }
-    ctx.stroke(); ctx.setLineDash([]);
-  }
+  const canvasOf = p => fin(p) ? [X(p), Y(p)] : null;  // (the shapes: views/draw.js)
+  const line = (pts, colour, width, dash) => kPolyline(ctx, pts.map(canvasOf), colour, width, dash);
   function arrow(p, d, colour, label, heads) {  // from p along d (pixels); heads 2: a moment
     const x = X(p), y = Y(p), ex = x + d[0], ey = y - d[1], L = Math.hypot(d[0], d[1]);
     if (!(L > 2)) return;
@@ -248,10 +241,7 @@ function kincasApp(root, transport) {
     if ($(".k-paths").checked) for (const k of D.moving) line(D.xy.map(q => q[k]), owner[k] || INK, 1, [5, 4]);
     const R = Math.max(3, D.r * view.sx);
     for (const k of D.ground) {  // a pivot on a hatched base
-      const p = xy[k]; if (!fin(p)) continue;
-      const x = X(p), y = Y(p), h = 2.5 * R;
-      ctx.beginPath(); ctx.moveTo(x, y); ctx.lineTo(x - 0.7 * h, y + h); ctx.lineTo(x + 0.7 * h, y + h);
-      ctx.closePath(); ctx.fillStyle = "#dddddd"; ctx.fill(); ctx.strokeStyle = INK; ctx.lineWidth = 1; ctx.stroke();
+      const p = xy[k]; if (fin(p)) kPivot(ctx, X(p), Y(p), R, INK);
     }
     if (!st.ok[i]) {
       ctx.globalAlpha = 1; ctx.fillStyle = "#b00"; ctx.font = "14px sans-serif";
@@ -263,12 +253,7 @@ function kincasApp(root, transport) {
       if (!fin(t) || !fin(d)) continue;
       line([[t[0] + g.lo * d[0], t[1] + g.lo * d[1]], [t[0] + g.hi * d[0], t[1] + g.hi * d[1]]], g.colour, 1.2);
       const p = xy[g.point];
-      if (fin(p)) {  // the block
-        ctx.save(); ctx.translate(X(p), Y(p)); ctx.rotate(-Math.atan2(d[1], d[0]));
-        ctx.fillStyle = "#f2f2f2"; ctx.strokeStyle = INK; ctx.lineWidth = 1.2;
-        ctx.fillRect(-2 * R, -1.4 * R, 4 * R, 2.8 * R); ctx.strokeRect(-2 * R, -1.4 * R, 4 * R, 2.8 * R);
-        ctx.restore();
-      }
+      if (fin(p)) kBlock(ctx, X(p), Y(p), -Math.atan2(d[1], d[0]), R, INK);  // the block
     }
     for (const c of (D.joints && D.joints[i]) || []) {  // gears, racks, cams
       if (c.pts.length === 1) {
@@ -284,22 +269,14 @@ function kincasApp(root, transport) {
     }
     for (const b of order) {
       const pts = b.ring.map(k => xy[k]);
-      if (!pts.every(fin)) continue;
-      if (pts.length >= 3) {
-        ctx.beginPath(); pts.forEach((p, j) => j ? ctx.lineTo(X(p), Y(p)) : ctx.moveTo(X(p), Y(p)));
-        ctx.closePath(); const a = ctx.globalAlpha; ctx.globalAlpha = 0.45 * a; ctx.fillStyle = b.colour; ctx.fill();
-        ctx.globalAlpha = a; ctx.strokeStyle = b.colour; ctx.lineWidth = 2.5; ctx.stroke();
-      } else {
-        ctx.lineCap = "round"; line(pts, b.colour, 7); ctx.lineCap = "butt";
-      }
+      if (pts.every(fin)) kBody(ctx, pts.map(canvasOf), b.colour);
     }
     if ($(".k-forces").checked) { drawLoads(D, xy, i); drawForces(D, xy, i); }
     if ($(".k-centres").checked) drawCentres(st, i);
     for (let k = 0; k < D.names.length; k++) {  // joints and points, with their names
       const p = xy[k]; if (!fin(p)) continue;
       const hot = dragging && dragging.k === k;
-      ctx.beginPath(); ctx.arc(X(p), Y(p), hot ? 6 : 4, 0, 2 * Math.PI);
-      ctx.fillStyle = hot ? "#ffd24d" : "white"; ctx.fill(); ctx.strokeStyle = INK; ctx.lineWidth = 1.3; ctx.stroke();
+      kJoint(ctx, X(p), Y(p), hot ? 6 : 4, hot ? "#ffd24d" : "white", INK);
       ctx.fillStyle = INK; ctx.font = "11px sans-serif"; ctx.fillText(D.names[k], X(p) + 7, Y(p) - 7);
     }
     ctx.globalAlpha = 1;
