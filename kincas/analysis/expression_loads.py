@@ -43,10 +43,10 @@ def sweep_with_expressions(m, inputs, expressions: dict, *, angle: float = 1.0, 
     names = list(report) if report is not None else None
     if not names or not expressions:
         return sweep(m, inputs, report=report, **kw)
-    sym = model_of(m).sym
-    if sym.check_names(names):  # the sweep names the bad quantity as usual
+    model = model_of(m)
+    if model.check_names(names):  # the sweep names the bad quantity as usual
         return sweep(m, inputs, report=report, **kw)
-    loaded = load_dependence(sym, names, list(expressions))
+    loaded = load_dependence(model, names, list(expressions))
     for n, on in loaded.items():
         e = expressions[on[0]]
         if parse_quantity(n)[0] == "sens":
@@ -62,25 +62,25 @@ def sweep_with_expressions(m, inputs, expressions: dict, *, angle: float = 1.0, 
     sw = sweep(m, inputs, report=[n for n in names if n not in loaded], **kw)
     if not loaded:
         return sw
-    got = _evaluate(sym, m, sw, list(loaded), expressions, angle, loaded_function)
+    got = _evaluate(loaded_function(model, list(loaded), expressions, angle), m, sw, list(loaded))
     sw.values = {n: got[n] if n in got else sw.values[n] for n in names}
     return sw
 
 
-def _evaluate(sym, m, sw, names, expressions, angle, loaded_function) -> dict:
-    """The force quantities `names` at every solved pose of `sw` (NaN elsewhere)."""
+def _evaluate(f, m, sw, names) -> dict:
+    """The force quantities `names` (f: `loaded_function`) at every solved pose of `sw` (NaN
+    elsewhere): the model's inputs and parameters in the mechanism's order."""
     n = len(sw.status)
     out = {k: np.full(n, np.nan) for k in names}
     idx = np.flatnonzero(sw.ok & np.all(np.isfinite(sw.q), axis=1))
     if not idx.size:
         return out
+    keys = [i.key for i in m.inputs]
     cols = lambda d: np.array([np.broadcast_to(np.asarray(d[k], float), (n,))[idx]  # noqa: E731
-                               for k in sym.ukeys]).reshape(sym.nu, idx.size)
+                               for k in keys]).reshape(len(keys), idx.size)
     U, Ud, Udd = cols(sw.inputs), cols(sw.rates), cols(sw.accelerations)
-    p = np.array([float(m.param_values[k]) for k in sym.pnames])
-    P = np.tile(p[:, None], idx.size)
-    f = loaded_function(sym, names, expressions, angle).map(idx.size)
-    vals = np.asarray(f(sw.q[idx].T, U, P, Ud, Udd, np.full((1, idx.size), np.nan)))
+    P = np.tile(np.array([float(v) for _, v in m.parameters])[:, None], idx.size)
+    vals = np.asarray(f.map(idx.size)(sw.q[idx].T, U, P, Ud, Udd, np.full((1, idx.size), np.nan)))
     for i, k in enumerate(names):
         out[k][idx] = vals[i]
     return out

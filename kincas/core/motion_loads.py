@@ -185,14 +185,15 @@ def substituted(sym, q, u, ud, t, p, expressions: dict, k: float):
     return out
 
 
-def load_dependence(sym, names: list[str], hidden: list[str]) -> dict[str, list[str]]:
-    """Which of the quantities `names` depend on the parameters `hidden` (those standing for
-    expressions), and on which: name -> hidden parameters (only names that depend on some).
-    Read off the symbolic graph: kinematics never do; efforts, reactions, shaking forces and
-    contact forces do where the load acts on them."""
+def load_dependence(model, names: list[str], hidden: list[str]) -> dict[str, list[str]]:
+    """Which of the quantities `names` of a model (kincas.core.numeric.Model) depend on the
+    parameters `hidden` (those standing for expressions), and on which: name -> hidden
+    parameters (only names that depend on some). Read off the symbolic graph: kinematics never
+    do; efforts, reactions, shaking forces and contact forces do where the load acts on them."""
     import casadi as ca
     if not names or not hidden:
         return {}
+    sym = model.sym
     q, u, p, ud, udd = (ca.SX.sym(n, k) for n, k in (("q", sym.nq), ("u", sym.nu), ("p", sym.np),
                                                      ("ud", sym.nu), ("udd", sym.nu)))
     rows = sym.quantity_function(list(names))(q, u, p, ud, udd)
@@ -204,16 +205,23 @@ def load_dependence(sym, names: list[str], hidden: list[str]) -> dict[str, list[
     return out
 
 
-def loaded_function(sym, names: list[str], expressions: dict, k: float):
+def loaded_function(model, names: list[str], expressions: dict, k: float):
     """f(q, u, p, u', u'', t) -> the quantities `names` with every expression's parameter
     replaced by the expression at that state (kincas/core/dynamics.py's kinetostatics with
-    the loads as they are at the pose)."""
+    the loads as they are at the pose); built once per model, names and expressions."""
     import casadi as ca
-    q, u, p, ud, udd = (ca.SX.sym(n, k_) for n, k_ in (("q", sym.nq), ("u", sym.nu), ("p", sym.np),
-                                                      ("ud", sym.nu), ("udd", sym.nu)))
-    t = ca.SX.sym("t")
-    p_eff = substituted(sym, q, u, ud, t, p, expressions, k)
-    return ca.Function("loaded", [q, u, p, ud, udd, t], [sym.quantity_function(list(names))(q, u, p_eff, ud, udd)])
+
+    def build():
+        sym = model.sym
+        q, u, p, ud, udd = (ca.SX.sym(n, k_) for n, k_ in (("q", sym.nq), ("u", sym.nu), ("p", sym.np),
+                                                          ("ud", sym.nu), ("udd", sym.nu)))
+        t = ca.SX.sym("t")
+        p_eff = substituted(sym, q, u, ud, t, p, expressions, k)
+        rows = sym.quantity_function(list(names))(q, u, p_eff, ud, udd)
+        return ca.Function("loaded", [q, u, p, ud, udd, t], [rows])
+    key = ("loaded", tuple(names), tuple((n, e.text, e.where) for n, e in expressions.items()),
+           tuple((n, tuple(v)) for e in expressions.values() for n, v in sorted(e.data.items())), k)
+    return model.memo(key, build)
 
 
 def data_lists(raw, where: str = "[data]") -> dict[str, list[float]]:
