@@ -35,6 +35,7 @@ CHILD = textwrap.dedent("""
     print("compiling", flush=True)
     if sys.argv[1] == "sigint":
         time.sleep(60)                     # Ctrl-C comes from the test
+    sys.stdin.readline()                   # the test has seen the compiler running: exit
 """)
 
 
@@ -55,7 +56,7 @@ def test_exit_mid_compile_kills_the_compiler_and_leaves_nothing(tmp_path, how):
     env = {**os.environ, "KINCAS_CACHE": str(cache), "CC": str(cc), "KINCAS_TEST_PIDFILE": str(pidfile)}
     env.pop("KINCAS_NO_COMPILE", None)
     proc = subprocess.Popen([sys.executable, "-c", CHILD, how], cwd=ROOT, env=env, text=True,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     pid = None
     try:
         assert proc.stdout.readline().strip() == "compiling", proc.stderr.read()
@@ -64,6 +65,9 @@ def test_exit_mid_compile_kills_the_compiler_and_leaves_nothing(tmp_path, how):
         t0 = time.monotonic()
         if how == "sigint":
             proc.send_signal(signal.SIGINT)
+        else:
+            proc.stdin.write("exit\n")
+            proc.stdin.flush()
         proc.wait(timeout=30)
         took = time.monotonic() - t0
         err = proc.stderr.read()
