@@ -338,3 +338,23 @@ def test_weights_and_an_actuators_effort_are_drawn_in_the_app():
     u = (p - g) / np.linalg.norm(p - g, axis=1)[:, None]
     np.testing.assert_allclose(np.array(e["vectors"], float), column(st, "effort(stroke)")[:, None] * u,
                                rtol=1e-9, atol=1e-9)
+
+
+def test_the_live_page_and_the_html_pages_draw_from_one_shared_script():
+    """views/draw.js is the one source of the shapes (pivots, blocks, bodies, joints): inlined
+    whole in the offline `--html` pages (planar and spatial: no script is fetched) and served
+    ahead of the live page's script; none of the three keeps a copy of its own."""
+    import kincas.views.html as html
+    import kincas.views.html3d as html3d
+    from kincas.views.live import asset
+    shared = (ROOT / "kincas" / "views" / "draw.js").read_text(encoding="utf-8")
+    sc = load(FOURBAR)
+    page = html.html_page(sc.mechanism, sc.run(), sc)
+    space = load(ROOT / "examples" / "space_rssr.toml")
+    page3 = html.html_page(space.mechanism, space.run(), space)
+    for text in (page, page3, asset("app.js")):
+        assert text.count(shared) == 1 and "<script src" not in text
+    own = [(ROOT / "kincas" / "views" / "live" / "app.js").read_text(encoding="utf-8"),
+           html._MECHANISM, html3d.MECHANISM_3D]
+    for source in own:  # the pivot's base and the block's rectangle are drawn only in draw.js
+        assert "0.7 * h" not in source and "fillRect(-2 * R" not in source

@@ -237,3 +237,106 @@ def test_a_spatial_scene_loads_in_3d_and_a_drag_turns_the_view(browser):
     finally:
         proc.terminate()
         proc.wait(timeout=10)
+
+
+CROSSING = """
+title = "two cranks crossing in the isometric view"
+space = "3d"
+units = { length = "mm", angle = "deg", time = "s" }
+gravity = [0, 0, -9810]
+
+[ground]
+ON = [90, 40, 10]
+OF = [0, 0, 0]
+
+[links]   # `near` is declared (and was drawn) first, though it is the nearer of the two
+near = { points = { ON = [90, 40, 10], QN = [90, 40, 70] } }
+far  = { points = { OF = [0, 0, 0], PF = [100, 0, 0] }, mass = 0.001 }
+
+[[joints]]
+type = "revolute"
+point = "ON"
+axis = [1, 0, 0]
+[[joints]]
+type = "revolute"
+point = "OF"
+axis = [0, 0, 1]
+
+[[loads]]
+point = "PF"
+force = [0, -10, -20]
+
+[[inputs]]
+joint = "ON"
+value = 0
+[[inputs]]
+joint = "OF"
+value = 0
+
+[output]
+report = ["PF.x", "effort(OF.angle)"]
+"""
+
+PIXEL = "const c = arguments[0].getContext('2d'); return Array.from(c.getImageData(arguments[1], arguments[2], 1, 1).data);"
+
+
+def _rgb(hexa: str) -> np.ndarray:
+    return np.array([int(hexa[k:k + 2], 16) for k in (1, 3, 5)], float)
+
+
+def _near_colour(d, canvas, xy, colour, r=2) -> bool:
+    """Whether a pixel within r of canvas pixel xy has `colour` (antialiasing aside)."""
+    want = _rgb(colour)
+    for dx in range(-r, r + 1):
+        for dy in range(-r, r + 1):
+            px = d.execute_script(PIXEL, canvas, int(round(xy[0])) + dx, int(round(xy[1])) + dy)
+            if np.abs(np.array(px[:3], float) - want).max() < 30:
+                return True
+    return False
+
+
+def test_a_spatial_page_draws_nearer_links_over_farther_ones_and_the_force_arrows(browser, tmp_path):
+    """Painter's order by mean depth: where the two bars cross on the screen the nearer one's
+    colour shows, whatever their order in the scene. With `forces` ticked, the load on PF is an
+    arrow along its projected direction (drawn like the links: the camera's rows)."""
+    scene = tmp_path / "crossing.toml"
+    scene.write_text(CROSSING, encoding="utf-8")
+    proc, url, _ = serve(scene)
+    try:
+        browser.get_log("browser")
+        browser.get(url)
+        settle(browser)
+        app = browser.find_element("id", "kincas-app")
+        canvas = browser.find_element("css selector", "canvas.k-mech")
+        D = state_now(url)["drawing"]
+        cam = np.array(json.loads(app.get_attribute("data-camera")))
+        sx, ox, oy = map(float, app.get_attribute("data-transform").split())
+        c = np.mean(np.array(D["box"], float), axis=0)
+        world = np.array(D["xy"], float)[0]
+        at = {n: world[k] for k, n in enumerate(D["names"])}
+
+        def pixel(p):
+            x, y = cam[:2] @ (np.asarray(p, float) - c)
+            return np.array([ox + sx * x, oy - sx * y])
+
+        # where the bars cross on the screen: F(s) = N(t), and N is nearer there
+        a, b, p, q = pixel(at["OF"]), pixel(at["PF"]), pixel(at["ON"]), pixel(at["QN"])
+        s, t = np.linalg.solve(np.stack([b - a, -(q - p)], axis=1), p - a)
+        assert 0.2 < s < 0.8 and 0.2 < t < 0.8
+        depth = lambda w: -cam[2] @ (w - c)  # noqa: E731
+        assert depth(at["ON"] + t * (at["QN"] - at["ON"])) < depth(at["OF"] + s * (at["PF"] - at["OF"]))
+        colour = {bd["name"]: bd["colour"] for bd in D["bodies"]}
+        cross = a + s * (b - a)
+        assert _near_colour(browser, canvas, cross, colour["near"], r=0)
+        assert not _near_colour(browser, canvas, cross, colour["far"], r=0)
+        # the load's arrow: from PF along the projected force, 12 % of the canvas long
+        f = cam[:2] @ np.array([0.0, -10, -20])
+        u = np.array([f[0], -f[1]]) / np.hypot(*f)
+        mid = b + 0.06 * min(canvas.get_property("width"), canvas.get_property("height")) * u
+        assert not _near_colour(browser, canvas, mid, "#c0392b")
+        browser.find_element("css selector", "input.k-forces").click()
+        assert _near_colour(browser, canvas, mid, "#c0392b")
+        assert not severe(browser)
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)

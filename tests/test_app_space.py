@@ -84,3 +84,43 @@ def test_a_fixed_joint_input_edited_in_the_page_is_written_back_to_the_toml():
     again = loads(sess.toml())
     (k2,) = again.study.inputs
     np.testing.assert_allclose(np.degrees(np.asarray(again.study.inputs[k2], float)), [75.0], atol=1e-9)
+
+
+def test_a_spatial_page_gets_its_loads_and_weights_in_space():
+    """The live page projects what it is given: a force as its vector in space, a torque as a
+    moment vector, each body's weight m g at its centre of gravity carried by the body's motion
+    (here a plate turning about z by theta: its cg, off the plate's plane, at Rz(theta) cg)."""
+    text = """
+space = "3d"
+units = { length = "mm", angle = "deg", time = "s" }
+gravity = [0, 0, -9810]
+[ground]
+O = [0, 0, 0]
+[links]
+plate = { points = { O = [0, 0, 0], P = [100, 0, 0], R = [0, 30, 0] }, mass = 0.002, cg = [50, 10, 5] }
+[[joints]]
+type = "revolute"
+point = "O"
+axis = [0, 0, 1]
+[[loads]]
+point = "P"
+force = [0, -10, -20]
+[[loads]]
+link = "plate"
+torque = [0, 0, 7]
+[[inputs]]
+joint = "O"
+sweep = { from = 0, to = 90, steps = 4 }
+[output]
+report = ["effort(O.angle)"]
+"""
+    d = Session(loads(text), "plate.toml", text).live.state()["drawing"]
+    by = {ld["kind"]: ld for ld in d["loads"]}
+    assert by["force"]["vector"] == [0, -10, -20] and d["names"][by["force"]["point"]] == "P"
+    assert by["moment"]["vector"] == [0, 0, 7] and d["names"][by["moment"]["point"]] == "O"
+    np.testing.assert_allclose(by["weight"]["vector"], [0, 0, -0.002 * 9810], rtol=1e-12)
+    th = np.radians([0, 30, 60, 90])
+    want = np.stack([50 * np.cos(th) - 10 * np.sin(th), 50 * np.sin(th) + 10 * np.cos(th), np.full(4, 5.0)], axis=1)
+    np.testing.assert_allclose(np.array(by["weight"]["at"], float), want, atol=1e-9)
+    (eff,) = d["forces"]
+    assert eff["kind"] == "effort" and d["names"][eff["point"]] == "O" and len(eff["values"]) == 4

@@ -90,13 +90,36 @@ def test_ctrl_c_stops_a_long_tolerance_analysis(tmp_path):
     assert_interrupted(proc, waited, err)
 
 
+# `python -m kincas` with a hook that says on standard output when each start begins: the
+# test interrupts once the starts are under way, however long imports and setup take on a
+# loaded machine (a fixed sleep once fell in them: the interrupt hit `import kincas`, before
+# the command line could answer it, and gave a traceback and exit -2)
+STARTS_HOOK = """
+import runpy, sys
+import kincas.synthesis.multistart as ms
+call, n = ms._Start.__call__, [0]
+def announced(self, x):
+    n[0] += 1
+    print(f"start {n[0]}", flush=True)
+    return call(self, x)
+ms._Start.__call__ = announced
+sys.argv = ["kincas", *sys.argv[1:]]
+runpy.run_module("kincas", run_name="__main__", alter_sys=True)
+"""
+
+
 def test_ctrl_c_stops_a_multistart_optimisation(tmp_path):
     # 3,000 starts: about two minutes; most of it inside IPOPT, which must not swallow Ctrl-C
     scene = write_scene(tmp_path, (EXAMPLES / "synthesis_function.toml").read_text(encoding="utf-8"))
-    proc = kincas("optimize", scene, "--starts", "3000")
-    # 5 s: the starts are surely under way (in a fresh venv on a loaded machine, 3.5 s once fell
-    # in the setup, and the process did not exit within 10 s: noted on issue [15], not masked here)
-    waited, err = interrupt(proc, after=5.0)
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen([sys.executable, "-c", STARTS_HOOK, "optimize", str(scene), "--starts", "3000"],
+                            cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    for line in proc.stdout:  # the first start has run through IPOPT: the loop is under way
+        if line.strip() == "start 2":
+            break
+    else:
+        pytest.fail(f"the starts never began: {proc.communicate()}")
+    waited, err = interrupt(proc, after=0.2)  # a few starts on (some 40 ms each, mostly in IPOPT)
     assert_interrupted(proc, waited, err)
 
 

@@ -20,9 +20,6 @@ from conftest import EXAMPLES, dump_toml, run_cli, write_scene
 KINDS = list(cf.CLOSED_FORMS)  # one closed form per example, named as the file
 # spatial scenes (space = "3d") have their own closed forms: tests/test_space_examples.py
 SHIPPED = sorted(p for p in EXAMPLES.glob("*.toml") if not p.stem.startswith(("space_", "simulate_space_")))
-# loads written as expressions of the state: only `kincas simulate` evaluates them (`kincas
-# solve` refuses such a scene); tests/test_simulate.py runs these
-SIMULATE_ONLY = {"simulate_engine", "simulate_press", "simulate_flywheel_textbook"}
 
 POSITION_TOL = 1e-9  # relative to the size of the mechanism
 ANGLE_TOL_RAD = 1e-9  # the same as an angle: a link of size L turned by 1e-9 rad moves by 1e-9 L
@@ -417,7 +414,7 @@ def test_sweep_out_of_range(capsys, tmp_path, make):
     assert_rates({"values": {k: v[ok] for k, v in out["values"].items()}}, rates)
 
 
-@pytest.mark.parametrize("path", [p for p in SHIPPED if p.stem not in SIMULATE_ONLY], ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda p: p.stem)
 def test_shipped_example_solves(capsys, path):
     """Every example as shipped: exit 0, the report's quantities, one entry per pose."""
     scene = cf.load_scene(path)

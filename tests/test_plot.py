@@ -21,10 +21,8 @@ from kincas.views.plot import draw, geometry, new_figure  # noqa: E402
 from kincas.cli.scene import load  # noqa: E402
 
 SIZE, DPI = (4.0, 3.0), 80
-# planar pictures; spatial scenes (space_*.toml) are drawn in a projection (tests of the 3D views);
-# loads written as expressions of the state are solved only by kincas simulate (test_simulate.py)
-EXAMPLE_FILES = sorted(p for p in EXAMPLES.glob("*.toml")
-                       if not p.stem.startswith(("space_", "simulate_space_")) and p.stem not in ("simulate_engine", "simulate_press", "simulate_flywheel_textbook"))
+# planar pictures; spatial scenes (space_*.toml) are drawn in a projection (tests of the 3D views)
+EXAMPLE_FILES = sorted(p for p in EXAMPLES.glob("*.toml") if not p.stem.startswith(("space_", "simulate_space_")))
 
 
 # --- helpers: render, find pixels ---

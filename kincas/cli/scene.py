@@ -80,13 +80,13 @@ class Scene:
         """Sweep the mechanism as the scene says. The Sweep is Python's: angles in RADIANS
         whatever the scene's unit (like every kincas result); `user_inputs(sweep)` and
         `user_values(sweep)` give the numbers in the scene's units, as `kincas solve` prints."""
-        from ..analysis.sweeps import sweep  # casadi stays out of scene parsing
+        from ..analysis.expression_loads import sweep_with_expressions  # casadi stays out of parsing
         st = self.study
-        self.refuse_expressions("kincas solve")
         if any(st.jerks.values()):
             kw.setdefault("jerks", st.jerks)
-        sw = sweep(self.mechanism, st.inputs, rates=st.rates, accelerations=st.accelerations,
-                   report=self.quantities, **kw)
+        sw = sweep_with_expressions(self.mechanism, st.inputs, self.load_expressions(),
+                                    angle=math.pi / 180 if st.deg else 1.0, rates=st.rates,
+                                    accelerations=st.accelerations, report=self.quantities, **kw)
         sw.info["display"] = self.display(sw)  # Jupyter shows it in the scene's units
         return sw
 
@@ -99,13 +99,13 @@ class Scene:
         return {"units": dict(self.study.units), "degrees": deg if self.study.deg else [],
                 "labels": {k: quantity_unit(self, k) for k in [*sw.inputs, *sw.values]}}
 
-    def refuse_expressions(self, what: str) -> None:
-        """Loads written as expressions of the state are only evaluated along a motion."""
-        exprs = self.study.simulation.get("expressions")
-        if exprs:
-            raise SceneError(f"[[loads]]: {len(exprs)} load component(s) are expressions of the "
-                             f"state and time ({next(iter(exprs.values()))!r}): {what} takes numbers "
-                             f"or parameters; `kincas simulate` evaluates expressions")
+    def load_expressions(self) -> dict:
+        """Loads written as expressions of the state: hidden parameter -> LoadExpression,
+        each named where the scene wrote it (a sweep evaluates them at each pose's state)."""
+        from ..core.motion_loads import LoadExpression
+        sim = self.study.simulation
+        return {k: LoadExpression(t, sim["where"][k], sim["data"])
+                for k, t in (sim.get("expressions") or {}).items()}
 
     def refuse_jerks(self, texts, where: str) -> None:
         """Only `kincas solve` passes the inputs' `jerk` on; elsewhere they would be taken as 0,

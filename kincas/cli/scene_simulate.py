@@ -4,8 +4,9 @@ of the state and time, `[data]` lists and the `[simulate]` section (docs/simulat
 A load's component that is a string and not a parameter's name (nor `-name`) is an
 expression: it becomes a hidden parameter of the mechanism (`_load1_torque`,
 `_load2_force_y`), whose value at every instant of a simulation is the expression's
-(kincas/core/motion_loads.py). Only `kincas simulate` and `kincas flywheel` evaluate them;
-`kincas solve` refuses such a scene rather than take them as zero.
+(kincas/core/motion_loads.py). `kincas simulate` and `kincas flywheel` evaluate them over
+time; `kincas solve` at each pose's state where a reported force needs them
+(kincas/analysis/expression_loads.py), refusing one that needs the time `t`.
 
 >>> from kincas.cli.scene import loads
 >>> sc = loads('''
@@ -142,8 +143,7 @@ def arguments_of(sc) -> dict:
     if sim.get("duration") is None:
         raise SceneError("[simulate]: missing (duration = T, steps = N)")
     st = sc.study
-    from ..core.motion_loads import LoadExpression  # each named where the scene wrote it
-    expressions = {k: LoadExpression(t, sim["where"][k], sim["data"]) for k, t in sim["expressions"].items()}
+    expressions = sc.load_expressions()  # each named where the scene wrote it
     kw = dict(free=sim["free"], initial={k: float(v[0]) for k, v in st.inputs.items()},
               rates=dict(st.rates), accelerations=dict(st.accelerations),
               expressions=expressions, data=sim["data"], flywheel=sim["flywheel"],

@@ -12,6 +12,8 @@ most recently used libraries. When to compile is `kincas.core.compiled.Backend`'
 """
 from __future__ import annotations
 
+import atexit
+import contextlib
 import ctypes
 import hashlib
 import os
@@ -122,7 +124,7 @@ class Library:
             raise RuntimeError("no C compiler found (set CC)")
         t0 = time.perf_counter()
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryDirectory(dir=self.path.parent) as tmp:
+        with _Compiles.folder(self.path.parent) as tmp:
             src, out = Path(tmp) / "k.c", Path(tmp) / "k.so"
             src.write_text(self.source)
             for flags in (_FLAGS, _PLAIN):  # a compiler that lacks a flag still gets a try
@@ -135,12 +137,76 @@ class Library:
         self.times["compile"] = time.perf_counter() - t0
 
 
+class _Compiles:
+    """The compilers running in this process and their temporary folders, ended at exit.
+
+    A background compile runs on a daemon thread, so the interpreter never waits for it; at
+    exit (normal, or after Ctrl-C) `end_all` kills every compiler still running (with its
+    process group: cc1, as) and removes their folders, and no compiler starts after it. The
+    library is only ever renamed into place whole, so the cache never holds part of one."""
+
+    lock = threading.Lock()
+    running: dict = {}  # pid -> Popen
+    folders: set = set()
+    exiting = False
+
+    @classmethod
+    @contextlib.contextmanager
+    def folder(cls, parent: Path):
+        with cls.lock:
+            if cls.exiting:
+                raise RuntimeError("the process is exiting")
+            tmp = tempfile.mkdtemp(dir=parent)
+            cls.folders.add(tmp)
+        try:
+            yield tmp
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+            with cls.lock:
+                cls.folders.discard(tmp)
+
+    @classmethod
+    def start(cls, cmd, group: bool) -> subprocess.Popen:
+        with cls.lock:
+            if cls.exiting:
+                raise RuntimeError("the process is exiting")
+            proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                    start_new_session=group)
+            cls.running[proc.pid] = proc
+            return proc
+
+    @classmethod
+    def end_all(cls) -> None:
+        with cls.lock:
+            cls.exiting = True
+            procs, folders = list(cls.running.values()), list(cls.folders)
+        for proc in procs:
+            _kill(proc)
+        for tmp in folders:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+atexit.register(_Compiles.end_all)  # runs before daemon threads are frozen
+
+
+def exiting() -> bool:
+    """Whether this process is exiting (its compiles were ended: their failure is no news)."""
+    return _Compiles.exiting
+
+
+def _kill(proc) -> None:
+    try:
+        os.killpg(proc.pid, 9) if os.name == "posix" else proc.kill()
+    except OSError:
+        pass
+
+
 def _run(cmd, timeout: float) -> tuple[int, str]:
     """(exit status, standard error) of `cmd`; killed on Ctrl-C, even from a worker thread
-    (kincas/core/cancel.py: a compile can take seconds, the exit must not wait for it)."""
+    (kincas/core/cancel.py: a compile can take seconds, the exit must not wait for it), and
+    at the process's exit (`_Compiles`)."""
     group = os.name == "posix"  # the compiler's own children (cc1, as) go with it
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=group)
+    proc = _Compiles.start(cmd, group)
     end = time.monotonic() + timeout
     try:
         while True:
@@ -152,12 +218,12 @@ def _run(cmd, timeout: float) -> tuple[int, str]:
                 if time.monotonic() > end:
                     raise
     except BaseException:
-        try:
-            os.killpg(proc.pid, 9) if group else proc.kill()
-        except OSError:
-            pass
+        _kill(proc)
         proc.communicate()
         raise
+    finally:
+        with _Compiles.lock:
+            _Compiles.running.pop(proc.pid, None)
 
 
 class _file_lock:

@@ -21,7 +21,7 @@ import threading
 import warnings
 
 from .c_library import (MAX_CACHED, _LIBS, Library, cache_dir, compiling_disabled,  # noqa: F401 (their old home)
-                        pair_sincos)
+                        exiting, pair_sincos)
 from .cancel import held
 
 import casadi as ca
@@ -59,11 +59,10 @@ class Backend:
         compiler runs outside the GIL); `compiled` answers None (the virtual machine) until
         it is loaded, and `Library.load` never loads a half-written file. Code generation is
         done here, in the caller's thread; nothing happens if compiling is off, failed,
-        done or under way. The thread is not a daemon: a process ending meanwhile waits for
-        the compiler, and the next process finds the library cached. (A daemon thread would
-        be frozen at exit mid-compile: nothing half-written is ever loaded, the rename never
-        happens and the file lock goes with the process, but the compiler, in a session of
-        its own, runs on orphaned and its temporary folder stays in the cache.)"""
+        done or under way. The thread is a daemon: a process ending meanwhile (or on Ctrl-C)
+        does not wait for the compiler; at exit the compiler is killed and its temporary
+        folder removed (kincas/core/c_library.py `_Compiles`), the library is never renamed
+        into the cache unfinished, and the file lock goes with the process."""
         if self._thread is not None or self.lib is not None or self.failed or self.compile is not None \
                 or compiling_disabled():
             return
@@ -75,14 +74,16 @@ class Backend:
                     self.library = self.make_library()
             except Exception as e:
                 return self._failed(e)
-            self._thread = threading.Thread(target=self._load, name=f"kincas compile {self.what}")
+            self._thread = threading.Thread(target=self._load, name=f"kincas compile {self.what}",
+                                            daemon=True)
             self._thread.start()
 
     def _load(self) -> None:
         try:
             lib = self.library.load()
         except Exception as e:
-            self._failed(e)
+            if not exiting():  # ended at the process's exit: nothing to report
+                self._failed(e)
         else:
             self.lib = lib  # one assignment: other threads see None or the loaded library
 

@@ -41,7 +41,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import ModelError
-from ..model.names import is_angular, parse_quantity
+from .motion_loads import substituted
 
 
 class Motion:
@@ -72,7 +72,7 @@ class Motion:
         nq, nu, npar, nf = sym.nq, sym.nu, sym.np, len(self.free)
         q, u, ud, p = (ca.SX.sym(n, k) for n, k in (("q", nq), ("u", nu), ("ud", nu), ("p", npar)))
         t, a_f, a_h = ca.SX.sym("t"), ca.SX.sym("a_f", nf), ca.SX.sym("a_h", nu - nf)
-        p_eff = self._substituted(q, u, ud, t, p, expressions or {}, angle)
+        p_eff = substituted(sym, q, u, ud, t, p, expressions or {}, angle)
         udd = ca.SX.zeros(nu)
         udd[self.free], udd[self.held] = a_f, a_h
         names = [f"effort({sym.ukeys[k]})" for k in self.free] + [f"contact({c})" for c in self.cams]
@@ -89,42 +89,6 @@ class Motion:
         qd = -sym.lsolve(ca.mtimes(sym.Ju, ud))
         self.f_qdot = ca.Function("qdot", [sym.q, sym.u, sym.p, ud], [ca.densify(qd)])
         self._rhs, self._int = None, {}
-
-    # --- the loads' expressions as parameters ---
-    def _substituted(self, q, u, ud, t, p, expressions, k):
-        """p with each expression's parameter replaced by the expression in (q, u, u', t, p)."""
-        sym = self.sym
-        if not expressions:
-            return p
-        names = []
-        for e in expressions.values():
-            for n in e.quantities:
-                kind, obj, attr = parse_quantity(n)
-                e_, order = sym.position_expr(obj, attr)
-                if e_ is None or order > 1:
-                    raise ModelError(f"{e.where}: {n!r}: a load may depend on positions and "
-                                     f"velocities (P.x, P.vx, L.angle, L.omega, S.s, S.v)")
-                names.append(n) if n not in names else None
-        vals = sym.quantity_function(names)(q, u, p, ud, ca.SX.zeros(sym.nu)) if names else ca.SX(0, 1)
-        driven = {i.target: j for j, i in enumerate(sym.mech.inputs) if i.kind == "parameter"}
-        hidden = set(expressions)
-
-        def leaf(kind, name):
-            if kind == "quantity":
-                v = vals[names.index(name)]
-                return v / k if is_angular(name, sym.mech) else v
-            if name in hidden or name not in sym.pnames:
-                raise ModelError(f"{where}: unknown name {name!r} (parameters: "
-                                 f"{[n for n in sym.pnames if n not in hidden and not n.startswith('_')]}, quantities, t, pi)")
-            return u[driven[name]] if name in driven else p[sym.pnames.index(name)]
-
-        out = ca.SX(p)
-        for name, e in expressions.items():
-            if name not in sym.pnames:
-                raise ModelError(f"{e.where}: {name!r} is not a parameter of the mechanism")
-            where = e.where
-            out[sym.pnames.index(name)] = e.symbolic(leaf, t, k)
-        return out
 
     # --- numbers ---
     def accelerations(self, q, u, ud, t, p, a_held=None):

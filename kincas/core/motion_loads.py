@@ -145,6 +145,85 @@ class LoadExpression:
         return {"sqrt": ca.sqrt, "exp": ca.exp, "log": ca.log, "abs": ca.fabs}[f](vals[0])
 
 
+def substituted(sym, q, u, ud, t, p, expressions: dict, k: float):
+    """p with each expression's parameter replaced by the expression in (q, u, u', t, p):
+    its quantities are those of the state (q, u, u'), angles continuous as q and u carry them,
+    in the caller's angle unit (`k` radians); `expressions` maps parameter -> LoadExpression."""
+    import casadi as ca
+    from ..model.names import is_angular, parse_quantity
+    if not expressions:
+        return p
+    names = []
+    for e in expressions.values():
+        for n in e.quantities:
+            kind, obj, attr = parse_quantity(n)
+            e_, order = sym.position_expr(obj, attr)
+            if e_ is None or order > 1:
+                raise ModelError(f"{e.where}: {n!r}: a load may depend on positions and "
+                                 f"velocities (P.x, P.vx, L.angle, L.omega, S.s, S.v)")
+            names.append(n) if n not in names else None
+    vals = sym.quantity_function(names)(q, u, p, ud, ca.SX.zeros(sym.nu)) if names else ca.SX(0, 1)
+    driven = {i.target: j for j, i in enumerate(sym.mech.inputs) if i.kind == "parameter"}
+    hidden = set(expressions)
+    where = ""
+
+    def leaf(kind, name):
+        if kind == "quantity":
+            v = vals[names.index(name)]
+            return v / k if is_angular(name, sym.mech) else v
+        if name in hidden or name not in sym.pnames:
+            raise ModelError(f"{where}: unknown name {name!r} (parameters: "
+                             f"{[n for n in sym.pnames if n not in hidden and not n.startswith('_')]}, quantities, t, pi)")
+        return u[driven[name]] if name in driven else p[sym.pnames.index(name)]
+
+    out = ca.SX(p)
+    for name, e in expressions.items():
+        if name not in sym.pnames:
+            raise ModelError(f"{e.where}: {name!r} is not a parameter of the mechanism")
+        where = e.where
+        out[sym.pnames.index(name)] = e.symbolic(leaf, t, k)
+    return out
+
+
+def load_dependence(model, names: list[str], hidden: list[str]) -> dict[str, list[str]]:
+    """Which of the quantities `names` of a model (kincas.core.numeric.Model) depend on the
+    parameters `hidden` (those standing for expressions), and on which: name -> hidden
+    parameters (only names that depend on some). Read off the symbolic graph: kinematics never
+    do; efforts, reactions, shaking forces and contact forces do where the load acts on them."""
+    import casadi as ca
+    if not names or not hidden:
+        return {}
+    sym = model.sym
+    q, u, p, ud, udd = (ca.SX.sym(n, k) for n, k in (("q", sym.nq), ("u", sym.nu), ("p", sym.np),
+                                                     ("ud", sym.nu), ("udd", sym.nu)))
+    rows = sym.quantity_function(list(names))(q, u, p, ud, udd)
+    out = {}
+    for i, n in enumerate(names):
+        on = [h for h in hidden if ca.depends_on(rows[i], p[sym.pnames.index(h)])]
+        if on:
+            out[n] = on
+    return out
+
+
+def loaded_function(model, names: list[str], expressions: dict, k: float):
+    """f(q, u, p, u', u'', t) -> the quantities `names` with every expression's parameter
+    replaced by the expression at that state (kincas/core/dynamics.py's kinetostatics with
+    the loads as they are at the pose); built once per model, names and expressions."""
+    import casadi as ca
+
+    def build():
+        sym = model.sym
+        q, u, p, ud, udd = (ca.SX.sym(n, k_) for n, k_ in (("q", sym.nq), ("u", sym.nu), ("p", sym.np),
+                                                          ("ud", sym.nu), ("udd", sym.nu)))
+        t = ca.SX.sym("t")
+        p_eff = substituted(sym, q, u, ud, t, p, expressions, k)
+        rows = sym.quantity_function(list(names))(q, u, p_eff, ud, udd)
+        return ca.Function("loaded", [q, u, p, ud, udd, t], [rows])
+    key = ("loaded", tuple(names), tuple((n, e.text, e.where) for n, e in expressions.items()),
+           tuple((n, tuple(v)) for e in expressions.values() for n, v in sorted(e.data.items())), k)
+    return model.memo(key, build)
+
+
 def data_lists(raw, where: str = "[data]") -> dict[str, list[float]]:
     """`[data]` as named lists: `xs = [...]` gives `xs`, `gas = { angle = [...] }` gives
     `gas.angle`. ModelError naming the entry when one is not a list of finite numbers.

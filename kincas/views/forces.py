@@ -153,6 +153,54 @@ def weights(m: Mechanism, geo) -> list[Arrow]:
     return out
 
 
+def space_weights(m, geo) -> list[Arrow]:
+    """A spatial mechanism's weights m g (N x 3) at each body's centre of gravity (N x 3), from
+    the world positions of its points (`geo`: N x K x 3). The cg, given as drawn (default: the
+    mean of the points, where a bar's mass is), is carried by the motion that carries the
+    body's points: an affine combination of them when it lies in their span (exact for any
+    rigid motion), else the best rotation of three or more points not in line (Kabsch); a
+    two-point body's cg off its line has no such motion (its spin is no freedom): left out."""
+    g = np.array([_number(m, c) for c in m.gravity], float)
+    if not g.any():
+        return []
+    out = []
+    for b in m.links:
+        mass = _number(m, b.mass)
+        if mass == 0:
+            continue
+        world = np.stack([geo.point(p) for p in b.point_names], axis=1)  # N x K x 3
+        if b.cg is None or b.two_point:
+            at = world.mean(axis=1)
+        else:
+            local = np.array([[_number(m, c) for c in xyz] for _, xyz in b.points], float)
+            at = _carried(local, world, np.array([_number(m, c) for c in b.cg], float))
+        if at is not None:
+            out.append(Arrow(f"weight of {b.name}", "load", at, np.tile(mass * g, (len(at), 1))))
+    return out
+
+
+def _carried(local, world, cg):
+    """`cg` (as drawn, with the body's points `local`, K x 3) where the motion taking `local`
+    to `world` (N x K x 3) takes it; None when the points do not fix it."""
+    lc = local.mean(axis=0)
+    A = local - lc
+    size = max(float(np.abs(A).max()), 1e-300)
+    w, *_ = np.linalg.lstsq(A.T, cg - lc, rcond=None)  # cg - lc = A' w, a combination
+    if np.linalg.norm(A.T @ w - (cg - lc)) <= 1e-9 * size:
+        wc = world.mean(axis=1)
+        return wc + np.einsum("k,nkj->nj", w, world - wc[:, None])
+    if np.linalg.matrix_rank(A, tol=1e-9 * size) < 2:
+        return None
+    out = np.full((len(world), 3), np.nan)
+    for i, W in enumerate(world):
+        if np.isfinite(W).all():
+            wc = W.mean(axis=0)
+            U, _, Vt = np.linalg.svd(A.T @ (W - wc))  # R A' ~ (W - wc)': R = V diag(1, 1, det) U'
+            d = np.sign(np.linalg.det(Vt.T @ U.T))
+            out[i] = wc + Vt.T @ np.diag([1.0, 1.0, d]) @ U.T @ (cg - lc)
+    return out
+
+
 def actuator(m: Mechanism, parameter: str) -> tuple[str, str] | None:
     """The ends (P, Q) of the two-point link whose length is `parameter` (a linear actuator
     driven by a parameter input), None when no link's length is it."""

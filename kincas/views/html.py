@@ -24,6 +24,7 @@ True
 from __future__ import annotations
 
 import json
+from importlib import resources
 
 import numpy as np
 
@@ -89,7 +90,7 @@ def html_page(m: Mechanism, sweep: Sweep, scene=None, paths=None, dense: int = 0
     page = _PAGE
     if "camera" in data:  # a spatial mechanism: the view that turns (views/html3d.py)
         from .html3d import MECHANISM_3D
-        page = _HEAD + MECHANISM_3D + _TAIL
+        page = _HEAD + DRAW_JS + MECHANISM_3D + _TAIL
     data = json.dumps(data, allow_nan=False, separators=(",", ":"))
     data = data.replace("</", "<\\/")  # nothing in the data may close the script element
     return (page.replace("@W@", str(WIDTH)).replace("@H@", str(HEIGHT)).replace("@INK@", INK)
@@ -173,16 +174,8 @@ function layout() {
 const X = p => ox + sx * p[0], Y = p => oy - sx * p[1];
 const fin = p => p !== null && p[0] !== null && p[1] !== null;
 
-function line(pts, colour, width, dash) {
-  ctx.beginPath(); ctx.setLineDash(dash || []); ctx.strokeStyle = colour; ctx.lineWidth = width;
-  let pen = false;
-  for (const p of pts) {
-    if (!fin(p)) { pen = false; continue; }
-    if (pen) ctx.lineTo(X(p), Y(p)); else ctx.moveTo(X(p), Y(p));
-    pen = true;
-  }
-  ctx.stroke(); ctx.setLineDash([]);
-}
+const canvasOf = p => fin(p) ? [X(p), Y(p)] : null;  // (the shapes: views/draw.js)
+const line = (pts, colour, width, dash) => kPolyline(ctx, pts.map(canvasOf), colour, width, dash);
 function zigzag(a, b) {  // a spring from a to b, as the other pictures draw it
   const dx = b[0] - a[0], dy = b[1] - a[1], n = Math.hypot(dx, dy);
   if (!(n > 0)) return [a, b];
@@ -204,10 +197,7 @@ function drawMechanism(i) {
     line(pts, owner[D.names.indexOf(p)] || "@INK@", 1, [5, 4]);
   }
   for (const k of D.ground) {  // a pivot on a hatched base
-    const p = xy[k]; if (!fin(p)) continue;
-    const x = X(p), y = Y(p), h = 2.5 * R;
-    ctx.beginPath(); ctx.moveTo(x, y); ctx.lineTo(x - 0.7 * h, y + h); ctx.lineTo(x + 0.7 * h, y + h);
-    ctx.closePath(); ctx.fillStyle = "#dddddd"; ctx.fill(); ctx.strokeStyle = "@INK@"; ctx.lineWidth = 1; ctx.stroke();
+    const p = xy[k]; if (fin(p)) kPivot(ctx, X(p), Y(p), R, "@INK@");
   }
   for (const g of D.guides) {
     const t = g.through[i], d = g.direction[i];
@@ -215,12 +205,7 @@ function drawMechanism(i) {
     const a = [t[0] + g.lo * d[0], t[1] + g.lo * d[1]], b = [t[0] + g.hi * d[0], t[1] + g.hi * d[1]];
     line([a, b], g.colour, 1.2);
     const p = xy[g.point];
-    if (fin(p)) {  // the block
-      ctx.save(); ctx.translate(X(p), Y(p)); ctx.rotate(-Math.atan2(d[1], d[0]));
-      ctx.fillStyle = "#f2f2f2"; ctx.strokeStyle = "@INK@"; ctx.lineWidth = 1.2;
-      ctx.fillRect(-2 * R, -1.4 * R, 4 * R, 2.8 * R); ctx.strokeRect(-2 * R, -1.4 * R, 4 * R, 2.8 * R);
-      ctx.restore();
-    }
+    if (fin(p)) kBlock(ctx, X(p), Y(p), -Math.atan2(d[1], d[0]), R, "@INK@");  // the block
   }
   for (const c of D.joints[i] || []) {  // gears, racks, cams; circles drawn round
     if (c.circle) {
@@ -238,14 +223,7 @@ function drawMechanism(i) {
   const order = D.bodies.filter(b => !b.driven).concat(D.bodies.filter(b => b.driven));
   for (const b of order) {
     const pts = b.ring.map(k => xy[k]);
-    if (!pts.every(fin)) continue;
-    if (pts.length >= 3) {
-      ctx.beginPath(); pts.forEach((p, j) => j ? ctx.lineTo(X(p), Y(p)) : ctx.moveTo(X(p), Y(p)));
-      ctx.closePath(); ctx.globalAlpha = 0.45; ctx.fillStyle = b.colour; ctx.fill(); ctx.globalAlpha = 1;
-      ctx.strokeStyle = b.colour; ctx.lineWidth = 2.5; ctx.stroke();
-    } else {
-      ctx.lineCap = "round"; line(pts, b.colour, 7); ctx.lineCap = "butt";
-    }
+    if (pts.every(fin)) kBody(ctx, pts.map(canvasOf), b.colour);
   }
   for (const f of D.forces[i] || []) {  // arrows: loads, springs, efforts, reactions
     line(f.pts, f.colour, 1.8);
@@ -261,8 +239,7 @@ function drawMechanism(i) {
   ctx.textAlign = "center"; ctx.textBaseline = "middle";
   for (let k = 0; k < D.names.length; k++) {  // joints and points, with their names in free space
     const p = xy[k]; if (!fin(p)) continue;
-    ctx.beginPath(); ctx.arc(X(p), Y(p), 4, 0, 2 * Math.PI);
-    ctx.fillStyle = "white"; ctx.fill(); ctx.strokeStyle = "@INK@"; ctx.lineWidth = 1.3; ctx.stroke();
+    kJoint(ctx, X(p), Y(p), 4, "white", "@INK@");
     const off = (D.labels[i] || [])[k];
     const at = fin(off) ? [p[0] + off[0], p[1] + off[1]] : [p[0] + 2 * D.r, p[1] + 2 * D.r];
     ctx.fillStyle = "@INK@"; ctx.font = "11px sans-serif"; ctx.fillText(D.names[k], X(at), Y(at));
@@ -373,4 +350,7 @@ layout();
 if (N) show(fromHash());
 </script></body></html>
 """
-_PAGE = _HEAD + _MECHANISM + _TAIL
+# the shapes every page draws alike (views/draw.js, shared with `kincas app`), inlined: the page
+# works offline
+DRAW_JS = resources.files(__package__).joinpath("draw.js").read_text(encoding="utf-8")
+_PAGE = _HEAD + DRAW_JS + _MECHANISM + _TAIL

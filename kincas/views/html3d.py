@@ -72,17 +72,7 @@ function layout() {  // the canvas fills its stage; set again when the window ch
 // a world point: canvas x, canvas y, depth (larger: farther from the viewer)
 const P = p => [OX + S * dot(cam[0], p), OY - S * dot(cam[1], p), -dot(cam[2], p)];
 const orbit = (dx, dy) => { cam = kOrbit(cam, up, dx, dy); };  // views/orbit.js
-function line(pts, colour, width, dash) {
-  ctx.beginPath(); ctx.setLineDash(dash || []); ctx.strokeStyle = colour; ctx.lineWidth = width;
-  let pen = false;
-  for (const p of pts) {
-    if (!fin(p)) { pen = false; continue; }
-    const q = P(p);
-    if (pen) ctx.lineTo(q[0], q[1]); else ctx.moveTo(q[0], q[1]);
-    pen = true;
-  }
-  ctx.stroke(); ctx.setLineDash([]);
-}
+const line = (pts, colour, width, dash) => kPolyline(ctx, pts.map(p => fin(p) ? P(p) : null), colour, width, dash);
 function triad() {  // the world axes, lower left
   const o = [38, H - 38], col = ["#d62728", "#2ca02c", "#1f77b4"];
   for (let j = 0; j < 3; j++) {
@@ -107,10 +97,7 @@ function drawMechanism(i) {
   const xy = D.xy[i];
   for (const [p, pts] of Object.entries(D.paths)) line(pts, pathColour[p], 1, [5, 4]);
   for (const k of D.ground) {  // a pivot on a base, upright on the screen
-    const p = xy[k]; if (!fin(p)) continue;
-    const [x, y] = P(p), h = 2.5 * R;
-    ctx.beginPath(); ctx.moveTo(x, y); ctx.lineTo(x - 0.7 * h, y + h); ctx.lineTo(x + 0.7 * h, y + h);
-    ctx.closePath(); ctx.fillStyle = "#dddddd"; ctx.fill(); ctx.strokeStyle = "@INK@"; ctx.lineWidth = 1; ctx.stroke();
+    const p = xy[k]; if (fin(p)) kPivot(ctx, P(p)[0], P(p)[1], R, "@INK@");
   }
   for (const g of D.guides) {
     const t = g.through[i], d = g.direction[i];
@@ -120,10 +107,7 @@ function drawMechanism(i) {
     const p = xy[g.point];
     if (fin(p)) {  // the block, along the guide as drawn
       const [x, y] = P(p), ea = P(a), eb = P(b);
-      ctx.save(); ctx.translate(x, y); ctx.rotate(Math.atan2(eb[1] - ea[1], eb[0] - ea[0]));
-      ctx.fillStyle = "#f2f2f2"; ctx.strokeStyle = "@INK@"; ctx.lineWidth = 1.2;
-      ctx.fillRect(-2 * R, -1.4 * R, 4 * R, 2.8 * R); ctx.strokeRect(-2 * R, -1.4 * R, 4 * R, 2.8 * R);
-      ctx.restore();
+      kBlock(ctx, x, y, Math.atan2(eb[1] - ea[1], eb[0] - ea[0]), R, "@INK@");
     }
   }
   for (const s of D.springs) {  // springs, straight
@@ -138,21 +122,11 @@ function drawMechanism(i) {
     order.push([q.reduce((s, v) => s + v[2], 0) / q.length, b, q]);
   }
   order.sort((u, v) => v[0] - u[0]);
-  for (const [, b, q] of order) {
-    if (q.length >= 3) {
-      ctx.beginPath(); q.forEach((p, j) => j ? ctx.lineTo(p[0], p[1]) : ctx.moveTo(p[0], p[1]));
-      ctx.closePath(); ctx.globalAlpha = 0.45; ctx.fillStyle = b.colour; ctx.fill(); ctx.globalAlpha = 1;
-      ctx.strokeStyle = b.colour; ctx.lineWidth = 2.5; ctx.stroke();
-    } else {
-      ctx.beginPath(); ctx.moveTo(q[0][0], q[0][1]); ctx.lineTo(q[1][0], q[1][1]);
-      ctx.lineCap = "round"; ctx.strokeStyle = b.colour; ctx.lineWidth = 7; ctx.stroke(); ctx.lineCap = "butt";
-    }
-  }
+  for (const [, b, q] of order) kBody(ctx, q, b.colour);  // (views/draw.js)
   for (let k = 0; k < D.names.length; k++) {  // joints and points, with their names
     const p = xy[k]; if (!fin(p)) continue;
     const [x, y] = P(p);
-    ctx.beginPath(); ctx.arc(x, y, 4, 0, 2 * Math.PI);
-    ctx.fillStyle = "white"; ctx.fill(); ctx.strokeStyle = "@INK@"; ctx.lineWidth = 1.3; ctx.stroke();
+    kJoint(ctx, x, y, 4, "white", "@INK@");
     ctx.fillStyle = "@INK@"; ctx.font = "11px sans-serif"; ctx.fillText(D.names[k], x + 7, y - 7);
   }
   triad();

@@ -14,11 +14,13 @@ ASSETS = ("page.html", "app.js", "app.css")
 
 def asset(name: str) -> str:
     """The text of one of the page's files (`ASSETS`); `app.js` starts with the camera that turns
-    a spatial mechanism with the mouse (views/orbit.js, shared with the spatial `--html` page)."""
+    a spatial mechanism with the mouse (views/orbit.js, shared with the spatial `--html` page)
+    and the shapes every page draws alike (views/draw.js, shared with the `--html` pages)."""
     if name not in ASSETS:
         raise KeyError(name)
     text = resources.files(__name__).joinpath(name).read_text(encoding="utf-8")
     if name == "app.js":
+        from ..html import DRAW_JS
         from ..html3d import ORBIT_JS
-        text = ORBIT_JS + text
+        text = ORBIT_JS + DRAW_JS + text
     return text

@@ -7,9 +7,12 @@
 // data-pose (the pose shown), data-busy ("1" while a request is out or waiting),
 // data-transform "sx ox oy" (world (x, y) is drawn at canvas pixel (ox + sx x, oy - sx y)).
 // A spatial mechanism (drawing.space) is drawn turned by a camera (views/orbit.js, inlined
-// before this file): its points relative to the box's centre c, projected on the camera's
-// rows, (x, y) = (right . (p - c), up . (p - c)), are drawn as a planar one's; data-camera
-// keeps the rows (JSON). The mouse turns it (drag) and zooms (wheel); its points are not dragged.
+// before this file, as views/draw.js is: the shapes every page draws, shared with the `--html`
+// pages): its points relative to the box's centre c, projected on the camera's rows,
+// (x, y) = (right . (p - c), up . (p - c)), are drawn as a planar one's; data-camera keeps the
+// rows (JSON). The mouse turns it (drag) and zooms (wheel); its points are not dragged.
+// Its loads and weights are projected the same way (an arrow keeps the force's own size), and
+// its bodies are drawn farthest first, by the mean depth -(toward . (p - c)) of their points.
 "use strict";
 
 // requests over HTTP to the server that served the page
@@ -177,7 +180,10 @@ function kincasApp(root, transport) {
     const on = p => (p === null || p === undefined || p.some(v => v === null)) ? null
       : [kDot(cam[0], p) - kDot(cam[0], c), kDot(cam[1], p) - kDot(cam[1], c)];
     const dir = d => (d === null || d === undefined || d.some(v => v === null)) ? null : [kDot(cam[0], d), kDot(cam[1], d)];
-    const out = { ...D, xy: D.xy.map(q => q.map(on)),
+    const far = p => (p === null || p === undefined || p.some(v => v === null)) ? null : kDot(cam[2], c) - kDot(cam[2], p);
+    const load = l => ({ ...l, size: l.vector ? Math.hypot(...l.vector) : undefined,  // the force's own size
+      vector: l.vector ? dir(l.vector) : l.vector, at: l.at ? l.at.map(on) : l.at });
+    const out = { ...D, xy: D.xy.map(q => q.map(on)), depth: D.xy.map(q => q.map(far)), loads: D.loads.map(load),
       guides: D.guides.map(g => ({ ...g, through: g.through.map(on), direction: g.direction.map(dir) })) };
     flatCache = [D, key, out];
     return out;
@@ -197,24 +203,19 @@ function kincasApp(root, transport) {
   const X = p => view.ox + view.sx * p[0], Y = p => view.oy - view.sx * p[1];
   const fin = p => p !== null && p !== undefined && p[0] !== null && p[1] !== null;
 
-  function line(pts, colour, width, dash) {
-    ctx.beginPath(); ctx.setLineDash(dash || []); ctx.strokeStyle = colour; ctx.lineWidth = width;
-    let pen = false;
-    for (const p of pts) {
-      if (!fin(p)) { pen = false; continue; }
-      if (pen) ctx.lineTo(X(p), Y(p)); else ctx.moveTo(X(p), Y(p));
-      pen = true;
-    }
-    ctx.stroke(); ctx.setLineDash([]);
-  }
-  function arrow(p, d, colour, label) {  // from p along d (pixels)
+  const canvasOf = p => fin(p) ? [X(p), Y(p)] : null;  // (the shapes: views/draw.js)
+  const line = (pts, colour, width, dash) => kPolyline(ctx, pts.map(canvasOf), colour, width, dash);
+  function arrow(p, d, colour, label, heads) {  // from p along d (pixels); heads 2: a moment
     const x = X(p), y = Y(p), ex = x + d[0], ey = y - d[1], L = Math.hypot(d[0], d[1]);
     if (!(L > 2)) return;
     const ux = d[0] / L, uy = -d[1] / L, h = Math.min(10, L / 2);
     ctx.beginPath(); ctx.strokeStyle = colour; ctx.fillStyle = colour; ctx.lineWidth = 2;
     ctx.moveTo(x, y); ctx.lineTo(ex, ey); ctx.stroke();
-    ctx.beginPath(); ctx.moveTo(ex, ey); ctx.lineTo(ex - h * ux - h * 0.4 * uy, ey - h * uy + h * 0.4 * ux);
-    ctx.lineTo(ex - h * ux + h * 0.4 * uy, ey - h * uy - h * 0.4 * ux); ctx.closePath(); ctx.fill();
+    for (let k = 0; k < (heads || 1); k++) {
+      const tx = ex - k * h * ux, ty = ey - k * h * uy;
+      ctx.beginPath(); ctx.moveTo(tx, ty); ctx.lineTo(tx - h * ux - h * 0.4 * uy, ty - h * uy + h * 0.4 * ux);
+      ctx.lineTo(tx - h * ux + h * 0.4 * uy, ty - h * uy - h * 0.4 * ux); ctx.closePath(); ctx.fill();
+    }
     if (label) { ctx.font = "11px sans-serif"; ctx.fillText(label, ex + 4, ey - 4); }
   }
 
@@ -240,10 +241,7 @@ function kincasApp(root, transport) {
     if ($(".k-paths").checked) for (const k of D.moving) line(D.xy.map(q => q[k]), owner[k] || INK, 1, [5, 4]);
     const R = Math.max(3, D.r * view.sx);
     for (const k of D.ground) {  // a pivot on a hatched base
-      const p = xy[k]; if (!fin(p)) continue;
-      const x = X(p), y = Y(p), h = 2.5 * R;
-      ctx.beginPath(); ctx.moveTo(x, y); ctx.lineTo(x - 0.7 * h, y + h); ctx.lineTo(x + 0.7 * h, y + h);
-      ctx.closePath(); ctx.fillStyle = "#dddddd"; ctx.fill(); ctx.strokeStyle = INK; ctx.lineWidth = 1; ctx.stroke();
+      const p = xy[k]; if (fin(p)) kPivot(ctx, X(p), Y(p), R, INK);
     }
     if (!st.ok[i]) {
       ctx.globalAlpha = 1; ctx.fillStyle = "#b00"; ctx.font = "14px sans-serif";
@@ -255,12 +253,7 @@ function kincasApp(root, transport) {
       if (!fin(t) || !fin(d)) continue;
       line([[t[0] + g.lo * d[0], t[1] + g.lo * d[1]], [t[0] + g.hi * d[0], t[1] + g.hi * d[1]]], g.colour, 1.2);
       const p = xy[g.point];
-      if (fin(p)) {  // the block
-        ctx.save(); ctx.translate(X(p), Y(p)); ctx.rotate(-Math.atan2(d[1], d[0]));
-        ctx.fillStyle = "#f2f2f2"; ctx.strokeStyle = INK; ctx.lineWidth = 1.2;
-        ctx.fillRect(-2 * R, -1.4 * R, 4 * R, 2.8 * R); ctx.strokeRect(-2 * R, -1.4 * R, 4 * R, 2.8 * R);
-        ctx.restore();
-      }
+      if (fin(p)) kBlock(ctx, X(p), Y(p), -Math.atan2(d[1], d[0]), R, INK);  // the block
     }
     for (const c of (D.joints && D.joints[i]) || []) {  // gears, racks, cams
       if (c.pts.length === 1) {
@@ -268,25 +261,22 @@ function kincasApp(root, transport) {
         ctx.beginPath(); ctx.arc(X(p), Y(p), 3, 0, 2 * Math.PI); ctx.fillStyle = c.colour; ctx.fill();
       } else line(c.pts, c.colour, 1.2);
     }
-    const order = D.bodies.filter(b => !b.driven).concat(D.bodies.filter(b => b.driven));
+    let order = D.bodies.filter(b => !b.driven).concat(D.bodies.filter(b => b.driven));
+    if (D.space) {  // painter's order: the farthest body first, by the mean depth of its points
+      const depth = b => { const d = b.ring.map(k => D.depth[i][k]);
+        return d.some(v => v === null) ? -Infinity : d.reduce((a, v) => a + v, 0) / d.length; };
+      order = order.map(b => [depth(b), b]).sort((a, b) => b[0] - a[0]).map(x => x[1]);
+    }
     for (const b of order) {
       const pts = b.ring.map(k => xy[k]);
-      if (!pts.every(fin)) continue;
-      if (pts.length >= 3) {
-        ctx.beginPath(); pts.forEach((p, j) => j ? ctx.lineTo(X(p), Y(p)) : ctx.moveTo(X(p), Y(p)));
-        ctx.closePath(); const a = ctx.globalAlpha; ctx.globalAlpha = 0.45 * a; ctx.fillStyle = b.colour; ctx.fill();
-        ctx.globalAlpha = a; ctx.strokeStyle = b.colour; ctx.lineWidth = 2.5; ctx.stroke();
-      } else {
-        ctx.lineCap = "round"; line(pts, b.colour, 7); ctx.lineCap = "butt";
-      }
+      if (pts.every(fin)) kBody(ctx, pts.map(canvasOf), b.colour);
     }
     if ($(".k-forces").checked) { drawLoads(D, xy, i); drawForces(D, xy, i); }
     if ($(".k-centres").checked) drawCentres(st, i);
     for (let k = 0; k < D.names.length; k++) {  // joints and points, with their names
       const p = xy[k]; if (!fin(p)) continue;
       const hot = dragging && dragging.k === k;
-      ctx.beginPath(); ctx.arc(X(p), Y(p), hot ? 6 : 4, 0, 2 * Math.PI);
-      ctx.fillStyle = hot ? "#ffd24d" : "white"; ctx.fill(); ctx.strokeStyle = INK; ctx.lineWidth = 1.3; ctx.stroke();
+      kJoint(ctx, X(p), Y(p), hot ? 6 : 4, hot ? "#ffd24d" : "white", INK);
       ctx.fillStyle = INK; ctx.font = "11px sans-serif"; ctx.fillText(D.names[k], X(p) + 7, Y(p) - 7);
     }
     ctx.globalAlpha = 1;
@@ -305,13 +295,17 @@ function kincasApp(root, transport) {
   }
 
   function drawLoads(D, xy, i) {
+    const size = l => l.size !== undefined ? l.size : Math.hypot(l.vector[0], l.vector[1]);
     const forces = D.loads.filter(l => l.kind === "force" || l.kind === "weight");
-    const most = Math.max(1e-300, ...forces.map(l => Math.hypot(l.vector[0], l.vector[1])));
+    const most = Math.max(1e-300, ...forces.map(size));
+    const moments = D.loads.filter(l => l.kind === "moment");
+    const mostM = Math.max(1e-300, ...moments.map(size));
     const L = 0.12 * Math.min(mech.width, mech.height);
     for (const l of D.loads) {
       if (l.kind === "force" && fin(xy[l.point])) {
-        arrow(xy[l.point], [L * l.vector[0] / most, L * l.vector[1] / most], "#c0392b",
-              fmt(Math.hypot(l.vector[0], l.vector[1]), 3));
+        arrow(xy[l.point], [L * l.vector[0] / most, L * l.vector[1] / most], "#c0392b", fmt(size(l), 3));
+      } else if (l.kind === "moment" && fin(xy[l.point])) {  // a torque in space: a double-headed arrow
+        arrow(xy[l.point], [L * l.vector[0] / mostM, L * l.vector[1] / mostM], "#c0392b", fmt(size(l), 3), 2);
       } else if (l.kind === "spring" && fin(xy[l.points[0]]) && fin(xy[l.points[1]])) {
         const a = xy[l.points[0]], b = xy[l.points[1]], n = 12, pts = [a];
         const dx = b[0] - a[0], dy = b[1] - a[1], len = Math.hypot(dx, dy) || 1, w = 6 / view.sx;
@@ -322,7 +316,7 @@ function kincasApp(root, transport) {
         pts.push(b); line(pts, "#8e44ad", 1.5);
       } else if (l.kind === "weight" && fin(l.at[i])) {  // m g at the centre of gravity
         arrow(l.at[i], [L * l.vector[0] / most, L * l.vector[1] / most], "#c0392b",
-              l.label + " " + fmt(Math.hypot(l.vector[0], l.vector[1]), 3));
+              l.label + " " + fmt(size(l), 3));
       } else if (l.kind === "torque" && fin(xy[l.point])) {
         torque(xy[l.point], l.value, "#c0392b", fmt(l.value, 3));
       }

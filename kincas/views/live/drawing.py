@@ -55,7 +55,8 @@ def _nulls(v):
 
 def drawing(m: Mechanism, sw: Sweep, handles: dict) -> dict:
     """Names, points per pose, bodies, guides, joint curves, loads; `draggable` lists the ground
-    points (they move the ground) and the moving points (they move the input)."""
+    points (they move the ground) and the moving points (they move the input). A spatial
+    mechanism's points, loads and weights stay in space: the page projects them with its camera."""
     n = len(sw)
     from ..poses import is_spatial
     space = is_spatial(m)  # a spatial mechanism's points stay in space: the page turns them
@@ -74,7 +75,7 @@ def drawing(m: Mechanism, sw: Sweep, handles: dict) -> dict:
                     "lo": g.lo, "hi": g.hi, "through": _list(g.through), "direction": _list(g.direction)}
                    for g in pic.guides],
         "joints": None if space else joints, "space": space, **(_camera() if space else {}),
-        "loads": [] if space else _loads(m, sw, pic), "forces": [] if space else forces(m, sw, pic.names),
+        "loads": _space_loads(m, sw, pic) if space else _loads(m, sw, pic), "forces": forces(m, sw, pic.names),
         "centres": {} if space else instant_centres(m, sw, pic.names, pic.xy),
     }
 
@@ -93,7 +94,15 @@ def forces(m: Mechanism, sw: Sweep, names: list[str]) -> list[dict]:
     along it at its far end (kind "effort-arrow"). A slide's reaction acts at the slide's point."""
     from ...core.dynamics import _EFFORT, _REACTION
     from ..forces import actuator
+    from ..poses import is_spatial
     out, v = [], sw.values
+    if is_spatial(m):  # an effort of a joint's angle, at the joint's point (the page turns it)
+        for name in v:
+            e = _EFFORT.match(name)
+            obj, _, attr = e["key"].rpartition(".") if e else ("", "", "")
+            if attr == "angle" and obj in names:
+                out.append({"kind": "effort", "point": names.index(obj), "label": name, "values": _list(v[name])})
+        return out
     for name in v:
         r = _REACTION.match(name)
         if r and r["attr"] == "x" and name[:-1] + "y" in v:
@@ -140,6 +149,26 @@ def _loads(m: Mechanism, sw: Sweep, pic) -> list[dict]:
             if lk is not None:
                 out.append({"kind": "torque", "point": pic.names.index(lk.point_names[0]),
                             "value": m.value(ld.value)})
+    return out
+
+
+def _space_loads(m, sw: Sweep, pic) -> list[dict]:
+    """A spatial mechanism's loads in space (the page projects them as it turns): each force as
+    {point, vector [x, y, z]}, each torque as {kind "moment", point: the body's first point,
+    vector}, each spring as {points}, each body's weight as {at: per pose [x, y, z], vector}."""
+    from ..forces import space_weights
+    from ..poses import geometry
+    out = [{"kind": "weight", "label": w.label, "at": _list(w.at), "vector": _list(w.vec[0])}
+           for w in space_weights(m, geometry(m, sw))]
+    bodies = {b.name: b for b in m.links}
+    for ld in m.loads:
+        if ld.kind == "force" and ld.at in pic.names:
+            out.append({"kind": "force", "point": pic.names.index(ld.at), "vector": [m.value(c) for c in ld.value]})
+        elif ld.kind == "spring" and all(p in pic.names for p in ld.points):
+            out.append({"kind": "spring", "points": [pic.names.index(p) for p in ld.points]})
+        elif ld.kind == "torque" and ld.at in bodies and bodies[ld.at].point_names[0] in pic.names:
+            out.append({"kind": "moment", "point": pic.names.index(bodies[ld.at].point_names[0]),
+                        "vector": [m.value(c) for c in ld.value]})
     return out
 
 
