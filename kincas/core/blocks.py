@@ -25,24 +25,38 @@ The blocks are `Model.blocks` (kincas/core/structure.py), each with `.rows` and 
 """
 from __future__ import annotations
 
+import functools
+
 import casadi as ca
 import numpy as np
+
+# casadi's linear solver for a tall group's normal equations in an MX kernel: sparse LDL'
+# (A'A is symmetric positive definite where the rank rules hold; code-generated as a loop)
+TALL_LINSOL = "ldl"
 
 
 # --- symbolic solves and measures over the blocks ---
 
 
 def _cholesky(M):
-    """Lower-triangular L with L L' = M for a symmetric positive definite M (no pivoting:
-    stable for a Gram matrix), written out entry by entry, n^3/6 operations."""
+    """Lower-triangular L (rows of entries) with L L' = M for a symmetric positive definite
+    M (no pivoting: stable for a Gram matrix), written out entry by entry, n^3/6 operations
+    (fewer where M is sparse: an entry known zero drops out of the expression)."""
     n = M.size1()
+    Lm = _cholesky_function(n)(ca.SX(M))  # evaluated in casadi: no Python call per operation
+    return [[Lm[i, j] for j in range(n)] for i in range(n)]
+
+
+@functools.lru_cache(maxsize=None)
+def _cholesky_function(n: int) -> ca.Function:
+    M = ca.SX.sym("M", n, n)
     L = [[ca.SX(0)] * n for _ in range(n)]
     for j in range(n):
         d = M[j, j] - sum((L[j][k] ** 2 for k in range(j)), ca.SX(0))
         L[j][j] = ca.sqrt(d)
         for i in range(j + 1, n):
             L[i][j] = (M[i, j] - sum((L[i][k] * L[j][k] for k in range(j)), ca.SX(0))) / L[j][j]
-    return L
+    return ca.Function("cholesky", [M], [ca.vertcat(*[ca.horzcat(*row) for row in L])])
 
 
 def _tri_solve(L, b, lower: bool):
@@ -62,18 +76,26 @@ def _tall_solve(A, b):
     """The least-squares solution of A x = b for a tall A of full column rank (redundant
     joints: a consistent system, so it is the exact solution at a root): the normal
     equations A'A x = A'b by Cholesky (Gauss-Newton's step; the rank rules of
-    kincas/core/redundant.py, not this solve, decide that A has full column rank)."""
+    kincas/core/redundant.py, not this solve, decide that A has full column rank).
+    In MX (the fast kernel of a tall structure, kincas/core/kernel.py) the same normal
+    equations go to a numeric sparse solver (`TALL_LINSOL`): a loop in the generated C,
+    where the Cholesky written out would be an expression of ~n^3 instructions."""
+    if isinstance(A, ca.MX):
+        return ca.solve(ca.mtimes(A.T, A), ca.mtimes(A.T, b), TALL_LINSOL)
     L = _cholesky(ca.mtimes(A.T, A))
     return _tri_solve(L, _tri_solve(L, ca.mtimes(A.T, b), True), False)
 
 
-def _tall_sigma(A):
-    """A lower bound of a tall A's smallest singular value: sigma_min(A) = sigma_min(L')
-    for A'A = L L', and 1 / ||L^-1||_2 >= 1 / ||L^-1||_F (within sqrt(n) of it)."""
+def _tall_sigma(A, c):
+    """A lower bound of the smallest singular value of a tall A with its columns scaled by
+    c > 0, A C (C = diag(c)): sigma_min(A C) = sigma_min(L_C') for (A C)'(A C) = L_C L_C',
+    and 1 / ||L_C^-1||_2 >= 1 / ||L_C^-1||_F (within sqrt(n) of it). L_C = C L for A'A =
+    L L' (C L is lower triangular with a positive diagonal), so L_C^-1 = L^-1 C^-1: the
+    Cholesky factor is `_tall_solve`'s, shared with the Gauss-Newton step in one function."""
     L = _cholesky(ca.mtimes(A.T, A))
     n = len(L)
     Linv = _tri_solve(L, ca.SX.eye(n), True)
-    return 1 / ca.sqrt(ca.sumsqr(Linv))
+    return 1 / ca.sqrt(ca.sumsqr(Linv / ca.repmat(ca.reshape(c, 1, -1), n, 1)))
 
 
 def _small_solve(A, b):
@@ -111,12 +133,11 @@ def block_measures(J, cs, blocks: list[Block]):
     singular value relative to max(1, its largest)), J's columns scaled by cs > 0."""
     signs, sig = [], []
     for blk in blocks:
-        c = cs[blk.cols.tolist()] if isinstance(cs, (ca.SX, ca.DM)) else ca.DM(np.asarray(cs)[blk.cols])
-        A = J[blk.rows.tolist(), blk.cols.tolist()] * ca.repmat(ca.reshape(c, 1, -1), len(blk.rows), 1)
+        A = _scaled(J, cs, blk)
         n, F = A.size1(), ca.sumsqr(A)
         if n > A.size2():  # tall (redundant joints): no determinant, so no mode (+1)
             signs.append(ca.SX(1))
-            sig.append(_tall_sigma(A) / ca.fmax(1, ca.sqrt(F)))
+            sig.append(_tall_sigma(J[blk.rows.tolist(), blk.cols.tolist()], _col_scales(cs, blk)) / ca.fmax(1, ca.sqrt(F)))
             continue
         d = ca.det(A) if n > 1 else A[0, 0]
         ad = ca.fabs(d)
@@ -129,6 +150,16 @@ def block_measures(J, cs, blocks: list[Block]):
     if not blocks:
         return ca.SX(0, 1), ca.SX(1)
     return ca.vertcat(*signs), ca.mmin(ca.vertcat(*sig))
+
+
+def _col_scales(cs, blk):
+    return cs[blk.cols.tolist()] if isinstance(cs, (ca.SX, ca.DM)) else ca.DM(np.asarray(cs)[blk.cols])
+
+
+def _scaled(J, cs, blk):
+    """J's block `blk`, its columns scaled by cs."""
+    c = _col_scales(cs, blk)
+    return J[blk.rows.tolist(), blk.cols.tolist()] * ca.repmat(ca.reshape(c, 1, -1), len(blk.rows), 1)
 
 
 def diagonal_blocks(J, blocks) -> ca.SX:
@@ -147,19 +178,35 @@ def is_tall(blocks) -> bool:
     return any(len(b.rows) > len(b.cols) for b in blocks)
 
 
-def block_change(J0d, J, D, blocks: list[Block]):
+def block_change(J0d, J, D, blocks: list[Block], cs=None):
     """max over blocks of sum |D^-1 (A0^-1 A - I) D| for the diagonal blocks A0 (given as
     `diagonal_blocks` of the last pose's g_q) and A of J. Below 1 for every block, each
     A0 + t (A - A0), t in [0, 1], is invertible, hence so is J0 + t (J - J0) (block
     triangular): det g_q keeps its sign between the two. A tall block (m x n) takes
     A0^+ A = (A0'A0)^-1 A0'A, measured by its induced 1-norm: below 1, A0^+ (A0 + t (A - A0)) = I + t (A0^+ A - I) is
-    invertible, so every A0 + t (A - A0) keeps full column rank between the two poses."""
-    out, at = [ca.SX(0)], 0
+    invertible, so every A0 + t (A - A0) keeps full column rank between the two poses.
+
+    With `cs` (the columns' scales of `block_measures`), a tall block takes instead the
+    bound ||(A - A0) D||_F / (s(A C) min_j D_j / c_j), s the lower bound of the smallest
+    singular value of `_tall_sigma` (the same as `block_measures`'), C = diag(cs): below 1,
+    ||(A - A0) D||_2 < sigma_min(A D) and, by Weyl's inequality, every A + s (A0 - A)
+    keeps full column rank as well. It costs no solve with n columns (kernel.py computes the
+    exact measure only where this bound is above JAC_CHANGE)."""
+    out, at = [ca.MX(0) if isinstance(J, ca.MX) else ca.SX(0)], 0
     for blk in blocks:
         r, c = blk.rows.tolist(), blk.cols.tolist()
         n, m, Db = len(c), len(r), D[c]
         A0 = ca.reshape(J0d[at:at + m * n], m, n)
+        if m > n:  # tall: A0 is g_q at the last pose, zero where g_q is structurally zero,
+            # so it takes J's sparsity (its normal equations then cost what J'J costs)
+            sp = J[r, c].sparsity()
+            A0 = type(J0d)(sp, J0d[[at + k for k in sp.find()]])
         at += m * n
+        if m > n and cs is not None:
+            dA = (J[r, c] - A0) * ca.repmat(ca.reshape(Db, 1, -1), m, 1)
+            ratio = ca.mmin(Db / cs[c])
+            out.append(ca.sqrt(ca.sumsqr(dA)) / (_tall_sigma(J[r, c], cs[c]) * ratio))
+            continue
         M = (_small_solve(A0, J[r, c]) - ca.DM.eye(n)) * ca.repmat(Db.T, n, 1) / ca.repmat(Db, 1, n)
         if m > n:  # tall: the induced 1-norm (largest column sum), below 1 just as well; the
             # sum of all n^2 entries would grow with n and stop a 21-unknown group every degree

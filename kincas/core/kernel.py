@@ -94,14 +94,34 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
     rs = ca.vertcat(_max_abs(g / Lg), _max_abs(step / D))
     T = -solve(Jq, Ju)
     y = ca.densify(given((q, u, p, ud, udd), ca.mtimes(T, ud))) if report else ca.SX(0, 1)
-    change = block_change(J0, Jq, D, blocks)
+    tall = is_tall(blocks)
+    change = block_change(J0, Jq, D, blocks, cs if tall else None)
     signs, sigma = block_measures(Jq, cs, blocks)
-    return [kP,
-            ca.Function("kN", [q, u, p, Lb], [d(step), rs], o),
-            ca.Function("kF", [q, u, p, L, ud, udd, J0, qp, Lb],
-                        [diagonal_blocks(Jq, blocks), d(T), rs, ca.vertcat(change, _group_correction((q - qp) / D, blocks)),
-                         ca.vertcat(signs, sigma), y, d(step)], o),
-            kL]
+    kF = ca.Function("kF", [q, u, p, L, ud, udd, J0, qp, Lb],
+                     [diagonal_blocks(Jq, blocks), d(T), rs, ca.vertcat(change, _group_correction((q - qp) / D, blocks)),
+                      ca.vertcat(signs, sigma), y, d(step), *((Jq, D) if tall else ())], o)
+    if tall:
+        kF = _exact_where_needed(kF, blocks)
+    return [kP, ca.Function("kN", [q, u, p, Lb], [d(step), rs], o), kF, kL]
+
+
+def _exact_where_needed(kF, blocks) -> ca.Function:
+    """kF of a tall kernel (redundant joints): its Jacobian change is the cheap bound of
+    `block_change` (a tall group's exact measure solves its normal equations for all n
+    columns: n^3 instructions written out, 40k of Bennett's linkage's 50k); where that bound
+    is above JAC_CHANGE, the exact measure, by a numeric sparse LDL' (MX: a loop in the
+    generated C, evaluated only then: a switch). Both certify that g_q keeps full column
+    rank between the two poses when below 1. kF's last two outputs (g_q, the scales D) are
+    for that; the function returned has the outputs of a square kernel's kF."""
+    ins = [ca.MX.sym(kF.name_in(i), kF.sparsity_in(i)) for i in range(kF.n_in())]
+    *outs, Jq, D = kF(*ins)
+    b, J0s, Js, Ds = (ca.MX.sym(n, a.sparsity()) for n, a in
+                      (("b", outs[3][0]), ("J0", ins[6]), ("J", Jq), ("D", D)))
+    exact = ca.Function("kC", [b, J0s, Js, Ds], [block_change(J0s, Js, Ds, blocks)])
+    change = ca.Function.conditional("kC_or_bound", [exact], ca.Function("kB", [b, J0s, Js, Ds], [b]))
+    bound, corr = outs[3][0], outs[3][1]  # index 0 (the bound above JAC_CHANGE, or NaN): exact
+    outs[3] = ca.vertcat(change(bound <= JAC_CHANGE, bound, ins[6], Jq, D), corr)
+    return ca.Function("kF", ins, outs)
 
 
 def _group_scales(Lb, blocks, nq, ng):
@@ -137,8 +157,10 @@ def vm_step(kP, kN, kF, kL, nq, nu, max_evals, skip: bool = True) -> ca.Function
     once converged (a small kernel: the switch's function calls cost more than a 2x2 kN).
     info = (residual, next step, Jacobian change, correction, kN steps, converged). The
     groups' lengths Lb are an input, computed once per sweep as the compiled loop does.
-    Functions written group by group are inlined (`expand`) for the virtual machine."""
-    kP, kN, kF = (f.expand() if f.is_a("MXFunction") else f for f in (kP, kN, kF))
+    Functions written group by group are inlined (`expand`) for the virtual machine; those
+    of a tall kernel (numeric linear solves, which have no SX form) stay MX, with `skip`."""
+    kP, kN, kF = (_expanded(f) for f in (kP, kN, kF))
+    skip = skip or kN.is_a("MXFunction") or kF.is_a("MXFunction")
     X = ca.MX if skip else ca.SX
     q0, J0, T0, u0 = X.sym("q0", nq), X.sym("J0", kF.size1_in(6)), X.sym("T0", nq, nu), X.sym("u0", nu)
     u, p, L, thr = X.sym("u", nu), X.sym("p", kN.size1_in(2)), X.sym("L"), X.sym("t", 5)
@@ -147,12 +169,13 @@ def vm_step(kP, kN, kF, kL, nq, nu, max_evals, skip: bool = True) -> ca.Function
     qp = kP(q0, T0, u0, u, T1, u1)
     converged = lambda rs: ca.logic_and(rs[0] <= thr[0], rs[1] <= thr[1])
     if skip:
-        x, ux, px = ca.SX.sym("q", nq), ca.SX.sym("u", nu), ca.SX.sym("p", kN.size1_in(2))
-        Lx, t4 = ca.SX.sym("Lb", kL.size1_out(0)), ca.SX.sym("t4")
+        Y = ca.MX if kN.is_a("MXFunction") else ca.SX
+        x, ux, px = Y.sym("q", nq), Y.sym("u", nu), Y.sym("p", kN.size1_in(2))
+        Lx, t4 = Y.sym("Lb", kL.size1_out(0)), Y.sym("t4")
         dq, rs = kN(x, ux, px, Lx)
         once = ca.Function.conditional(  # index 0 (not converged): one Newton step; else stay
             "vm_newton", [ca.Function("vm_step", [x, ux, px, Lx, t4], [x - dq, rs[1] <= t4])],
-            ca.Function("vm_stay", [x, ux, px, Lx, t4], [x, ca.SX(1)]))
+            ca.Function("vm_stay", [x, ux, px, Lx, t4], [x, Y(1)]))
         # the first evaluation: kN at the prediction, or (near) kF there, whose outputs the
         # last evaluation passes on where it converged
         fin = [ca.MX.sym(f"f{i}", kF.sparsity_out(i)) for i in range(kF.n_out())]
@@ -194,6 +217,17 @@ def vm_step(kP, kN, kF, kL, nq, nu, max_evals, skip: bool = True) -> ca.Function
     near_next = ca.logic_or(evals == 0, mc[1] <= thr[1])
     return ca.Function("kS", [q0, J0, T0, u0, T1, u1, near, u, p, L, thr, ud, udd, Lb],
                        [q, J, T, u, T0, u0, near_next, info, y, meas])
+
+
+def _expanded(f: ca.Function) -> ca.Function:
+    """f as one SX function where it has one; an MX function that calls a numeric linear
+    solver (a tall kernel's exact Jacobian change, `_exact_where_needed`) as it is."""
+    if not f.is_a("MXFunction"):
+        return f
+    try:
+        return f.expand()
+    except RuntimeError:  # casadi: eval_sx not defined for its linear solver
+        return f
 
 
 def _group_correction(dx, blocks):
