@@ -23,7 +23,7 @@ from ..core.assembly import ambiguous as _ambiguous, first_pose as _first, no_as
 from ..core import branch
 from ..core.numeric import Model, Solution
 from ..core.limits import on_step, polish_singular
-from ..core.tolerances import ACCEPT, BRANCH, CAREFUL_DEPTH, ILL, NEAR_SINGULAR, SLOW, STRAIGHT, WATCH
+from ..core.tolerances import ACCEPT, BRANCH, CAREFUL_DEPTH, ILL, NEAR_SINGULAR, SLOW, STRAIGHT, TINY, WATCH, WATCH_REACH
 from ..model.mechanism import Mechanism
 from .path import Bisect, Steps, Walk, follow, follow_all, wandered
 from .resume import carry_groups, larger_groups, resume_label
@@ -234,6 +234,8 @@ def _passes_singular(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
     from .singular import locate_singular
     c = np.minimum(watch_conditioning(model, J0, L), watch_conditioning(model, sol.J, L))
     watch = np.flatnonzero(c < WATCH)
+    if watch.size and "quaternion" in model.unknown_kinds:  # space: only a dip within reach
+        watch = watch[[within_reach(model, J0, sol.J, L, int(i)) for i in watch]]
     watch = watch[np.argsort(c[watch], kind="stable")]  # the likeliest crossing first: any one decides
     scales = model.scales(u0, p) if watch.size else None  # one pose's: shared by every search
     for i in watch:
@@ -269,6 +271,32 @@ def watch_conditioning(model: Model, J, L) -> np.ndarray:
         s = np.linalg.svd(B, compute_uv=False)
         cn[:, i] = s[:, -1] / np.maximum(s[:, 0], np.finfo(float).tiny)
     return cn[0] if one else cn
+
+
+def within_reach(model: Model, J0, J1, L, i: int) -> bool:
+    """Whether group i's block could be singular somewhere inside a step whose ends have
+    g_q = J0 and J1 (a spatial group's watch, beside its conditioning below WATCH).
+
+    Both ends' blocks get one scaling (columns by `column_scale`, then columns and rows to
+    unit length on average over the two ends), so that Weyl's inequality holds between them:
+    sigma_min(B(s)) >= sigma_min(B0) - ||B(s) - B0||_2. The block is singular at some s only
+    if ||B(s) - B0|| reaches sigma_min(B0) and ||B(s) - B1|| reaches sigma_min(B1). Along a
+    step the block moves by about its chord ||B1 - B0|| (WATCH_REACH times it allows for
+    the block turning along the step), so a group whose smallest singular value at both ends
+    lies beyond that reach has no singular position inside, however poor its conditioning:
+    an RSSR whose transmission angle stays near 20 degrees (sigma_min / sigma_max ~ 0.3 at
+    every pose, kincas/analysis/continuation.py's test) is not searched at every step of a
+    dense sweep, while a step ending next to a singular position (sigma_min ~ its distance)
+    still is. Scale-free: positive column and row factors, one L."""
+    b = model.blocks[i]
+    cs = model.column_scale(L)[b.cols]
+    B0, B1 = J0[np.ix_(b.rows, b.cols)] * cs, J1[np.ix_(b.rows, b.cols)] * cs
+    c = np.maximum((np.linalg.norm(B0, axis=0) + np.linalg.norm(B1, axis=0)) / 2, TINY)
+    B0, B1 = B0 / c, B1 / c
+    r = np.maximum((np.linalg.norm(B0, axis=1) + np.linalg.norm(B1, axis=1)) / 2, TINY)[:, None]
+    B0, B1 = B0 / r, B1 / r
+    s0, s1 = (np.linalg.svd(B, compute_uv=False)[-1] for B in (B0, B1))
+    return bool(max(s0, s1) <= WATCH_REACH * np.linalg.norm(B1 - B0, 2))
 
 
 def _crossed(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
