@@ -100,7 +100,7 @@ def test_rssr_far_from_singular_positions_is_not_searched_at_every_step(monkeypa
     # every pose, yet no singular position is anywhere near (a crank-rocker: the closed form
     # has a real root at every crank angle). The careful path searched one at every step
     # (locate_singular per step: ~10 s for 360 poses); a spatial group is searched only where
-    # the step could reach a singular block (continuation.within_reach).
+    # the step could reach a singular block (kincas/analysis/watch.py: within_reach).
     from kincas.analysis.continuation import watch_conditioning
     from kincas.core.tolerances import WATCH
     m = rssr()
@@ -121,7 +121,7 @@ def test_watch_still_searches_a_step_ending_next_to_a_limit(monkeypatch):
     # With a 140 mm coupler the RSSR's rocker meets a limit where c / rho = 1 in the closed
     # form (test_space.rssr_closed): a careful sweep finds it at its closed-form place, and
     # the step into the last pose before it is within reach of the singular block.
-    from kincas.analysis.continuation import within_reach
+    from kincas.analysis.watch import within_reach
     from scipy.optimize import brentq
     lc = 140.0
     m = rssr(lc=lc)

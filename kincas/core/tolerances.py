@@ -48,7 +48,7 @@ MIN_ARC_STEP = 1e-12  # following a branch gives up when its step (scaled) halve
 WATCH = 0.5  # a group conditioned below this at either end of a step is checked for a crossing
 # ... and a spatial one only where its block's smallest singular value at both ends is within
 # this times the block's change over the step (Weyl: singular inside needs that much change;
-# the factor allows for the block turning along the step), kincas/analysis/continuation.py
+# the factor allows for the block turning along the step), kincas/analysis/watch.py
 WATCH_REACH = 2.0
 
 # --- continuation (kincas/analysis/path.py: every walk along a path of poses) ---
