@@ -23,10 +23,11 @@ from ..core.assembly import ambiguous as _ambiguous, first_pose as _first, no_as
 from ..core import branch
 from ..core.numeric import Model, Solution
 from ..core.limits import on_step, polish_singular
-from ..core.tolerances import ACCEPT, BRANCH, CAREFUL_DEPTH, ILL, NEAR_SINGULAR, SLOW, STRAIGHT, WATCH
+from ..core.tolerances import ACCEPT, BRANCH, CAREFUL_DEPTH, ILL, NEAR_SINGULAR, SLOW, STRAIGHT
 from ..model.mechanism import Mechanism
 from .path import Bisect, Steps, Walk, follow, follow_all, wandered
 from .resume import carry_groups, larger_groups, resume_label
+from .watch import passes_singular as _passes_singular, watch_conditioning, within_reach  # noqa: F401
 
 
 @dataclass
@@ -173,17 +174,23 @@ def walk_inputs(model: Model, q0, u0, u1, p, L, depth: int, prev=None) -> Walk:
         sol = model.newton(pred, ub, p, L)
         if not sol.ok:
             return sol, "not converged"
+        ends = []
+
+        def measured():  # each end's groups' (modes, conditioning): the tests below share them
+            if not ends:
+                ends.extend((modes(model, J0, L), modes(model, sol.J, L)))
+            return ends
         if w.last:  # the shortest step: a group may change mode only by crossing
             # a singular position of its own that lies in this step (else it jumped branch)
-            kept = _same_branch(model, J0, sol, L) or _crossed(model, qa, ua, ub, J0, sol, p, L)
+            kept = _same_branch(model, J0, sol, L, measured) or _crossed(model, qa, ua, ub, J0, sol, p, L, measured)
             return sol, None if kept else "branch changed"
         if sol.iterations > SLOW:
             return sol, "slow"
         if wandered(qa, pred, sol.q, np.where(model.is_length, L, 1.0)):
             return sol, "wandered"
-        if not _same_branch(model, J0, sol, L):
+        if not _same_branch(model, J0, sol, L, measured):
             return sol, "branch changed"
-        if _passes_singular(model, qa, ua, ub, J0, sol, p, L):
+        if _passes_singular(model, qa, ua, ub, J0, sol, p, L, measured):
             return sol, "singular crossed"
         return sol, None
     start = _Pose(np.asarray(q0))
@@ -227,56 +234,12 @@ def _gap_inside(model: Model, run, U, p, L, j, k, sol: Solution, reach) -> bool:
     return False
 
 
-def _passes_singular(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
-    """Whether a group that is not well conditioned at either end of the step has a singular
-    position inside it: then Newton may have landed on the other branch through a change
-    point with its mode unchanged (branches cross there), and the step must be cut."""
-    from .singular import locate_singular
-    c = np.minimum(watch_conditioning(model, J0, L), watch_conditioning(model, sol.J, L))
-    watch = np.flatnonzero(c < WATCH)
-    watch = watch[np.argsort(c[watch], kind="stable")]  # the likeliest crossing first: any one decides
-    scales = model.scales(u0, p) if watch.size else None  # one pose's: shared by every search
-    for i in watch:
-        # two extended Newton steps putting s outside (-0.5, 1.5): not in this step
-        found = locate_singular(model, q0, u0, p, L, u1 - u0, group=int(i), window=(-0.5, 1.5), scales=scales)
-        if found is not None and 0 < found[2] < 1:
-            return True
-    return False
-
-
-def watch_conditioning(model: Model, J, L) -> np.ndarray:
-    """Each group's conditioning as `modes` gives it, except that a group with quaternion
-    unknowns (space) has its block's columns, then its rows, scaled to unit length first: a
-    quaternion's norm equation (2 L e), a revolute's axis equations (a half-angle's 1/2) and
-    a quaternion column against a position's (a lever over the size) carry factors of their
-    own that held a regular group's sigma_min / sigma_max at 0.1-0.5 (an RSSR: every pose
-    watched, a singular position searched at every step). The value is independent of the
-    unknowns' units and of L (the columns are normalised); positive factors change no rank, so a singular group still measures 0; a planar group's value is unchanged.
-    J is g_q at one pose (ng, nq) or at many (n, ng, nq)."""
-    cond = np.array(modes(model, J, L)[1], float)
-    kinds = model.unknown_kinds
-    if "quaternion" not in kinds:
-        return cond
-    one = J.ndim == 2
-    Jn, cn = (J[None] if one else J) * model.column_scale(L), cond[None] if one else cond
-    for i, b in enumerate(model.blocks):
-        if len(b.cols) < 2 or not any(kinds[j] == "quaternion" for j in b.cols):
-            continue
-        B = Jn[:, b.rows][:, :, b.cols]
-        tiny = np.finfo(float).tiny
-        B = B / np.maximum(np.linalg.norm(B, axis=1, keepdims=True), tiny)  # columns, then rows
-        B = B / np.maximum(np.linalg.norm(B, axis=2, keepdims=True), tiny)
-        s = np.linalg.svd(B, compute_uv=False)
-        cn[:, i] = s[:, -1] / np.maximum(s[:, 0], np.finfo(float).tiny)
-    return cn[0] if one else cn
-
-
-def _crossed(model: Model, q0, u0, u1, J0, sol: Solution, p, L) -> bool:
+def _crossed(model: Model, q0, u0, u1, J0, sol: Solution, p, L, measured=None) -> bool:
     """Whether every group whose mode differs between J0 (at u0) and sol (at u1) has a
-    singular position of its own between u0 and u1 (located from the nearer end)."""
+    singular position of its own between u0 and u1 (located from the nearer end).
+    `measured()`, if given, returns `modes` at J0 and at sol.J."""
     from .singular import locate_singular
-    s0, c0 = modes(model, J0, L)
-    s1, c1 = modes(model, sol.J, L)
+    (s0, c0), (s1, c1) = measured() if measured is not None else (modes(model, J0, L), modes(model, sol.J, L))
     for i in np.flatnonzero(branch.changed(s0, s1)):
         start, d = ((q0, u0), u1 - u0) if c0[i] <= c1[i] else ((sol.q, u1), u0 - u1)
         if min(c0[i], c1[i]) < NEAR_SINGULAR and polish_singular(model, *start, p, L, [int(i)]) is not None:
@@ -320,7 +283,7 @@ def _det_sign(model: Model, sol: Solution, L) -> int:
     return int(np.prod(modes(model, sol.J, L)[0]))
 
 
-def _same_branch(model: Model, J0, sol: Solution, L) -> bool:
+def _same_branch(model: Model, J0, sol: Solution, L, measured=None) -> bool:
     """Whether every Assur group kept its mode from J0 to sol.J (or is nearly singular at
     either: there the mode is not defined, and the sweep's events locate the crossing).
 
@@ -328,9 +291,10 @@ def _same_branch(model: Model, J0, sol: Solution, L) -> bool:
     with J0 = Q0 R0 (Q0 an orthonormal basis of J0's column space), det(Q0' J) is
     continuous in J and equals det R0 at J0, so it changes sign only where Q0' J is
     singular: det(Q0' J1) and det(R0) of opposite signs mean a singular position was
-    crossed, exactly as det g_q's sign change does for a square system."""
+    crossed, exactly as det g_q's sign change does for a square system. `measured()`, if
+    given, returns `modes` at J0 and at sol.J."""
     if model.square:
-        s0, s1 = modes(model, J0, L)[0], modes(model, sol.J, L)[0]
+        (s0, _), (s1, _) = measured() if measured is not None else (modes(model, J0, L), modes(model, sol.J, L))
         return not branch.changed(s0, s1).any()
     c = model.column_scale(L)
     Q0, R0 = np.linalg.qr(J0 * c)

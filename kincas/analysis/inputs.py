@@ -17,6 +17,8 @@ import numpy as np
 from ..errors import ModelError
 from ..model.mechanism import Mechanism
 
+_PLAIN = (float, int, np.float64)  # numbers an input gives as they are (not bool)
+
 
 def input_table(m: Mechanism, inputs, what: str, default: float | None, keys=None) -> np.ndarray:
     """(N x nu) array of one value per input and pose from a mapping key -> scalar or array
@@ -33,6 +35,13 @@ def input_table(m: Mechanism, inputs, what: str, default: float | None, keys=Non
             c = _floats(c, what, keys[0])
         if c.ndim <= 1 and c.size and np.isfinite(c).all():
             return c.reshape(-1, 1)
+    if type(inputs) is dict and len(inputs) == len(keys) and keys:  # one plain number per
+        # input (a pose of kincas.solve): the row as it is, without a column per input
+        row = [inputs.get(k, inputs) for k in keys]
+        if all(type(v) in _PLAIN for v in row):
+            a = np.array([row], dtype=float)
+            if np.isfinite(a).all():
+                return a
     if inputs is None:
         if default is None and keys:
             raise ModelError(f"{what}: give a value for each of {keys}")

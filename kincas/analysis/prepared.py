@@ -25,14 +25,17 @@ True
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..core.assembly import Placement, ambiguous, assemble
 from ..core.caches import Memo
 from ..core.fast import sweeper_for
 from ..core.guessed import guessed_start
-from ..model.mechanism import Mechanism
+from ..model.mechanism import Mechanism, check_guess
 
+_PLAIN = (float, int, np.float64)  # numbers a guess gives as they are (not bool: not a number)
 RECENT = 32  # mechanisms kept per structure
 PLACEMENTS = 8  # first-pose placements kept per mechanism (inputs and guesses of its sweeps)
 
@@ -58,6 +61,34 @@ class Prepared:
         self._sweepers: dict = {}  # (report, compile) -> FastSweeper
         self._names: set = set()  # reports whose names were checked
         self.reports: dict = {}  # report as given (None, a name, a tuple of names) -> the names
+        self._moving = frozenset(m.moving_points)  # the points a guess may place
+        self._dim = 3 if getattr(m, "space", "2d") == "3d" else 2
+
+    def with_guess(self, guess) -> dict:
+        """The guessed points (`guess`, numbers) updated by a guess given to one call, checked
+        as the mechanism's own (`check_guess`: ModelError naming what is wrong). Plain finite
+        numbers for moving points, the usual case, are taken as they are without the full
+        check (a forward-kinematics loop passes a fresh guess at every call)."""
+        if not guess:
+            return self.guess
+        if type(guess) is dict:
+            new, dim, moving = {}, self._dim, self._moving
+            for k, xy in guess.items():
+                t = type(xy)
+                if t is np.ndarray:
+                    xy = xy.tolist() if xy.dtype == np.float64 and xy.shape == (dim,) else None
+                elif t is not tuple and t is not list:
+                    xy = None
+                if xy is None or len(xy) != dim or k not in moving:
+                    break
+                c = tuple(float(v) for v in xy if type(v) in _PLAIN)
+                if len(c) != dim or not all(map(math.isfinite, c)):
+                    break
+                new[k] = c
+            else:
+                return {**self.guess, **new}
+        m = self.m
+        return {**self.guess, **{k: tuple(map(m.value, xy)) for k, xy in check_guess(m, guess)}}
 
     def sweeper(self, model, report: tuple, compile):
         """The model's `FastSweeper` for `report` and `compile` (`sweeper_for`), found here

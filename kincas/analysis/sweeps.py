@@ -32,7 +32,6 @@ from .resume import unlabelled_resumes
 from .events import null_derivatives, sweep_events
 from ..core.joints import check_first_pose
 from .inputs import derivative_table, input_table as _input_table
-from ..model.mechanism import check_guess
 from .prepared import model_and_prepared
 from .methods import SweepMethod, method_of
 
@@ -126,7 +125,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     Udd = _per_pose(m, accelerations, "accelerations", 0.0, n, pm.keys)
     Uddd = None if jerks is None else derivative_table(m, jerks, "jerks", 0.0, n, pm.keys)
     p, L = pm.p, pm.size
-    g = pm.guess if not guess else {**pm.guess, **{k: tuple(map(m.value, xy)) for k, xy in check_guess(m, guess)}}
+    g = pm.with_guess(guess)
     events = []
 
     def first(k):

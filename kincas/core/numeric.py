@@ -50,6 +50,7 @@ def _structure_key(m: Mechanism):
 
 
 _CACHE = Memo("models by structure", bound=64)
+SCALES_KEPT = 16  # geometries (parameter values, driven lengths) whose scales a model keeps
 
 
 def model_of(m: Mechanism, check: bool = True) -> "Model":
@@ -167,6 +168,7 @@ class Model(FirstPose):
         self._blocks = None
         self._lock = threading.RLock()  # guards the lazily built members above
         self._memo = Memo(gate=self._lock)  # builds of one model never overlap (CasADi symbols)
+        self._scales = Memo(bound=SCALES_KEPT)  # geometry -> scales (`scales`)
         self._resjac, self._tangent = _Call(sym.f_resjac), _Call(sym.f_tangent)
         self._res = _Call(sym.f_res)
         self.structure = Structure(sym)
@@ -185,6 +187,13 @@ class Model(FirstPose):
         Both come from the unknown's or equation's own group (its block's bodies), not from
         the whole drawing, so a far point elsewhere loosens nobody's tolerance."""
         local, ground = (a.ravel() for a in self._geometry(u, p))
+        # a pure function of the geometry at (u, p), kept for the last few: every Newton and
+        # every first pose asks for it, mostly at the same parameter values
+        eq, qs = self._scales.get_or_build(local.tobytes() + ground.tobytes(),
+                                           lambda: self._scales_of(local, ground))
+        return eq.copy(), qs.copy()
+
+    def _scales_of(self, local, ground):
         Lb = self.structure.block_lengths(local, ground)
         eq, qs = np.ones(self.ng), np.ones(self.nq)
         for b, L in zip(self.blocks, Lb):

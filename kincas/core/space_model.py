@@ -101,45 +101,51 @@ class SpatialFirstPose:
         gv = {g: ground[3 * i:3 * i + 3] for i, (g, _) in enumerate(m.ground)}
         return out, gv
 
+    def _placing(self):
+        """What `initial_q` reads of the structure, once per model: per rigid body its name and
+        point names and where its r and e sit in q; per point only bars carry, where its
+        coordinates sit; whether any input drives a joint."""
+        def build():
+            m, sym = self.sym.mech, self.sym
+            index = {name: i for i, (name, _) in enumerate(sym.unknowns)}
+            bodies = [(b.name, b.point_names, [index[f"{b.name}.r{a}"] for a in "xyz"],
+                       [index[f"{b.name}.q{a}"] for a in "wxyz"]) for b in m.bodies if not b.two_point]
+            bars = [(pt, [index[f"{pt}.{a}"] for a in "xyz"]) for pt in m.moving_points if f"{pt}.x" in index]
+            return bodies, bars, any(inp.kind == "joint" for inp in m.inputs)
+        return self.memo("first_pose.placing", build)
+
     def initial_q(self, u, p, guess, L, turn=None, free=None) -> np.ndarray:
         """Unknowns placed from the drawing pose, the guess and the inputs (module text)."""
-        m, sym = self.sym.mech, self.sym
+        m = self.sym.mech
         u = np.asarray(u, float)
         drawn, gv = self._drawn(u, p)
-        index = {name: i for i, (name, _) in enumerate(sym.unknowns)}
+        bodies, bars, driven = self._placing()
         q = np.zeros(self.nq)
         o = gv[m.ground[0][0]] if m.ground else np.zeros(3)  # the model's origin
         pose = {GROUND: (np.zeros(3), np.eye(3), np.zeros(3))}  # body -> (r, R, c)
-        for b in m.bodies:
-            if b.two_point:
-                continue
-            P0 = drawn[b.name]
-            c = P0.mean(axis=0)
-            names = b.point_names
+        for name, names, _, _ in bodies:
+            P0 = drawn[name]
+            c = P0.sum(axis=0) / len(P0)  # (the mean's own arithmetic, without its checks)
             have = [i for i, pt in enumerate(names) if pt in guess or pt in gv]
             if have:
                 A = P0[have]
-                B = np.array([np.asarray(guess[names[i]] if names[i] in guess else gv[names[i]], float)
-                              for i in have])
-                R = kabsch(A - A.mean(axis=0), B - B.mean(axis=0)) if len(have) > 1 else np.eye(3)
-                r = B.mean(axis=0) - R @ (A.mean(axis=0) - c)
+                B = np.array([guess[names[i]] if names[i] in guess else gv[names[i]] for i in have], float)
+                a0, b0 = A.sum(axis=0) / len(A), B.sum(axis=0) / len(B)
+                R = kabsch(A - a0, B - b0) if len(have) > 1 else np.eye(3)
+                r = b0 - R @ (a0 - c)
             else:
                 R, r = np.eye(3), c
-            pose[b.name] = (r, R, c)
-        for k, inp in enumerate(m.inputs):
-            if inp.kind == "joint":
-                self._drive(pose, m, inp.target, u[k], drawn)
-        for name, (r, R, c) in pose.items():
-            if name == GROUND:
-                continue
-            for a, v in zip("xyz", r - o):
-                q[index[f"{name}.r{a}"]] = v
-            for a, v in zip("wxyz", quat_of(R)):
-                q[index[f"{name}.q{a}"]] = v
-        for pt in m.moving_points:
-            if f"{pt}.x" in index:
-                for a, v, oa in zip("xyz", guess[pt], o):
-                    q[index[f"{pt}.{a}"]] = float(v) - oa
+            pose[name] = (r, R, c)
+        if driven:
+            for k, inp in enumerate(m.inputs):
+                if inp.kind == "joint":
+                    self._drive(pose, m, inp.target, u[k], drawn)
+        for name, _, ri, ei in bodies:
+            r, R, _ = pose[name]
+            q[ri] = r - o
+            q[ei] = quat_of(R)
+        for pt, xi in bars:
+            q[xi] = np.array(guess[pt], float) - o
         return q
 
     @staticmethod

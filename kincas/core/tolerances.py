@@ -46,6 +46,10 @@ REACHED = 1e-3  # a located position this fraction of a step away from a pose: t
 STEP_SLACK = 1e-9  # a position located at s in [-STEP_SLACK, 1 + STEP_SLACK] of a step lies on it
 MIN_ARC_STEP = 1e-12  # following a branch gives up when its step (scaled) halves below this
 WATCH = 0.5  # a group conditioned below this at either end of a step is checked for a crossing
+# ... and a spatial one only where its block's smallest singular value at both ends is within
+# this times the block's change over the step (Weyl: singular inside needs that much change;
+# the factor allows for the block turning along the step), kincas/analysis/watch.py
+WATCH_REACH = 2.0
 
 # --- continuation (kincas/analysis/path.py: every walk along a path of poses) ---
 # A corrected pose farther than WANDER_SHARE of the predicted move (or WANDER_FLOOR, scaled)
