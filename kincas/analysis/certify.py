@@ -53,7 +53,7 @@ from ..model.joints import split_relative
 from ..model.mechanism import Mechanism
 from .certify_msolve import solve
 from ..core.tolerances import SAME_ASSEMBLY as SAME
-from .assembly_mode import Mode, input_vector as _input_vector, mode_at
+from .assembly_mode import Mode, input_vector as _input_vector, mode_at, signature
 
 
 @dataclass(frozen=True)
@@ -140,7 +140,7 @@ def certify_modes(m: Mechanism, inputs=None, *, threads: int = 1,
     model, p = model_of(m_r), np.array([v for _, v in m_r.parameters], dtype=float)
     guess = {k: tuple(m_r.value(c) for c in xyz) for k, xyz in m_r.guess}
     first = first_pose(model, u_r, p, L, guess)
-    picked = model.points(first.q, u_r, p).T.ravel() if first.ok else None
+    picked = signature(model, first.q, u_r, p, L)[0] if first.ok else None
     scale = np.where(S.length, L, 1.0)
     centres = [np.array([float((a + b) / 2) for a, b in box]) for box in boxes]
     out, rejected = [], []
