@@ -86,6 +86,8 @@ FREE_LINKS = 6  # links left free by a guess that are tried in several turns (co
 NEARER = 1e-9  # another start's assembly is nearer the guessed points when its cost is below (1 - this) times
 CHOICE_STARTS = 128  # scattered starts finding a guessless sweep's other assemblies (analysis/choice.py)
 CHOICE_TRIES = 8  # of which at most this many are swept
+CHOICE_TRIES_CERTIFIED = 40  # certified assemblies swept at most (all of them, to say with certainty that none runs)
+CHOICE_CERTIFY_TIMEOUT = 10.0  # seconds msolve may take to certify a guessless sweep's first pose (else the multistart)
 
 # --- pictures ---
 END_ON = 1e-6  # a slide's unit direction drawn shorter than this is seen end on (views/projection.py)
