@@ -173,6 +173,7 @@ def test_stewart_dietmaier_40():
     assert len(S.names) == 12 and S.rounded == []
     found = certified(m, {f"l{k + 1}": v for k, v in enumerate(DIETMAIER["L"])})
     assert found.count == 40  # the published count: 40, all of the complex ones real
+    assert [md.note for md in found if md.note] == []  # each refined inside its box (to its error bound)
     poses = []
     for md in found:  # each: six legs of the given lengths (an independent check)
         for A, P, L, k in zip(DIETMAIER["A"], DIETMAIER["P"], DIETMAIER["L"], range(6)):

@@ -9,8 +9,10 @@ solution, each isolated in a box that holds it and no other. Then, per box:
 
 1. the box's centre is mapped to kincas's unknowns (an angle is atan2(s, c); a relative
    input's angle is kept within a turn of its equation), and refined by kincas's own Newton;
-2. the refined point must lie in its box (to the rounding of a float solve, CERTIFY_SLACK
-   times the size): if it does not (Newton left for another root, or crawled onto a
+2. the refined point must lie in its box to its own floating-point error bound (first
+   order: the scaled Jacobian's pseudo-inverse times the residual left plus its rounding,
+   so it grows with the conditioning; `_refined`), that bound below half the distance to
+   the nearest other root: if it does not (Newton left for another root, or crawled onto a
    singular one), the mode says so and keeps the box's centre, itself right to 2^-64;
 3. the rule for an assembly: kincas's relative residual at the point is at most ACCEPT.
    Every real solution of these equations is an assembly (no mirror images, no spurious
@@ -46,7 +48,7 @@ import numpy as np
 from ..core.assembly import first_pose
 from ..core.numeric import model_of
 from ..core.polynomial_planar import closure
-from ..core.tolerances import (ACCEPT, CERTIFY_NUDGE, CERTIFY_SLACK, CERTIFY_SPLIT, CERTIFY_TIMEOUT,
+from ..core.tolerances import (ACCEPT, CERTIFY_NUDGE, CERTIFY_ROUNDING, CERTIFY_SPLIT, CERTIFY_TIMEOUT,
                                RANK, TINY)
 from ..frames import Modes
 from ..model.joints import split_relative
@@ -146,11 +148,11 @@ def certify_modes(m: Mechanism, inputs=None, *, threads: int = 1,
     out, rejected = [], []
     for k, box in enumerate(boxes):
         c, hw = centres[k], np.array([float((b - a) / 2) for a, b in box])
-        q, note = _refined(m, model, S, c, hw, scale, u_r, p)
+        others = [np.abs((c - o) / scale).max() for j, o in enumerate(centres) if j != k]
+        q, note = _refined(m, model, S, c, hw, scale, u_r, p, L, min(others, default=math.inf))
         mult = 1
         corank = _corank(model, q, u_r, p, L)
         if corank:
-            others = [np.abs((c - o) / scale).max() for j, o in enumerate(centres) if j != k]
             mult = max(1 + corank, _split_count(m, u, S, c, scale, L, min(others, default=1.0)))
         halfwidth = max((P.subs(value).spread(box) for xy in S.points.values() for P in xy), default=0.0)
         md = mode_at(m_r, model, q, u_r, p, L, picked, kind=CertifiedMode, halfwidth=halfwidth,
@@ -267,17 +269,43 @@ def _variables_at(S, q) -> np.ndarray:
     return x
 
 
-def _refined(m, model, S, c, hw, scale, u, p):
-    """(q, note): Newton from the box's centre, kept when it converges inside the box."""
+def _refined(m, model, S, c, hw, scale, u, p, L, nearest=math.inf):
+    """(q, note): Newton from the box's centre, kept when it converges inside the box.
+
+    Inside to what? The float point q is the root only to its forward error: to first order
+    |dz| <= ||G^+|| (|g(q)| / L + CERTIFY_ROUNDING), G the column-scaled g_q over L (O(1)),
+    g(q) the residual left and CERTIFY_ROUNDING the rounding of its evaluation (relative):
+    a bound that grows with the conditioning, not a fixed 1e-12. In the polynomial
+    variables (cosines, lengths over the size, a rotation matrix's entries: at most
+    4 |de| for a unit quaternion's change de) that is `_error_bound`. The refined point
+    counts as the box's root when every variable is within the box's half-width plus that
+    bound of its centre, and the bound is below half the (scaled) distance to the nearest
+    other root, so that it cannot be another box's. At a multiple root (a singular pose) the
+    first-order bound is infinite; the float point's error there is of the order of the
+    square root of the rounding (a double root), the cap used."""
     q0 = _unknowns_at(m, S, c, u)
     sol = model.newton(q0, u, p)
     if not sol.ok:
         return q0, "Newton did not converge from the box (a singular pose?): the box's centre is used"
-    off = np.abs(_variables_at(S, sol.q) - c) - hw
-    if (off > CERTIFY_SLACK * scale).any():
-        return q0, (f"the refined point left its box by {float((off / scale).max()):.1e} "
-                    f"(relative): the box's centre is used")
+    # plus the rounding of the map from q to the variables (cosines, a rotation's entries)
+    bound = _error_bound(model, sol.q, u, p, L) * (4.0 if _spatial(m) else 1.0) + CERTIFY_ROUNDING
+    off = (np.abs(_variables_at(S, sol.q) - c) - hw) / scale
+    if (off > bound).any() or bound >= 0.5 * nearest:
+        return q0, (f"the refined point left its box by {float(off.max()):.1e} (relative; its error "
+                    f"bound {bound:.1e}, the nearest root at {nearest:.1e}): the box's centre is used")
     return sol.q, ""
+
+
+def _error_bound(model, q, u, p, L) -> float:
+    """First-order bound on the float point q's distance to the root (relative to the size
+    for lengths, radians for angles): ||(g_q s)^+||_inf (|g(q)|_inf / L + CERTIFY_ROUNDING),
+    s the column scale (kincas's `column_scale`)."""
+    if model.nq == 0:
+        return 0.0
+    G = model.jac(q, u, p) * model.column_scale(L)
+    g = np.abs(model.residual(q, u, p)).max(initial=0.0) / L
+    bound = float(np.abs(np.linalg.pinv(G)).sum(axis=1).max() * (g + CERTIFY_ROUNDING))
+    return min(bound, math.sqrt(CERTIFY_ROUNDING)) if math.isfinite(bound) else math.sqrt(CERTIFY_ROUNDING)
 
 
 def _corank(model, q, u, p, L) -> int:
