@@ -58,7 +58,7 @@ def cli_run(args) -> int:
                          for md, ang in zip(modes, user_ang)]}
         if modes.certified:
             doc.update(count=modes.count, rounded=modes.rounded, rejected=modes.rejected,
-                       positive_dimension=modes.positive_dimension)
+                       discarded=modes.discarded, positive_dimension=modes.positive_dimension)
         else:
             doc.update(starts=args.starts, seed=args.seed)
         json.dump(doc, sys.stdout, allow_nan=False)
@@ -106,6 +106,9 @@ def _print_modes(sc, modes, user_in, user_ang, args):
         print(f"  the certificate is for the rounded pose: {note}")
     for note in getattr(modes, "rejected", []):
         print(f"  rejected: {note}")
+    if getattr(modes, "discarded", []):
+        print(f"  discarded: {len(modes.discarded)} real solutions of the kept equations that break an "
+              f"implied one (not assemblies; --json lists them)")
     for k, (md, ang) in enumerate(zip(modes, user_ang), 1):
         mark = "" if not md.from_guess else ("  <- the scene's [guess] gives this one" if sc.mechanism.guess
                                              else "  <- `kincas solve` starts on this one (no [guess])")
