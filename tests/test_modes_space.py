@@ -49,3 +49,5 @@ def test_double_cardan_four_modes_told_apart_by_orientation():
 def test_double_cardan_cli_modes_count(capsys):
     code, out, err = run_cli(capsys, "modes", CARDAN, "--json")
     assert code == 0 and len(out["modes"]) == 4
+    code, out, err = run_cli(capsys, "modes", CARDAN)
+    assert code == 0 and "4 assembly modes" in out and "cannot pick between them" in out

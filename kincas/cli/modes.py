@@ -109,6 +109,10 @@ def _print_modes(sc, modes, user_in, user_ang, args):
     if getattr(modes, "discarded", []):
         print(f"  discarded: {len(modes.discarded)} real solutions of the kept equations that break an "
               f"implied one (not assemblies; --json lists them)")
+    blocks = [md.guess_block() for md in modes]
+    if len(set(blocks)) < len(blocks):  # in space: a body's spin about the line of its points
+        print("  some modes have the same points (they differ in a body's turn about the line of its "
+              "points): a [guess] of points cannot pick between them")
     for k, (md, ang) in enumerate(zip(modes, user_ang), 1):
         mark = "" if not md.from_guess else ("  <- the scene's [guess] gives this one" if sc.mechanism.guess
                                              else "  <- `kincas solve` starts on this one (no [guess])")
