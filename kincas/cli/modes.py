@@ -7,7 +7,10 @@ import math
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from ..analysis.modes import find_modes
+from ..core.tolerances import SAME_ASSEMBLY
 from ..errors import OutputError, SceneError
 from .scene import load
 from .scene_guess import scene_with_guess
@@ -109,8 +112,10 @@ def _print_modes(sc, modes, user_in, user_ang, args):
     if getattr(modes, "discarded", []):
         print(f"  discarded: {len(modes.discarded)} real solutions of the kept equations that break an "
               f"implied one (not assemblies; --json lists them)")
-    blocks = [md.guess_block() for md in modes]
-    if len(set(blocks)) < len(blocks):  # in space: a body's spin about the line of its points
+    size = sc.mechanism.size()
+    pts = [np.ravel(list(md.points.values())) for md in modes]
+    if any(np.abs(a - b).max(initial=0.0) <= SAME_ASSEMBLY * size for i, a in enumerate(pts) for b in pts[:i]):
+        # in space: a body's spin about the line of its points
         print("  some modes have the same points (they differ in a body's turn about the line of its "
               "points): a [guess] of points cannot pick between them")
     for k, (md, ang) in enumerate(zip(modes, user_ang), 1):
