@@ -63,8 +63,8 @@ def _assemblies(m, inputs):
         from .certify import certify_modes
         try:
             found = certify_modes(m, inputs, timeout=CHOICE_CERTIFY_TIMEOUT)
-            if not found.positive_dimension and not found.rejected:
-                return found, True
+            if len(found) and not found.positive_dimension and not found.rejected:
+                return found, True  # (the default's first pose assembles: none found is a fault)
         except KincasError:  # not polynomial, refused, msolve out of time: the multistart
             pass
     from .modes import find_modes
