@@ -33,7 +33,7 @@ import math
 from dataclasses import dataclass, field
 from fractions import Fraction
 
-from .tolerances import CERTIFY_DENOMINATOR
+from .tolerances import CERTIFY_DENOMINATOR, TINY
 
 
 def exact(v: float) -> Fraction:
@@ -189,7 +189,7 @@ def independent(equations, x, n: int, scale, tol: float, always=()) -> list[int]
     """
     import numpy as np
     J = np.array([P.gradient(x, n) for P in equations]).reshape(len(equations), n) * np.asarray(scale, float)
-    J /= np.maximum(np.linalg.norm(J, axis=1, keepdims=True), 1e-300)
+    J /= np.maximum(np.linalg.norm(J, axis=1, keepdims=True), TINY)
     basis, keep = [], []
 
     def add(k, forced):
