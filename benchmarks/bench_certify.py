@@ -3,7 +3,8 @@ often the multistart misses a mode that the certificate proves exists.
 
     python benchmarks/bench_certify.py [--quick]
 
-For each case and a few poses along its sweep: `kincas.modes(m, u, certify=True)` (wall time:
+For each case (planar and spatial; the overconstrained spatial ones with float axes through
+their square subsystems, kincas/analysis/certify_over.py) and a few poses along its sweep: `kincas.modes(m, u, certify=True)` (wall time:
 msolve is another process, so CPU time of this one would not count it), and the multistart
 `find_modes` with 16, 64 and 512 starts over several seeds: its median wall time and the
 fraction of (pose, seed) runs whose count is below the certified one. Writes
@@ -59,6 +60,9 @@ CASES = {  # name: (mechanism, input key, poses to try)
     "Assur group 4.4 (tests/test_certify.py)": "group44",
     "spatial RSSR (space_rssr)": "space_rssr",
     "spatial slider-crank (space_slider_crank)": "space_slider_crank",
+    "double Cardan shaft (space_double_cardan)": "space_double_cardan",
+    "spherical four-bar, float axes (space_spherical_fourbar)": "space_spherical_fourbar",
+    "Bennett linkage, float axes (space_bennett)": "space_bennett",
     "Stewart-Gough, Dietmaier's 40 (space_stewart_40)": "space_stewart_40",
 }
 

@@ -173,6 +173,7 @@ def test_stewart_dietmaier_40():
     assert len(S.names) == 12 and S.rounded == []
     found = certified(m, {f"l{k + 1}": v for k, v in enumerate(DIETMAIER["L"])})
     assert found.count == 40  # the published count: 40, all of the complex ones real
+    assert [md.note for md in found if md.note] == []  # each refined inside its box (to its error bound)
     poses = []
     for md in found:  # each: six legs of the given lengths (an independent check)
         for A, P, L, k in zip(DIETMAIER["A"], DIETMAIER["P"], DIETMAIER["L"], range(6)):
@@ -182,9 +183,73 @@ def test_stewart_dietmaier_40():
     assert min(gaps) > 1e-6  # 40 distinct assemblies
 
 
+def sphere_line_count(m, u):
+    """The spherical four-bar's assemblies at input u, independently: C on the sphere
+    |C| = |C0|, on the output's plane a.C = a.C0, on the plane B(u).C = B0.C0 (the coupler
+    keeps the angle BOC): a line through a sphere, 2, 1 or 0 points. Also the predicate."""
+    pts = {p: np.array(xyz, float) for b in m.bodies for p, xyz in b.points}
+    B0, C0 = pts["B"], pts["C"]
+    B = np.array([[math.cos(u), -math.sin(u), 0], [math.sin(u), math.cos(u), 0], [0, 0, 1]]) @ B0
+    a = np.asarray(m.joint("out").axis, float)
+    a /= np.linalg.norm(a)
+    M, d = np.array([a, B]), np.array([a @ C0, B0 @ C0])
+    p0 = np.linalg.lstsq(M, d, rcond=None)[0]  # the line's point nearest O
+    on = lambda C: max(abs(np.linalg.norm(C) - np.linalg.norm(C0)), abs(a @ C - d[0]), abs(B @ C - d[1]) / 100)
+    return (2 if p0 @ p0 < C0 @ C0 else 0), on
+
+
+@pytest.mark.slow
 @needs_msolve
-def test_overconstrained_with_inexact_geometry_refused(capsys):
-    """The example spherical four-bar's axes meet at O only to float rounding: as exact
-    rationals it is rigid, so its count would not be the mechanism's: refused, exit 2."""
-    code, out, err = run_cli(capsys, "modes", EXAMPLES / "space_spherical_fourbar.toml", "--certify")
-    assert code == 2 and "overconstrained" in err and len(err.strip().splitlines()) == 1
+def test_float_axes_spherical_fourbar_certified(capsys):
+    """The example's axes meet at O only to float rounding: as exact rationals it is rigid.
+    The equations implied at the drawing pose are left out (the square subsystem), every root
+    refined on the scene's floats into its box: the line-sphere count."""
+    m = kincas.cli.scene.load(EXAMPLES / "space_spherical_fourbar.toml").mechanism
+    count, on = sphere_line_count(m, 0.0)
+    code, out, err = run_cli(capsys, "modes", EXAMPLES / "space_spherical_fourbar.toml", "--certify", "--json")
+    assert code == 0 and out["certified"] and out["count"] == count == 2 and out["rejected"] == []
+    assert any("overconstrained" in note for note in out["rounded"])
+    for md in out["modes"]:
+        assert on(np.array(md["points"]["C"])) < 1e-9 and "note" not in md
+
+
+def bennett_angles(m, u):
+    """Bennett's linkage at input u, independently of kincas: the coupler L2 turns by t2
+    about its axis at O2 (carried by the crank), the follower L3 by t4 about the ground's
+    axis at O4; the joint at O3 needs the point and the axis z3 the same from both. Every
+    root of that 2 x 2 problem on the torus, from a 16 x 16 grid of starts."""
+    from scipy.optimize import least_squares
+    pts = {p: np.array(xyz, float) for b in m.bodies for p, xyz in b.points}
+    pts.update({g: np.array(xyz, float) for g, xyz in m.ground})
+    z = {j.point: np.asarray(j.axis, float) / np.linalg.norm(j.axis) for j in m.joints}
+    rot = lambda a, t: kincas.core.space_model.axis_rotation(a, t)
+    R1 = rot(z["O1"], u)
+    o2, a2 = R1 @ pts["O2"], R1 @ z["O2"]
+
+    def f(v):
+        P2 = o2 + rot(a2, v[0]) @ (R1 @ pts["O3"] - o2)
+        P3 = pts["O4"] + rot(z["O4"], v[1]) @ (pts["O3"] - pts["O4"])
+        Z2, Z3 = rot(a2, v[0]) @ R1 @ z["O3"], rot(z["O4"], v[1]) @ z["O3"]
+        return np.concatenate([P2 - P3, 100 * (Z2 - Z3)])
+    roots = []
+    for t2 in np.linspace(-math.pi, math.pi, 16, endpoint=False):
+        for t4 in np.linspace(-math.pi, math.pi, 16, endpoint=False):
+            r = least_squares(f, [t2, t4], xtol=1e-15, ftol=1e-15, gtol=1e-15)
+            w = np.angle(np.exp(1j * r.x))
+            if np.abs(r.fun).max() < 1e-8 and all(np.abs(np.angle(np.exp(1j * (w - s)))).max() > 1e-6 for s in roots):
+                roots.append(w)
+    return roots, lambda v: R1 @ pts["O2"], lambda v: pts["O4"] + rot(z["O4"], v[1]) @ (pts["O3"] - pts["O4"])
+
+
+@pytest.mark.slow
+@needs_msolve
+def test_float_axes_bennett_certified():
+    m = kincas.cli.scene.load(EXAMPLES / "space_bennett.toml").mechanism
+    u = 0.5
+    roots, O2, O3 = bennett_angles(m, u)
+    found = kincas.modes(m, {"O1.angle": u}, certify=True)
+    assert found.count == len(roots) == 1 and not found.rejected
+    assert found.rounded and "overconstrained" in found.rounded[-1]
+    assert [md.note for md in found] == [""]  # refined on the floats into its box
+    assert np.allclose(found[0].points["O3"], O3(roots[0]), atol=1e-8)
+    assert np.allclose(found[0].points["O2"], O2(roots[0]), atol=1e-8)

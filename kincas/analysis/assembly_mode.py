@@ -57,9 +57,33 @@ def input_vector(m: Mechanism, inputs) -> np.ndarray:
     return U[0]
 
 
+def signature(model, Q, u, p, L) -> np.ndarray:
+    """One row per row of unknowns Q that tells assemblies apart: the moving points
+    (x1, y1[, z1], x2, ...) and, for a spatial body, its rotation matrix times the size L.
+    Points alone fix every planar link's angle, but not a spatial body's spin about the line
+    of its points (a shaft held at two points: the double Cardan's intermediate shaft has
+    the same points in two assemblies turned half a turn apart about it).
+
+    >>> import kincas
+    >>> from kincas.core.numeric import model_of
+    >>> m = kincas.Mechanism(ground={"A": (0, 0)}, links=[kincas.Link.bar("crank", "A", "B", 2)],
+    ...     inputs=[kincas.Input.angle("crank")])
+    >>> signature(model_of(m), np.zeros((1, 0)), np.array([0.0]), np.zeros(0), 2.0).round(9).tolist()
+    [[2.0, 0.0]]
+    """
+    Q = np.atleast_2d(np.asarray(Q, float))
+    rows = [model.points_many(Q, u, p)]
+    for j, nm in enumerate(model.unknown_names):
+        if nm.endswith(".qw"):  # a spatial body's unit quaternion: its rotation, scaled by L
+            from ..core.space_model import rot_of
+            E = Q[:, j:j + 4] / np.linalg.norm(Q[:, j:j + 4], axis=1, keepdims=True)
+            rows.append(L * np.moveaxis(rot_of(E.T), -1, 0).reshape(len(Q), 9))
+    return np.hstack(rows)
+
+
 def mode_at(m, model, q, u, p, L, picked=None, pts=None, kind=None, **extra) -> Mode:
     """The `Mode` at unknowns q: its points, link angles, relative residual, orientation, and
-    whether it is the assembly `picked` (a row of points, or None); `kind` a subclass of
+    whether it is the assembly `picked` (a `signature` row, or None); `kind` a subclass of
     Mode built with the `extra` fields (kincas/analysis/certify.py)."""
     names = m.moving_points
     pts = model.points(q, u, p).T.ravel() if pts is None else pts
@@ -77,5 +101,6 @@ def mode_at(m, model, q, u, p, L, picked=None, pts=None, kind=None, **extra) -> 
         points={nm: tuple(float(c) for c in pts[dim * j:dim * j + dim]) for j, nm in enumerate(names)},
         angles={lk: float(wrap_angle(a)) for lk, a in zip(links, ang)},
         residual=res, orientation=int(np.sign(det)) if abs(det) > BRANCH else 0,
-        from_guess=bool(picked is not None and np.abs(pts - picked).max() <= SAME * L),
+        from_guess=bool(picked is not None and
+                        np.abs(signature(model, q, u, p, L)[0] - picked).max() <= SAME * L),
         inputs={i.key: float(v) for i, v in zip(m.inputs, u)}, **extra)

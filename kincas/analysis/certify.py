@@ -9,8 +9,10 @@ solution, each isolated in a box that holds it and no other. Then, per box:
 
 1. the box's centre is mapped to kincas's unknowns (an angle is atan2(s, c); a relative
    input's angle is kept within a turn of its equation), and refined by kincas's own Newton;
-2. the refined point must lie in its box (to the rounding of a float solve, CERTIFY_SLACK
-   times the size): if it does not (Newton left for another root, or crawled onto a
+2. the refined point must lie in its box to its own floating-point error bound (first
+   order: the scaled Jacobian's pseudo-inverse times the residual left plus its rounding,
+   so it grows with the conditioning; `_refined`), that bound below half the distance to
+   the nearest other root: if it does not (Newton left for another root, or crawled onto a
    singular one), the mode says so and keeps the box's centre, itself right to 2^-64;
 3. the rule for an assembly: kincas's relative residual at the point is at most ACCEPT.
    Every real solution of these equations is an assembly (no mirror images, no spurious
@@ -38,22 +40,22 @@ solutions (a link free to spin at this pose) is reported as `positive_dimension`
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 
 import numpy as np
 
 from ..core.assembly import first_pose
 from ..core.numeric import model_of
-from ..core.polynomial_planar import closure
-from ..core.tolerances import (ACCEPT, CERTIFY_NUDGE, CERTIFY_SLACK, CERTIFY_SPLIT, CERTIFY_TIMEOUT,
+from ..core.polynomial_planar import NotPolynomial, closure
+from ..core.tolerances import (ACCEPT, CERTIFY_NUDGE, CERTIFY_ROUNDING, CERTIFY_SPLIT, CERTIFY_TIMEOUT,
                                RANK, TINY)
 from ..frames import Modes
 from ..model.joints import split_relative
 from ..model.mechanism import Mechanism
 from .certify_msolve import solve
 from ..core.tolerances import SAME_ASSEMBLY as SAME
-from .assembly_mode import Mode, input_vector as _input_vector, mode_at
+from .assembly_mode import Mode, input_vector as _input_vector, mode_at, signature
 
 
 @dataclass(frozen=True)
@@ -72,13 +74,16 @@ class CertifiedMode(Mode):
 class CertifiedModes(Modes):
     """Every real assembly, certified: a list of `CertifiedMode`, with `count` (None when the
     solutions are not finite in number), `rounded` (inputs taken as nearby rational ones),
-    `positive_dimension` and `rejected` (solutions that failed to refine: none expected)."""
+    `positive_dimension`, `rejected` (solutions that failed to refine: none expected) and
+    `discarded` (an overconstrained mechanism's square subsystem's roots that break an
+    implied equation: not assemblies, kincas/analysis/certify_over.py)."""
 
     certified = True
 
-    def __init__(self, modes=(), *, rounded=(), positive_dimension=False, rejected=(), inputs=None):
+    def __init__(self, modes=(), *, rounded=(), positive_dimension=False, rejected=(), inputs=None,
+                 discarded=()):
         super().__init__(modes)
-        self.rounded, self.rejected = list(rounded), list(rejected)
+        self.rounded, self.rejected, self.discarded = list(rounded), list(rejected), list(discarded)
         self.positive_dimension = positive_dimension
         self.count = None if positive_dimension else len(self)
         self.inputs = dict(inputs or {})
@@ -126,10 +131,12 @@ def certify_modes(m: Mechanism, inputs=None, *, threads: int = 1,
     ...     assert found.count == 2 and all(md.multiplicity == 1 for md in found)
     """
     u = _input_vector(m, inputs)
-    S = _closure(m, u)
-    if _spatial(m):
-        _check_mobile(m, u, threads, timeout)
+    system = lambda v: _system(m, v, threads, timeout)
+    S = system(u)
     kind, boxes, value = _solve(S, threads, timeout)
+    if kind == "positive" and S.implied:
+        from .certify_over import REFUSED
+        raise NotPolynomial(REFUSED.format(why=" (and its square subsystem has infinitely many solutions)"))
     u_r = np.array([S.at.get(i.key, float(v)) for i, v in zip(m.inputs, u)])
     m_r = _rounded_lines(m, S)
     driven = {i.target: float(v) for i, v in zip(m.inputs, u) if i.kind == "parameter"}
@@ -140,29 +147,32 @@ def certify_modes(m: Mechanism, inputs=None, *, threads: int = 1,
     model, p = model_of(m_r), np.array([v for _, v in m_r.parameters], dtype=float)
     guess = {k: tuple(m_r.value(c) for c in xyz) for k, xyz in m_r.guess}
     first = first_pose(model, u_r, p, L, guess)
-    picked = model.points(first.q, u_r, p).T.ravel() if first.ok else None
+    picked = signature(model, first.q, u_r, p, L)[0] if first.ok else None
     scale = np.where(S.length, L, 1.0)
     centres = [np.array([float((a + b) / 2) for a, b in box]) for box in boxes]
-    out, rejected = [], []
+    out, rejected, discarded = [], [], []
     for k, box in enumerate(boxes):
         c, hw = centres[k], np.array([float((b - a) / 2) for a, b in box])
-        q, note = _refined(m, model, S, c, hw, scale, u_r, p)
-        mult = 1
+        others = [np.abs((c - o) / scale).max() for j, o in enumerate(centres) if j != k]
+        q, note = _refined(m, model, S, c, hw, scale, u_r, p, L, min(others, default=math.inf))
+        halfwidth = max((P.subs(value).spread(box) for xy in S.points.values() for P in xy), default=0.0)
+        md = mode_at(m_r, model, q, u_r, p, L, picked, kind=CertifiedMode, halfwidth=halfwidth, note=note)
+        if md.residual > ACCEPT:  # the rule for an assembly (every real root should pass)
+            if S.implied:  # a root of the kept equations only: it breaks an implied one
+                discarded.append(f"real solution {k + 1} of the kept equations: relative residual "
+                                 f"{md.residual:.1e} of all of them (above {ACCEPT:g}): not an assembly")
+            else:
+                rejected.append(f"real solution {k + 1}: relative residual {md.residual:.1e} "
+                                f"after refinement (above {ACCEPT:g}): not an assembly")
+            continue
         corank = _corank(model, q, u_r, p, L)
         if corank:
-            others = [np.abs((c - o) / scale).max() for j, o in enumerate(centres) if j != k]
-            mult = max(1 + corank, _split_count(m, u, S, c, scale, L, min(others, default=1.0)))
-        halfwidth = max((P.subs(value).spread(box) for xy in S.points.values() for P in xy), default=0.0)
-        md = mode_at(m_r, model, q, u_r, p, L, picked, kind=CertifiedMode, halfwidth=halfwidth,
-                     multiplicity=mult, flag="singular" if mult > 1 else "", note=note)
-        if md.residual <= ACCEPT:  # the rule for an assembly (every real root should pass)
-            out.append(md)
-        else:
-            rejected.append(f"real solution {k + 1}: relative residual {md.residual:.1e} "
-                            f"after refinement (above {ACCEPT:g}): not an assembly")
+            mult = max(1 + corank, _split_count(m, u, S, c, scale, L, min(others, default=1.0), system))
+            md = replace(md, multiplicity=mult, flag="singular" if mult > 1 else "")
+        out.append(md)
     rows = lambda md: np.array([v for xy in md.points.values() for v in xy])
     out.sort(key=lambda md: tuple(np.round(rows(md) / (SAME * L))))
-    return CertifiedModes(out, rounded=S.rounded, rejected=rejected, inputs=used)
+    return CertifiedModes(out, rounded=S.rounded, rejected=rejected, inputs=used, discarded=discarded)
 
 
 def _solve(S, threads=1, timeout=CERTIFY_TIMEOUT):
@@ -200,6 +210,17 @@ def _spatial(m) -> bool:
     return isinstance(m, SpatialMechanism)
 
 
+def _system(m, u, threads=1, timeout=CERTIFY_TIMEOUT):
+    """The system to solve at inputs u: the closure equations, or for an overconstrained
+    spatial mechanism whose float axes lost its motion, their square subsystem
+    (kincas/analysis/certify_over.py)."""
+    S = _closure(m, u)
+    if _spatial(m):
+        from .certify_over import system_to_solve
+        S = system_to_solve(m, u, S, lambda T: _solve(T, threads, timeout))
+    return S
+
+
 def _closure(m, u):
     """The polynomial closure equations: planar, or spatial (kincas/core/polynomial_space.py)."""
     if _spatial(m):
@@ -208,27 +229,8 @@ def _closure(m, u):
     return closure(m, u)
 
 
-def _check_mobile(m, u, threads, timeout):
-    """An overconstrained spatial mechanism moves only thanks to special geometry that the
-    scene's floats, taken as exact rationals, may have lost (axes meeting at a point to
-    1e-16 only): then the exact system is rigid, and its count would not be the
-    mechanism's. Without its joint inputs the exact system must keep a motion (positive
-    dimension), else the certified search is refused (`NotPolynomial`, one line)."""
-    from ..core.polynomial_space import closure_space, overconstrained
-    from ..core.polynomial_planar import NotPolynomial
-    if not overconstrained(m) or not any(i.kind in ("joint", "slide") for i in m.inputs):
-        return
-    kind, _, _ = _solve(closure_space(m, u, driven_joints=False), threads, timeout)
-    if kind != "positive":
-        raise NotPolynomial(
-            "the mechanism is overconstrained (it moves thanks to special geometry) and with the "
-            "scene's numbers taken as exact rationals it does not move: give its axes and points "
-            "exactly (e.g. axes as small integers, points on them), or use the multistart search")
-
-
 def _rounded_lines(m: Mechanism, S) -> Mechanism:
     """`m` with each slide's line angle as the equations took it (rounded where said)."""
-    from dataclasses import replace
     if _spatial(m):  # spatial slides have directions, not angles
         return m
     slides = tuple(replace(sl, angle=S.at[f"slide {sl.name}"]) if f"slide {sl.name}" in S.at
@@ -267,17 +269,46 @@ def _variables_at(S, q) -> np.ndarray:
     return x
 
 
-def _refined(m, model, S, c, hw, scale, u, p):
-    """(q, note): Newton from the box's centre, kept when it converges inside the box."""
+def _refined(m, model, S, c, hw, scale, u, p, L, nearest=math.inf):
+    """(q, note): Newton from the box's centre, kept when it converges inside the box.
+
+    Inside to what? The float point q is the root only to its forward error: to first order
+    |dz| <= ||G^+|| (|g(q)| / L + CERTIFY_ROUNDING), G the column-scaled g_q over L (O(1)),
+    g(q) the residual left and CERTIFY_ROUNDING the rounding of its evaluation (relative):
+    a bound that grows with the conditioning, not a fixed 1e-12. In the polynomial
+    variables (cosines, lengths over the size, a rotation matrix's entries: at most
+    4 |de| for a unit quaternion's change de) that is `_error_bound`. The refined point
+    counts as the box's root when every variable is within the box's half-width plus that
+    bound of its centre, and the bound is below half the (scaled) distance to the nearest
+    other root, so that it cannot be another box's. At a multiple root (a singular pose) the
+    first-order bound is infinite; the float point's error there is of the order of the
+    square root of the rounding (a double root), the cap used."""
     q0 = _unknowns_at(m, S, c, u)
     sol = model.newton(q0, u, p)
     if not sol.ok:
         return q0, "Newton did not converge from the box (a singular pose?): the box's centre is used"
-    off = np.abs(_variables_at(S, sol.q) - c) - hw
-    if (off > CERTIFY_SLACK * scale).any():
-        return q0, (f"the refined point left its box by {float((off / scale).max()):.1e} "
-                    f"(relative): the box's centre is used")
+    # plus the rounding of the map from q to the variables (cosines, a rotation's entries)
+    bound = (_error_bound(model, sol.q, u, p, L, S.perturbation) * (4.0 if _spatial(m) else 1.0)
+             + CERTIFY_ROUNDING)
+    off = (np.abs(_variables_at(S, sol.q) - c) - hw) / scale
+    if (off > bound).any() or bound >= 0.5 * nearest:
+        return q0, (f"the refined point left its box by {float(off.max()):.1e} (relative; its error "
+                    f"bound {bound:.1e}, the nearest root at {nearest:.1e}): the box's centre is used")
     return sol.q, ""
+
+
+def _error_bound(model, q, u, p, L, perturbation=0.0) -> float:
+    """First-order bound on the float point q's distance to the root (relative to the size
+    for lengths, radians for angles): ||(g_q s)^+||_inf (|g(q)|_inf / L + CERTIFY_ROUNDING
+    + 2 perturbation), s the column scale (kincas's `column_scale`); `perturbation` the
+    relative distance of the exact system's geometry from the floats' (a rounded axis a
+    changes R1 a - R2 a by at most twice its change)."""
+    if model.nq == 0:
+        return 0.0
+    G = model.jac(q, u, p) * model.column_scale(L)
+    g = np.abs(model.residual(q, u, p)).max(initial=0.0) / L
+    bound = float(np.abs(np.linalg.pinv(G)).sum(axis=1).max() * (g + CERTIFY_ROUNDING + 2 * perturbation))
+    return min(bound, math.sqrt(CERTIFY_ROUNDING)) if math.isfinite(bound) else math.sqrt(CERTIFY_ROUNDING)
 
 
 def _corank(model, q, u, p, L) -> int:
@@ -288,7 +319,7 @@ def _corank(model, q, u, p, L) -> int:
     return int(model.nq - np.sum(sv > RANK * max(sv.max(initial=0.0), TINY)))
 
 
-def _split_count(m, u, S, c, scale, L, nearest) -> int:
+def _split_count(m, u, S, c, scale, L, nearest, system=None) -> int:
     """How many real roots the multiple root at c splits into when the first input moves by
     +-CERTIFY_NUDGE (times the size for a length): the larger count of the two sides, within
     half the distance to the nearest other root (at most CERTIFY_SPLIT, scaled)."""
@@ -300,7 +331,7 @@ def _split_count(m, u, S, c, scale, L, nearest) -> int:
     for sign in (1, -1):
         v = np.array(u, dtype=float)
         v[0] += sign * step
-        kind, boxes, _ = _solve(_closure(m, v))
+        kind, boxes, _ = _solve((system or (lambda w: _closure(m, w)))(v))
         if kind == "finite":
             near = [b for b in boxes
                     if np.abs((np.array([float((a + z) / 2) for a, z in b]) - c) / scale).max() <= radius]

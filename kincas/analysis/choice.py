@@ -12,6 +12,15 @@ until one solves every pose. That one is returned with an `"assembly"` event nam
 `[guess]`; the groups whose mode differs from the default) and why; where none does, the
 default stands. A user's guess is never overridden: this runs only without one.
 
+Which assemblies: where the exact solver is installed (`kincas[certify]`) and the closure is
+polynomial, the first pose's assemblies are certified (kincas/analysis/certify.py: every
+real one, proven) and every one of them is swept; the event says `"certified": true` and
+`"count"`, and where none runs every pose (each sweep checked to have started on its own
+assembly) it says so with certainty, the default standing. Otherwise (no solver, gears or
+cams, an overconstrained spatial scene the exact system cannot take, msolve out of time)
+the multistart search with CHOICE_STARTS starts, of which CHOICE_TRIES are swept:
+`"certified": false`, and nothing claimed where none runs.
+
 >>> import numpy as np, kincas
 >>> m = kincas.Mechanism(ground={"O": (0, 0), "A": (0, -20)},
 ...     links=[kincas.Link.bar("crank", "O", "B", 40), kincas.Link.bar("lever", "B", "D", 100),
@@ -28,8 +37,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.assembly import ambiguous, first_pose, group_links, modes
-from ..core.tolerances import CHOICE_STARTS, CHOICE_TRIES, SAME_ASSEMBLY
-from ..errors import ModelError
+from ..core.tolerances import (CHOICE_CERTIFY_TIMEOUT, CHOICE_STARTS, CHOICE_TRIES,
+                               CHOICE_TRIES_CERTIFIED, SAME_ASSEMBLY)
+from ..errors import KincasError, ModelError
+from .assembly_mode import signature
 
 
 def _unreachable(model, U, p, L, ok) -> bool:
@@ -43,42 +54,77 @@ def _unreachable(model, U, p, L, ok) -> bool:
     return any(not first_pose(model, U[k], p, L, {}).ok for k in bad)
 
 
+def _assemblies(m, inputs):
+    """(the first pose's assemblies, whether certified): the certified list where msolve is
+    installed and the closure is polynomial, else the multistart's (None where it cannot be
+    posed: the search is a courtesy, the default then stands)."""
+    from . import certify_msolve
+    if certify_msolve.available():
+        from .certify import certify_modes
+        try:
+            found = certify_modes(m, inputs, timeout=CHOICE_CERTIFY_TIMEOUT)
+            if len(found) and not found.positive_dimension and not found.rejected:
+                return found, True  # (the default's first pose assembles: none found is a fault)
+        except KincasError:  # not polynomial, refused, msolve out of time: the multistart
+            pass
+    from .modes import find_modes
+    try:
+        return find_modes(m, inputs, starts=CHOICE_STARTS), False
+    except ModelError:
+        return None, False
+
+
 def choose_assembly(model, m, U, p, L, default, rerun):
     """`default` (a Sweep from the default modes, no guess) or, where it fails poses, the
     sweep `rerun(guess)` from the first of the first pose's other assemblies that solves
-    every pose, with an "assembly" event; None to keep the default."""
+    every pose, with an "assembly" event; the default with an "assembly" event saying so
+    where the assemblies are certified and none does; None to keep the default as it is."""
     ok, n = np.asarray(default.ok), len(default)
     if ok.all() or not ok[0] or model.nq == 0:
         return None
     if _unreachable(model, U, p, L, ok):
         return None  # some pose has no assembly at all: none runs the whole sweep
-    from .modes import find_modes
     u0 = U[0]
-    try:
-        found = find_modes(m, {i.key: float(v) for i, v in zip(m.inputs, u0)}, starts=CHOICE_STARTS)
-    except ModelError:  # the search is a courtesy: where it cannot be posed, the default stands
+    inputs = {i.key: float(v) for i, v in zip(m.inputs, u0)}
+    found, certified = _assemblies(m, inputs)
+    if found is None:
         return None
     sign0 = modes(model, model.jac(default.q[0], u0, p), L)[0]
-    pts0 = model.points(default.q[0], u0, p).T.ravel()
+    sig0 = signature(model, default.q[0], u0, p, L)[0]
     names = group_links(model)
     others = []
     for k, md in enumerate(found):
-        pts = np.ravel([md.points[nm] for nm in m.moving_points])
-        if np.abs(pts - pts0).max() <= SAME_ASSEMBLY * L:
+        if np.abs(signature(model, md.q, u0, p, L)[0] - sig0).max() <= SAME_ASSEMBLY * L:
             continue  # the default itself
         changed = np.flatnonzero(modes(model, model.jac(md.q, u0, p), L)[0] != sign0)
         others.append((len(changed), k, md, changed))
     others.sort(key=lambda t: t[:2])
-    for _, _, md, changed in others[:CHOICE_TRIES]:
+    tries = CHOICE_TRIES_CERTIFIED if certified else CHOICE_TRIES
+    lost = int((~ok).sum())
+    said = {"pose": 0, "poses": n, "certified": certified, "count": len(found), "inputs": inputs}
+    proven = certified and len(others) <= tries  # every other assembly swept...
+    for _, _, md, changed in others[:tries]:
         sw = rerun(md.guess)
+        # ... from itself (a guess of points may not pick a spatial body's spin about them)
+        proven = proven and np.abs(signature(model, sw.q[0], u0, p, L)[0]
+                                   - signature(model, md.q, u0, p, L)[0]).max() <= SAME_ASSEMBLY * L
         if np.asarray(sw.ok).all():
             groups = [names[i] for i in changed]
             which = (", ".join("[" + ", ".join(g) + "]" for g in groups) + " in the other mode"
                      if groups else "another assembly of the same modes")
-            reason = (f"no [guess], and the default assembly fails {int((~ok).sum())} of {n} poses; "
-                      f"this one (group {which}) solves all {n}; to keep it, give its points as [guess]")
-            sw.events.insert(0, {"kind": "assembly", "pose": 0, "poses": n, "groups": groups,
-                                 "guess": dict(md.guess), "reason": reason,
-                                 "inputs": {i.key: float(v) for i, v in zip(m.inputs, u0)}})
+            among = (f"of the first pose's {len(found)} assemblies (certified: every real one), "
+                     if certified else "")
+            reason = (f"no [guess], and the default assembly fails {lost} of {n} poses; "
+                      f"{among}this one (group {which}) solves all {n}; to keep it, give its points as [guess]")
+            sw.events.insert(0, {"kind": "assembly", **said, "groups": groups,
+                                 "guess": dict(md.guess), "reason": reason})
             return sw
-    return None
+    if not proven:
+        return None
+    # certified: none of the first pose's assemblies runs every pose; the default stands
+    reason = (f"no [guess], and the default assembly fails {lost} of {n} poses; none of the first "
+              f"pose's {len(found)} assemblies (certified: every real one) solves all {n}: the default stands")
+    guess = {nm: tuple(float(c) for c in xy) for nm, xy in
+             zip(m.moving_points, model.points(default.q[0], u0, p).T)}
+    default.events.insert(0, {"kind": "assembly", **said, "groups": [], "guess": guess, "reason": reason})
+    return default

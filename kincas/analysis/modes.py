@@ -41,7 +41,7 @@ from ..core.assembly import first_pose
 from ..core.scatter import newton_starts
 from ..core.numeric import model_of
 from ..core.tolerances import ACCEPT, SAME_ASSEMBLY as SAME, START_CONVERGED as CONVERGED
-from .assembly_mode import Mode, input_vector as _input_vector, mode_at  # noqa: F401  (their old home)
+from .assembly_mode import Mode, input_vector as _input_vector, mode_at, signature  # noqa: F401  (their old home)
 
 # SAME: two assemblies are one mode when every point agrees to this times the size
 
@@ -143,7 +143,7 @@ def find_modes(m: Mechanism, inputs=None, *, starts: int = 512, seed: int = 0,
         Q = np.array([turns(model, q, u, p) for q in Q])
     Q, r = newton_starts(model, Q, u, p, iterations)
     Q = Q[np.isfinite(r) & (r <= CONVERGED)]
-    Q = Q[_unique(_point_rows(model, Q, u, p), 10 * SAME * L)]  # many starts, few modes
+    Q = Q[_unique(signature(model, Q, u, p, L), 10 * SAME * L)]  # many starts, few modes
 
     found = [sol.q for sol in (model.newton(q, u, p, L) for q in Q) if sol.ok]  # polish
     first = first_pose(model, u, p, L, guess)  # the assembly a sweep from the guess starts on
@@ -175,11 +175,6 @@ def _scatter(m: Mechanism, model, n: int, L: float, seed: int) -> np.ndarray:
 # --- duplicates ---
 
 
-def _point_rows(model, Q, u, p) -> np.ndarray:
-    """The moving points of every row of Q, one row (x1, y1, x2, y2, ...) per start."""
-    return model.points_many(Q, u, p)
-
-
 def _unique(rows: np.ndarray, tol: float) -> list[int]:
     """Indices of the first row of each group of rows that agree to `tol` (max norm)."""
     keep: list[int] = []
@@ -191,13 +186,14 @@ def _unique(rows: np.ndarray, tol: float) -> list[int]:
 
 def _distinct(m, model, found, u, p, L, picked_q) -> list[Mode]:
     """One Mode per distinct assembly: two solutions are the same mode when all their moving
-    points agree to SAME * L (the points fix every link's angle modulo 2 pi)."""
-    picked = None if picked_q is None else model.points(picked_q, u, p).T.ravel()
+    points, and every spatial body's rotation times L, agree to SAME * L (the points fix
+    every planar link's angle modulo 2 pi, not a spatial body's spin about its points' line)."""
+    picked = None if picked_q is None else signature(model, picked_q, u, p, L)[0]
     Q = np.array(found).reshape(len(found), model.nq)
-    rows = _point_rows(model, Q, u, p)
+    rows = signature(model, Q, u, p, L)
     keep = [(Q[k], rows[k]) for k in _unique(rows, SAME * L)]
     keep.sort(key=lambda t: tuple(np.round(t[1] / (SAME * L))))
-    out = [mode_at(m, model, q, u, p, L, picked, pts) for q, pts in keep]
+    out = [mode_at(m, model, q, u, p, L, picked) for q, _ in keep]
     return [md for md in out if md.residual <= ACCEPT]  # each checked by its residual
 
 

@@ -7,7 +7,10 @@ import math
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from ..analysis.modes import find_modes
+from ..core.tolerances import SAME_ASSEMBLY
 from ..errors import OutputError, SceneError
 from .scene import load
 from .scene_guess import scene_with_guess
@@ -58,7 +61,7 @@ def cli_run(args) -> int:
                          for md, ang in zip(modes, user_ang)]}
         if modes.certified:
             doc.update(count=modes.count, rounded=modes.rounded, rejected=modes.rejected,
-                       positive_dimension=modes.positive_dimension)
+                       discarded=modes.discarded, positive_dimension=modes.positive_dimension)
         else:
             doc.update(starts=args.starts, seed=args.seed)
         json.dump(doc, sys.stdout, allow_nan=False)
@@ -106,6 +109,15 @@ def _print_modes(sc, modes, user_in, user_ang, args):
         print(f"  the certificate is for the rounded pose: {note}")
     for note in getattr(modes, "rejected", []):
         print(f"  rejected: {note}")
+    if getattr(modes, "discarded", []):
+        print(f"  discarded: {len(modes.discarded)} real solutions of the kept equations that break an "
+              f"implied one (not assemblies; --json lists them)")
+    size = sc.mechanism.size()
+    pts = [np.ravel(list(md.points.values())) for md in modes]
+    if any(np.abs(a - b).max(initial=0.0) <= SAME_ASSEMBLY * size for i, a in enumerate(pts) for b in pts[:i]):
+        # in space: a body's spin about the line of its points
+        print("  some modes have the same points (they differ in a body's turn about the line of its "
+              "points): a [guess] of points cannot pick between them")
     for k, (md, ang) in enumerate(zip(modes, user_ang), 1):
         mark = "" if not md.from_guess else ("  <- the scene's [guess] gives this one" if sc.mechanism.guess
                                              else "  <- `kincas solve` starts on this one (no [guess])")

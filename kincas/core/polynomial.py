@@ -33,7 +33,7 @@ import math
 from dataclasses import dataclass, field
 from fractions import Fraction
 
-from .tolerances import CERTIFY_DENOMINATOR
+from .tolerances import CERTIFY_DENOMINATOR, TINY
 
 
 def exact(v: float) -> Fraction:
@@ -153,12 +153,62 @@ class Poly:
             return None
         return ({m[0][0]: c for m, c in self.terms.items() if m}, self.terms.get((), Fraction(0)))
 
+    def gradient(self, x, n: int) -> list[float]:
+        """The partial derivatives at a point (floats; x indexed by variable), n variables.
+
+        >>> P = Poly({((0, 2), (1, 1)): 3})  # 3 x0^2 x1
+        >>> P.gradient([2.0, 5.0], 2)
+        [60.0, 12.0]
+        """
+        out = [0.0] * n
+        for m, c in self.terms.items():
+            for k, (v, e) in enumerate(m):
+                rest = math.prod(x[w] ** f for j, (w, f) in enumerate(m) if j != k)
+                out[v] += float(c) * e * x[v] ** (e - 1) * rest
+        return out
+
     def integer_terms(self) -> dict:
         """The same equation with coprime integer coefficients (denominators cleared)."""
         lcm = math.lcm(*(c.denominator for c in self.terms.values())) if self.terms else 1
         ints = {m: int(c * lcm) for m, c in self.terms.items()}
         g = math.gcd(*ints.values()) if ints else 1
         return {m: c // g for m, c in ints.items()}
+
+
+def independent(equations, x, n: int, scale, tol: float, always=()) -> list[int]:
+    """Indices of a largest set of `equations` whose gradients at x are independent: the
+    `always` ones kept whatever they are (a rotation's R'R = I and det R = 1: locally
+    dependent, globally needed against reflections), then each of the others in turn, the
+    linear ones first, kept when its gradient leaves the span of those kept (Gram-Schmidt,
+    each gradient normalised, the columns of length variables times their `scale`; a
+    remainder below `tol` counts as inside). The others are implied there to first order.
+
+    >>> S = PolySystem(); x, y = S.var("x"), S.var("y")
+    >>> independent([x * y - 1, 2 * x - 2 * y, x - y, x + y], [1.0, 1.0], 2, [1.0, 1.0], 1e-8)
+    [1, 3]
+    """
+    import numpy as np
+    J = np.array([P.gradient(x, n) for P in equations]).reshape(len(equations), n) * np.asarray(scale, float)
+    J /= np.maximum(np.linalg.norm(J, axis=1, keepdims=True), TINY)
+    basis, keep = [], []
+
+    def add(k, forced):
+        r = J[k].copy()
+        for _ in range(2):  # twice: Gram-Schmidt's rounding
+            for b in basis:
+                r -= (b @ r) * b
+        norm = np.linalg.norm(r)
+        if norm > tol:
+            basis.append(r / norm)
+        if forced or norm > tol:
+            keep.append(k)
+
+    for k in always:
+        add(k, True)
+    rest = [k for k in range(len(equations)) if k not in set(always)]
+    for k in sorted(rest, key=lambda k: equations[k].degree > 1):  # linear first, stable
+        add(k, False)
+    return sorted(keep)
 
 
 def _times(m1, m2):
@@ -186,6 +236,9 @@ class PolySystem:
     at: dict = field(default_factory=dict)  # the values the equations were written at (rounded ones)
     to_unknowns: object = None  # x -> kincas's q, when not per unknown as in `unknowns` (spatial: R -> e)
     from_unknowns: object = None  # q -> x, its inverse
+    perturbation: float = 0.0  # relative distance of the rationalised geometry (axes) from the scene's floats
+    structural: list = field(default_factory=list)  # indices of equations kept whatever the rank (R'R = I, det R = 1)
+    implied: int = 0  # equations left out as implied (an overconstrained mechanism: kincas/analysis/certify_over.py)
 
     def var(self, name: str, length: bool = False) -> Poly:
         self.names.append(name)

@@ -63,6 +63,31 @@ def exact(v: float) -> Fraction:
     return Fraction(repr(float(v)))
 
 
+def snapped(v: float, size: float) -> Fraction:
+    """The simplest rational within about 1e-12 of the size of v (a grid of size / 2^40,
+    then the simplest fraction near it): a float's noise such as -1.07e-14 becomes 0.
+
+    >>> snapped(-1.0658141036401503e-14, 146.0), snapped(34.20201433256687, 146.0)
+    (Fraction(0, 1), Fraction(176585, 5163))
+    """
+    grid = Fraction(size).limit_denominator(1 << 20) / (1 << 40) or Fraction(1, 1 << 40)
+    k = Fraction(float(v)) / grid
+    lo, hi = (math.floor(k) - Fraction(1, 2)) * grid, (math.floor(k) + Fraction(3, 2)) * grid
+    return _simplest(lo, hi)
+
+
+def _simplest(lo: Fraction, hi: Fraction) -> Fraction:
+    """The rational of least denominator in [lo, hi] (continued fractions)."""
+    if lo <= 0 <= hi:
+        return Fraction(0)
+    if hi < 0:
+        return -_simplest(-hi, -lo)
+    fl = math.floor(lo)
+    if fl == lo or fl + 1 <= hi:
+        return Fraction(math.ceil(lo))
+    return fl + 1 / _simplest(1 / (hi - fl), 1 / (lo - fl))
+
+
 def direction(v) -> tuple[list[Fraction], bool]:
     """A rational direction along v, and whether it is v's direction to floating rounding.
 
@@ -178,16 +203,27 @@ def overconstrained(m) -> bool:
     return nq - ng < len(m.inputs)
 
 
-def closure_space(m, u, driven_joints=True) -> PolySystem:
+def closure_space(m, u, driven_joints=True, snap=False) -> PolySystem:
     """The closure equations of the spatial mechanism `m` at inputs `u` as a `PolySystem`
     (module text), with `to_unknowns` / `from_unknowns` mapping a solution to kincas's
     unknowns and back. `driven_joints=False` leaves out the joint and slide inputs'
-    equations (the mechanism free to move: an overconstrained one must keep a motion)."""
+    equations (the mechanism free to move: an overconstrained one must keep a motion).
+    `snap`: the geometry's numbers (points, lengths) as the simplest rationals within
+    ~1e-12 of the size (`snapped`; smaller coefficients, a faster msolve), the distance
+    added to `perturbation` (where the certificate is already for a nearby geometry)."""
     driven = {i.target: float(v) for i, v in zip(m.inputs, u) if i.kind == "parameter"}
     m = m.with_parameters(**driven) if driven else m
     S = PolySystem()
-    o = [exact(m.value(c)) for c in m.ground[0][1]] if m.ground else [Fraction(0)] * 3
-    rel = lambda xyz: [exact(m.value(c)) - oc for c, oc in zip(xyz, o)]
+    number = exact
+    if snap:
+        size = m.size()
+
+        def number(v):
+            r = snapped(v, size)
+            S.perturbation = max(S.perturbation, abs(float(r) - float(v)) / size)
+            return r
+    o = [number(m.value(c)) for c in m.ground[0][1]] if m.ground else [Fraction(0)] * 3
+    rel = lambda xyz: [number(m.value(c)) - oc for c, oc in zip(xyz, o)]
     const = lambda v: [Poly.const(c) for c in v]
     one, zero = Poly.const(1), Poly.const(0)
     frames = {GROUND: (const([0, 0, 0]), [[one, zero, zero], [zero, one, zero], [zero, zero, one]], [0, 0, 0])}
@@ -205,7 +241,9 @@ def closure_space(m, u, driven_joints=True) -> PolySystem:
         layout.append(("body", list(range(ir, ir + 3)), list(range(ir + 3, ir + 12))))
         for i in range(3):  # R'R = I: unit, orthogonal columns
             for j in range(i, 3):
+                S.structural.append(len(S.equations))
                 S.equations.append(sum((R[k][i] * R[k][j] for k in range(3)), Poly()) - (1 if i == j else 0))
+        S.structural.append(len(S.equations))
         S.equations.append(_dot(R[0], _cross(R[1], R[2])) - 1)  # det R = 1: no reflections
         frames[b.name] = (r, R, c)
         for p, P0 in loc.items():
@@ -224,7 +262,7 @@ def closure_space(m, u, driven_joints=True) -> PolySystem:
         if b.two_point:
             P, Q = (points[n] for n in b.point_names)
             d = [P[i] - Q[i] for i in range(3)]
-            S.equations.append(_dot(d, d) - exact(m.value(b.length)) ** 2)
+            S.equations.append(_dot(d, d) - number(m.value(b.length)) ** 2)
     inputs = {i.target: float(v) for i, v in zip(m.inputs, u)
               if i.kind in ("joint", "slide") and driven_joints}
     for j in m.joints:
@@ -262,6 +300,9 @@ def _axis(S, v, what, exact_unit):
     direction matters; an exact rational unit vector where an input's value is measured about
     or along it; rounded beyond floating rounding only where need be, and then said."""
     a, same = direction(v) if not exact_unit else unit_vector(v)
+    f = np.asarray(v, float) / np.linalg.norm(np.asarray(v, float))
+    r = np.array([float(c) for c in a])
+    S.perturbation = max(S.perturbation, float(np.abs(r / np.linalg.norm(r) - f).max()))
     if not same:
         S.rounded.append(f"{what} {tuple(v)!r} taken as the rational direction "
                          f"{tuple(float(c) for c in a)!r}")

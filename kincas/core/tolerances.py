@@ -90,6 +90,8 @@ FREE_LINKS = 6  # links left free by a guess that are tried in several turns (co
 NEARER = 1e-9  # another start's assembly is nearer the guessed points when its cost is below (1 - this) times
 CHOICE_STARTS = 128  # scattered starts finding a guessless sweep's other assemblies (analysis/choice.py)
 CHOICE_TRIES = 8  # of which at most this many are swept
+CHOICE_TRIES_CERTIFIED = 40  # certified assemblies swept at most (all of them, to say with certainty that none runs)
+CHOICE_CERTIFY_TIMEOUT = 10.0  # seconds msolve may take to certify a guessless sweep's first pose (else the multistart)
 
 # --- pictures ---
 END_ON = 1e-6  # a slide's unit direction drawn shorter than this is seen end on (views/projection.py)
@@ -101,7 +103,7 @@ PROJECTION = 1e-9  # a unit axis projected on a plane shorter than this is norma
 # --- certified assembly modes (kincas/core/polynomial*.py, kincas/analysis/certify*.py) ---
 CERTIFY_DENOMINATOR = 2 ** 20  # a driven or line angle's half-angle tangent rounded to a rational of this denominator at most (angle within ~1e-12 rad)
 CERTIFY_BITS = 64  # msolve's precision of the isolating boxes (bits; boxes far smaller than a float's rounding)
-CERTIFY_SLACK = 1e-12  # a refined float point lies in its box when within this (times the size, or 1 for a cosine) of it
+CERTIFY_ROUNDING = 2.0 ** -46  # relative rounding error of a residual evaluated in floats (64 ulps), for a refined point's error bound
 CERTIFY_TIMEOUT = 120.0  # seconds msolve may take before the certificate is given up
 CERTIFY_SPLIT = 1e-2  # roots a multiple root splits into are counted within this (scaled) distance of it, at most
 CERTIFY_NUDGE = 1e-7  # input change (rad, or times the size) that splits coinciding assemblies to count them

@@ -1,0 +1,62 @@
+"""The multistart search (`kincas modes`, `find_modes`) on spatial mechanisms: assemblies that
+differ only in a body's spin about the line of its points.
+
+The double Cardan shaft at in.angle = 0: shaft_in is fixed by the input, O2 by the output's
+revolute (O3 - 150 x, whatever it turns), so the intermediate shaft can only spin by phi about
+its line O1 O2, and the output by psi about x. Cross 1 asks (y) . (R_mid z) = 0, where
+R_mid z = cos(phi) z + sin(phi) d x z and y . (d x z) = -d_x != 0: sin(phi) = 0. Cross 2 asks
+(R_mid z) . (R_out y) = +-z . (cos(psi) y + sin(psi) z) = 0: sin(psi) = 0. Four assemblies
+(phi, psi in {0, pi}), every one with the same points: a search that tells modes apart by
+points alone (it did, and found 1 of 4) must also compare the bodies' orientations.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import kincas
+import kincas.cli.scene
+from conftest import EXAMPLES, run_cli
+from kincas.analysis.modes import find_modes
+from kincas.core.space_model import rot_of
+
+CARDAN = EXAMPLES / "space_double_cardan.toml"
+
+
+def rotations(md, body):
+    k = md.unknowns.index(f"{body}.qw")
+    e = np.asarray(md.q[k:k + 4], float)
+    return rot_of(e / np.linalg.norm(e))
+
+
+def test_double_cardan_four_modes_told_apart_by_orientation():
+    m = kincas.cli.scene.load(CARDAN).mechanism
+    found = find_modes(m, {"in.angle": 0.0}, starts=64)
+    assert len(found) == 4
+    d = np.array([181.26155740732997, 84.52365234813989, 0.0])
+    d /= np.linalg.norm(d)
+    seen = set()
+    for md in found:
+        Rm, Ro = rotations(md, "mid"), rotations(md, "shaft_out")
+        # the independent answer: R_mid a rotation by 0 or pi about d, R_out by 0 or pi about x
+        phi = next(a for a in (0.0, np.pi) if np.allclose(Rm, kincas.core.space_model.axis_rotation(d, a), atol=1e-9))
+        psi = next(a for a in (0.0, np.pi) if np.allclose(Ro, kincas.core.space_model.axis_rotation([1, 0, 0], a), atol=1e-9))
+        seen.add((phi, psi))
+        assert np.allclose(md.points["O2"], [181.26155740732997, 84.52365234813989, 0.0], atol=1e-9)
+    assert len(seen) == 4
+    assert sum(md.from_guess for md in found) == 1  # the guess's assembly: one of the four
+
+
+@pytest.mark.slow
+def test_double_cardan_cli_modes_count(capsys):
+    code, out, err = run_cli(capsys, "modes", CARDAN)  # plain: 512 starts
+    assert code == 0 and "4 assembly modes" in out and "cannot pick between them" in out
+
+
+def test_double_cardan_multistart_matches_the_certified_count():
+    from kincas.analysis import certify_msolve
+    if not certify_msolve.available():
+        pytest.skip('msolve not installed (pip install "kincas[certify]")')
+    m = kincas.cli.scene.load(CARDAN).mechanism
+    u = 0.7  # (0 is the CLI test's)
+    assert len(find_modes(m, {"in.angle": u}, starts=64)) == kincas.modes(m, {"in.angle": u}, certify=True).count == 4
