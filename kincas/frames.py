@@ -25,10 +25,9 @@ import importlib
 
 import numpy as np
 
+from .model.names import derivative_order
 from .result_base import Result
 
-_ORDER = {"x": 0, "y": 0, "s": 0, "angle": 0, "vx": 1, "vy": 1, "v": 1, "omega": 1,
-          "ax": 2, "ay": 2, "a": 2, "alpha": 2, "jx": 3, "jy": 3, "jerk": 3}
 
 
 def require(package: str):
@@ -52,10 +51,11 @@ def unit_of(name: str, length: str = "", angle: str = "rad", time: str = "s") ->
         uq = unit_of(q, length, angle, time)
         return f"{uq or '1'}/{length}" if length else uq
     attr = name.rsplit(".", 1)[-1] if "." in name else None
-    order = _ORDER.get(attr) if attr else None
+    order = derivative_order(attr) if attr else None
     if order is None:
         return length if "." not in name else ""  # a parameter driven by an input: a length
-    base = angle if attr in ("angle", "omega", "alpha", "jerk") else length
+    angular = attr.rstrip("0123456789").split("_")[0] in ("angle", "omega", "alpha", "jerk")
+    base = angle if angular else length
     if not base:
         return ""
     return base + ("" if order == 0 else f"/{time}" if order == 1 else f"/{time}^{order}")

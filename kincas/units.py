@@ -16,10 +16,8 @@ import re
 import numpy as np
 
 from .model.mechanism import Param
-from .model.names import is_angular, parse_quantity
+from .model.names import derivative_order, is_angular, is_rotation_entry, parse_quantity
 
-_ORDER = {"vx": 1, "vy": 1, "omega": 1, "v": 1, "ax": 2, "ay": 2, "alpha": 2, "a": 2,
-          "jx": 3, "jy": 3, "jerk": 3}
 
 
 def json_list(v) -> list:
@@ -88,8 +86,10 @@ def unit_label(units: dict, mech, name: str, extra=None) -> str:
     other = extra(name, L) if extra is not None else None
     if other is not None:
         return other
+    if kind != "sens" and attr is not None and is_rotation_entry(attr):
+        return ""  # a quaternion's or rotation matrix's entry is a pure number
     base = A if is_angular(name, mech) else L  # input keys L.angle included
-    order = _ORDER.get(attr, 0)
+    order = derivative_order(attr) or 0 if attr else 0
     return base + ("" if order == 0 else f"/{T}" if order == 1 else f"/{T}^{order}")
 
 

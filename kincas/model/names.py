@@ -33,6 +33,33 @@ def parse_quantity(name: str):
     return ("plain", obj, attr)
 
 
+_ORDERS = {**dict.fromkeys(("x", "y", "z", "s", "angle"), 0), **dict.fromkeys(("vx", "vy", "vz", "v", "omega"), 1),
+           **dict.fromkeys(("ax", "ay", "az", "a", "alpha"), 2), **dict.fromkeys(("jx", "jy", "jz", "jerk"), 3)}
+_ROTATION = re.compile(r"^(q[wxyz]|R[123][123])$")
+
+
+def derivative_order(attr: str) -> int | None:
+    """How many times a quantity's attribute is differentiated in time: 0 for a position, an
+    angle or a coordinate, 1 for a rate, 2 an acceleration, 3 a jerk; None where it has no
+    time unit of its own (a quaternion or rotation-matrix entry, a cam's pressure angle...).
+    2D and 3D names alike: `omega_x` and `omega1` are rates as `omega` is.
+
+    >>> [derivative_order(a) for a in ("x", "vz", "omega_x", "alpha2", "jerk", "a1", "R11")]
+    [0, 1, 1, 2, 3, 2, None]
+    """
+    base = attr.rstrip("0123456789").split("_")[0]
+    return _ORDERS.get(base)
+
+
+def is_rotation_entry(attr: str) -> bool:
+    """Whether `attr` is an entry of a body's unit quaternion or rotation matrix (no unit).
+
+    >>> is_rotation_entry("qw"), is_rotation_entry("R23"), is_rotation_entry("x")
+    (True, True, False)
+    """
+    return _ROTATION.match(attr) is not None
+
+
 def is_angular(name: str, mech=None) -> bool:
     """Whether a quantity is an angle or an angle's rate (converted to degrees at the edge).
     `S.jerk` of a slide is a length's: give the mechanism to tell it from a link's `L.jerk`.
@@ -50,6 +77,10 @@ def is_angular(name: str, mech=None) -> bool:
         return b in LINK_Q or b in ANGULAR
     if b == "jerk" and mech is not None and a in {s.name for s in mech.slides}:
         return False
+    if mech is None:  # no mechanism to ask: a 3D rate's name (omega_x) is an angle's too
+        from .space_names import ANGULAR
+        if b in ANGULAR and not b.startswith("jerk"):
+            return True
     return b in LINK_Q or b in ANGULAR_ATTRS
 
 

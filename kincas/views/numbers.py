@@ -21,8 +21,6 @@ import numpy as np
 
 EPS = 1e-11  # relative to a quantity's scale: below it, a value is zero to the solve's accuracy
 
-_ORDER = {"x": 0, "y": 0, "s": 0, "angle": 0, "vx": 1, "vy": 1, "v": 1, "omega": 1,
-          "ax": 2, "ay": 2, "a": 2, "alpha": 2}
 
 
 def snap(v, scale: float) -> np.ndarray:
@@ -38,7 +36,7 @@ def snap(v, scale: float) -> np.ndarray:
 def scale_of(name: str, scene, sweep) -> float:
     """The natural scale of quantity `name` in the scene's units (0 when unknown: then only
     the column's own largest value sets it)."""
-    from ..model.names import parse_quantity
+    from ..model.names import derivative_order, parse_quantity
     try:
         kind, obj, attr = parse_quantity(name)
     except Exception:  # a quantity kind this module does not know
@@ -46,10 +44,10 @@ def scale_of(name: str, scene, sweep) -> float:
     L = _size(scene)
     if kind == "sens":
         return scale_of(obj, scene, sweep) / L if L > 0 else 0.0
-    order = _ORDER.get(attr)
-    if order is None:
+    order = derivative_order(attr)
+    if order is None or order > 2:
         return 0.0
-    angular = attr in ("angle", "omega", "alpha")
+    angular = attr.rstrip("0123456789").split("_")[0] in ("angle", "omega", "alpha")
     base = (180 / math.pi if scene.study.deg else 1.0) if angular else L
     w, a = _input_rates(scene, sweep, L)
     return base * (1.0, w, w * w + a)[order]
