@@ -122,7 +122,8 @@ def _table(sc, sw, inputs, values):
         at = ", ".join(f"{k} = {v:.12g}" for k, v in e["inputs"].items())
         what = label_text(e) if e["kind"] == "resume" else e["kind"]
         if e["kind"] == "assembly":  # the assembly a sweep without [guess] chose, and why
-            pts = ", ".join(f"{pt} = [{x:.12g}, {y:.12g}]" for pt, (x, y) in e["guess"].items())
+            pts = ", ".join(f"{pt} = [" + ", ".join(f"{c:.12g}" for c in xyz) + "]"  # 2D or 3D
+                            for pt, xyz in e["guess"].items())
             print(f"pose {e['pose']}: assembly chosen at {at}: {e['reason']} ({pts})")
             continue
         print(f"pose {e['pose']}: {what} at {at}")
