@@ -12,12 +12,13 @@ and `_take` read rates and accelerations given as a table or as one row for ever
 """
 from __future__ import annotations
 
+import ctypes
 from itertools import accumulate
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .compiled import ptr, rows, table
+from .compiled import rows, table
 from .kernel import CORRECTION, JAC_CHANGE, KERNEL_NEAR, RESIDUAL, STEP
 
 if TYPE_CHECKING:
@@ -47,7 +48,8 @@ class FastRun:
         self.n = n = U.shape[0]
         Ud, sud = _rows(np.ones(nu) if Ud is None else Ud, n, nu)
         Udd, sudd = _rows(np.zeros(nu) if Udd is None else Udd, n, nu)
-        p = np.asarray(p, dtype=float).ravel()
+        if not (type(p) is np.ndarray and p.dtype == np.float64 and p.ndim == 1):  # (a mechanism's
+            p = np.asarray(p, dtype=float).ravel()  # prepared values are: no call for them)
         # everything the kernel reads or writes of this run in one block of memory: L and
         # the thresholds, the state, Q, info, values, measures, then copies of the inputs
         # (U, rates, accelerations: a table, or one row for every pose) and the parameters
@@ -71,13 +73,14 @@ class FastRun:
         self.p[...] = p
         self.accepted, self.solved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
         self.first_bad, self._s, self._addr, self.recorded = 0, None, None, 0
+        self.attempted = False  # True once every pose was attempted (`FastSweeper.sweep`)
         self.backend = None  # "compiled" or "virtual machine": what `advance` ran last
 
     residual = property(lambda self: self.info[0], doc="max |g| / L at each pose (L: each group's)")
     step = property(lambda self: self.info[1], doc="the last Newton step (negligible, applied)")
     jac_change = property(lambda self: self.info[2], doc="max per group of sum |D^-1 (A_prev^-1 A - I) D|")
     correction = property(lambda self: self.info[3], doc="max per group of ||D^-1 (q - q_pred)||_1")
-    iterations = property(lambda self: np.fmax(self.info[4], 0.0).astype(int),  # fmax: NaN -> 0
+    iterations = property(lambda self: self.info[4].astype(int) if self.attempted else _counts(self.info[4]),
                           doc="Newton steps taken at each pose (0 where none was attempted)")
     signs = property(lambda self: self.measures[:-1].T, doc="(N, groups) signs of det per group")
     sigma = property(lambda self: self.measures[-1], doc="smallest relative singular value bound")
@@ -96,8 +99,9 @@ class FastRun:
         lib = sw.backend.compiled(self.n)
         self.backend = "virtual machine" if lib is None else "compiled"
         if lib is not None:
-            if self._addr is None:  # the address of the run's block (inputs included)
-                self._addr = ptr(self._block)
+            if self._addr is None:  # the address of the run's block (inputs included): a
+                # ctypes view of the (writable, contiguous) block costs a third of `ptr`'s
+                self._addr = ctypes.addressof(ctypes.c_char.from_buffer(self._block))
             a, o, sud, sudd, nq, nu = self._addr, self._off, self.Ud[1], self.Udd[1], sw.nq, sw.nu
             k = start + lib.kincas_sweep(
                 stop - start, a + 8 * (o[6] + start * nu), a + 8 * o[9], a, a + 8, sw.max_evals, a + 8 * o[1],
@@ -131,6 +135,12 @@ def _rows(a, n: int, width: int) -> tuple[np.ndarray, int]:
     if a.size == width and width:
         return np.ascontiguousarray(a.reshape(width)), 0
     return rows(a, n, width)
+
+
+def _counts(steps: np.ndarray) -> np.ndarray:
+    """Newton's steps per pose as integers, NaN (a pose not attempted) as 0 (np.fmax calls
+    libm per number: a run whose every pose was attempted skips it)."""
+    return np.fmax(steps, 0.0).astype(int)
 
 
 def _take(table, idx):
