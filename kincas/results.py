@@ -348,7 +348,15 @@ class Sweep(Result):
         >>> sw.ok.tolist(), (sw.status == "ok").tolist()
         ([True, True], [True, True])
         """
-        return np.asarray(self.status == "ok", dtype=bool).reshape(len(self.status))
+        st = self.status
+        n = len(st)
+        if type(st) is np.ndarray and st.dtype == object and st.ndim == 1 and st.tolist().count("ok") == n:
+            # every pose solved (the usual sweep): list.count compares by identity first,
+            # numpy's == calls each string's __eq__ (three times the cost)
+            out = np.empty(n, dtype=bool)
+            out.fill(True)
+            return out
+        return np.asarray(st == "ok", dtype=bool).reshape(n)
 
     @property
     def names(self) -> list[str]:

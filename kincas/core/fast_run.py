@@ -60,9 +60,9 @@ class FastRun:
         block = self._block = np.empty(o[-1])
         block[:6] = _HEAD  # the thresholds, then L in its place
         block[0] = L
-        self.L, self.thr, self._state = block[0:1], block[1:6], block[o[1]:o[2]]
-        self.Q, self.info = block[o[2]:o[3]].reshape(n, nq), block[o[3]:o[4]].reshape(5, n)
-        self.values, self.measures = block[o[4]:o[5]].reshape(no, n), block[o[5]:o[6]].reshape(nm, n)
+        self._state, self.Q = block[o[1]:o[2]], block[o[2]:o[3]].reshape(n, nq)
+        per_pose = block[o[3]:o[6]].reshape(5 + no + nm, n)  # info, values, measures: one table
+        self.info, self.values, self.measures = per_pose[:5], per_pose[5:5 + no], per_pose[5 + no:]
         self.U = block[o[6]:o[7]].reshape(n, nu)
         self.U[...] = U
         self.Ud = (block[o[7]:o[8]].reshape(-1, nu) if sud else block[o[7]:o[8]], sud)
@@ -76,6 +76,8 @@ class FastRun:
         self.attempted = False  # True once every pose was attempted (`FastSweeper.sweep`)
         self.backend = None  # "compiled" or "virtual machine": what `advance` ran last
 
+    L = property(lambda self: self._block[0:1], doc="(1,) the length the residuals are relative to")
+    thr = property(lambda self: self._block[1:6], doc="(5,) the kernel's acceptance thresholds")
     residual = property(lambda self: self.info[0], doc="max |g| / L at each pose (L: each group's)")
     step = property(lambda self: self.info[1], doc="the last Newton step (negligible, applied)")
     jac_change = property(lambda self: self.info[2], doc="max per group of sum |D^-1 (A_prev^-1 A - I) D|")
