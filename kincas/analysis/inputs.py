@@ -10,7 +10,6 @@
 """
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 
 import numpy as np
@@ -32,7 +31,7 @@ def input_table(m: Mechanism, inputs, what: str, default: float | None, keys=Non
         c = inputs[keys[0]]  # the common case, one input: no copy
         if not (type(c) is np.ndarray and c.dtype == np.float64):
             c = _floats(c, what, keys[0])
-        if c.ndim <= 1 and c.size and _finite(c):
+        if c.ndim <= 1 and c.size and np.isfinite(c).all():
             return c.reshape(-1, 1)
     if inputs is None:
         if default is None and keys:
@@ -82,18 +81,6 @@ def derivative_table(m: Mechanism, values, what: str, default: float, n: int, ke
         raise ModelError(f"{what}: {keys[0] if len(keys) == 1 else keys}: {T.shape[0]} values for "
                          f"{n} poses (give one value, or one per pose)")
     return np.broadcast_to(T, (n, T.shape[1]))
-
-
-def _finite(c: np.ndarray) -> bool:
-    """Whether every number of c is finite: the sum is finite only if every term is (a NaN
-    or an infinity carries into it), so one reduction decides the usual case; only a sum
-    that overflows looks at every number (a short sweep pays every microsecond)."""
-    try:
-        if math.isfinite(c.sum()):
-            return True
-    except FloatingPointError:  # (np.seterr(over="raise") and a sum that overflows)
-        pass
-    return bool(np.isfinite(c).all())
 
 
 def _floats(v, what: str, key: str) -> np.ndarray:
