@@ -193,7 +193,11 @@ class Sweep(Result):
         # object dtype: a longer status assigned later is kept whole, not truncated
         if not (isinstance(st := self.status, np.ndarray) and st.dtype == object):  # (kept if it is one)
             self.status = st.astype(object) if isinstance(st, np.ndarray) else np.array(list(st), dtype=object)
-        for k in list(self.values):
+        try:  # (the usual report has no angle: one search of all the names, not one per name)
+            angles = ".angle" in (joined := "\n".join(self.values)) or ".phi" in joined
+        except TypeError:  # a name that is not a string: looked at one by one, as ever
+            angles = True
+        for k in list(self.values) if angles else ():
             if k.endswith((".angle", ".phi")) and not k.startswith("d("):  # cam.phi too
                 self.values[k] = wrap_angle(self.values[k])
 

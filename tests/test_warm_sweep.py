@@ -173,3 +173,16 @@ def test_iterations_are_newtons_steps_with_careful_poses_too():
         assert sw.iterations.dtype.kind == "i" and (sw.iterations >= 0).all()
         assert sw.ok.any() and not sw.ok.all()
         assert (sw.ok == (sw.status == "ok")).all()
+
+
+def test_reported_angles_are_wrapped_beside_other_names():
+    """Angles among other names are still taken into (-pi, pi] (the Sweep looks for angle
+    names once over all the names): the crank driven to 3 pi reports its angle wrapped."""
+    m, th = fourbar(), np.linspace(0.0, 3 * np.pi, 50)
+    for rep in (["C.x", "crank.angle"], ["crank.angle"], ["C.x", "C.y"]):
+        sw = kincas.sweep(m, {"crank.angle": th}, report=rep)
+        if "crank.angle" in rep:
+            a = sw["crank.angle"]
+            assert (a > -np.pi).all() and (a <= np.pi).all()
+            assert np.abs(np.exp(1j * a) - np.exp(1j * th)).max() < 1e-12
+        assert np.array_equal(sw.inputs["crank.angle"], th)
