@@ -193,10 +193,7 @@ class Sweep(Result):
         # object dtype: a longer status assigned later is kept whole, not truncated
         if not (isinstance(st := self.status, np.ndarray) and st.dtype == object):  # (kept if it is one)
             self.status = st.astype(object) if isinstance(st, np.ndarray) else np.array(list(st), dtype=object)
-        try:  # (the usual report has no angle: one search of all the names, not one per name)
-            angles = ".angle" in (joined := "\n".join(self.values)) or ".phi" in joined
-        except TypeError:  # a name that is not a string: looked at one by one, as ever
-            angles = True
+        angles = ".angle" in (names := "\n".join(map(str, self.values))) or ".phi" in names  # (one search)
         for k in list(self.values) if angles else ():
             if k.endswith((".angle", ".phi")) and not k.startswith("d("):  # cam.phi too
                 self.values[k] = wrap_angle(self.values[k])
@@ -352,14 +349,9 @@ class Sweep(Result):
         >>> sw.ok.tolist(), (sw.status == "ok").tolist()
         ([True, True], [True, True])
         """
-        st = self.status
-        n = len(st)
+        st, n = self.status, len(self.status)  # every pose solved (the usual sweep): list.count
         if type(st) is np.ndarray and st.dtype == object and st.ndim == 1 and st.tolist().count("ok") == n:
-            # every pose solved (the usual sweep): list.count compares by identity first,
-            # numpy's == calls each string's __eq__ (three times the cost)
-            out = np.empty(n, dtype=bool)
-            out.fill(True)
-            return out
+            return np.ones(n, dtype=bool)  # compares by identity first (numpy's == calls __eq__: 3x)
         return np.asarray(st == "ok", dtype=bool).reshape(n)
 
     @property
