@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .result_base import Result
+from .result_base import Result, listed as _names
 
 
 def wrap_angle(a: np.ndarray) -> np.ndarray:
@@ -394,11 +394,3 @@ class Sweep(Result):
                     status=str(self.status[i]), flag=self.flags[i],
                     values={k: float(v[i]) for k, v in self.values.items()},
                     residual=float(self.residual[i]))
-
-
-def _names(d, most: int = 4) -> str:
-    """'a, b, c' or 'a, b, c, d and 5 more'."""
-    names = list(d)
-    if len(names) <= most:
-        return ", ".join(names)
-    return ", ".join(names[:most]) + f" and {len(names) - most} more"
