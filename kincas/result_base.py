@@ -101,3 +101,15 @@ def result_type(name: str):
                       f"goes in the next release)", DeprecationWarning, stacklevel=3)
         name = RENAMED[name]
     return getattr(importlib.import_module(f"kincas.{TYPES[name]}"), name)
+
+
+def listed(d, most: int = 4) -> str:
+    """'a, b, c' or 'a, b, c, d and 5 more' (the names of `d`, at most `most` of them).
+
+    >>> listed("abcdef", 4)
+    'a, b, c, d and 2 more'
+    """
+    names = list(d)
+    if len(names) <= most:
+        return ", ".join(names)
+    return ", ".join(names[:most]) + f" and {len(names) - most} more"

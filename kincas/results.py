@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .result_base import Result
+from .result_base import Result, listed as _names
 
 
 def wrap_angle(a: np.ndarray) -> np.ndarray:
@@ -193,7 +193,8 @@ class Sweep(Result):
         # object dtype: a longer status assigned later is kept whole, not truncated
         if not (isinstance(st := self.status, np.ndarray) and st.dtype == object):  # (kept if it is one)
             self.status = st.astype(object) if isinstance(st, np.ndarray) else np.array(list(st), dtype=object)
-        for k in list(self.values):
+        angles = ".angle" in (names := "\n".join(map(str, self.values))) or ".phi" in names  # (one search)
+        for k in list(self.values) if angles else ():
             if k.endswith((".angle", ".phi")) and not k.startswith("d("):  # cam.phi too
                 self.values[k] = wrap_angle(self.values[k])
 
@@ -348,7 +349,10 @@ class Sweep(Result):
         >>> sw.ok.tolist(), (sw.status == "ok").tolist()
         ([True, True], [True, True])
         """
-        return np.asarray(self.status == "ok", dtype=bool).reshape(len(self.status))
+        st, n = self.status, len(self.status)  # every pose solved (the usual sweep): list.count
+        if type(st) is np.ndarray and st.dtype == object and st.ndim == 1 and st.tolist().count("ok") == n:
+            return np.ones(n, dtype=bool)  # compares by identity first (numpy's == calls __eq__: 3x)
+        return np.asarray(st == "ok", dtype=bool).reshape(n)
 
     @property
     def names(self) -> list[str]:
@@ -390,11 +394,3 @@ class Sweep(Result):
                     status=str(self.status[i]), flag=self.flags[i],
                     values={k: float(v[i]) for k, v in self.values.items()},
                     residual=float(self.residual[i]))
-
-
-def _names(d, most: int = 4) -> str:
-    """'a, b, c' or 'a, b, c, d and 5 more'."""
-    names = list(d)
-    if len(names) <= most:
-        return ", ".join(names)
-    return ", ".join(names[:most]) + f" and {len(names) - most} more"

@@ -99,3 +99,90 @@ def test_inputs_checked_finite_whatever_their_size():
     C = closed_C(th, 3.5)  # the crank at angle 1e200 rad is somewhere on its circle
     solved = sw.ok
     assert np.abs(np.array([sw["C.x"], sw["C.y"]])[:, solved] - C[:, solved]).max(initial=0) < 1e-9
+
+
+# --- what the warm road keeps per mechanism, report and guess must never be served to another ---
+
+
+def test_two_mechanisms_one_length_apart_swept_alternately():
+    """Same structure, same report list, same input array, coupler 3.5 against 3.4: each sweep
+    gives its own mechanism's closed form, however they alternate (warm and compiled)."""
+    th = np.linspace(0.1, 6.0, 120)
+    m1, m2 = fourbar(3.5), fourbar(3.4)
+    kincas.sweep(m1, {"crank.angle": th}, report=REPORT, compile=True)
+    for mech, b in [(m1, 3.5), (m2, 3.4), (m1, 3.5), (m2, 3.4), (m2, 3.4), (m1, 3.5)]:
+        check(kincas.sweep(mech, {"crank.angle": th}, rates={"crank.angle": 2.0}, report=REPORT), th, b, 2.0)
+
+
+def test_a_changed_guess_picks_the_other_branch_every_time():
+    """The guess (C above or below the ground line) picks the branch on every call: the
+    placement kept for one guess is not served for the other."""
+    th = np.linspace(0.1, 6.0, 90)
+    m = fourbar()
+    for sign in (+1, -1, +1, -1, -1, +1):
+        sw = kincas.sweep(m, {"crank.angle": th}, report=REPORT, guess={"C": (3.6, sign * 2.9)})
+        C = closed_forms.fourbar((0, 0), (4, 0), 1.0, 3.5, 3.0, th, sign)[1].T
+        assert sw.ok.all() and np.abs(np.array([sw["C.x"], sw["C.y"]]) - C).max() < 1e-12
+    # and the mechanism's own guess (upper) again, after the others
+    check(kincas.sweep(m, {"crank.angle": th}, report=REPORT), th, 3.5, 1.0)
+
+
+def test_reports_swept_alternately_give_each_their_own_values():
+    th = np.linspace(0.1, 6.0, 60)
+    m = fourbar()
+    C = closed_C(th, 3.5)
+    for rep in (["C.y"], ["C.x", "C.y"], ["C.y", "C.x"], ["C.y"], REPORT, ["C.x"]):
+        sw = kincas.sweep(m, {"crank.angle": th}, report=rep)
+        assert sw.names == rep
+        for name in rep[:2]:
+            want = C[0] if name == "C.x" else C[1] if name == "C.y" else None
+            if want is not None:
+                assert np.abs(sw[name] - want).max() < 1e-12
+
+
+def test_ok_follows_the_status_as_it_is_now():
+    """`Sweep.ok` is `status == "ok"` whatever was assigned to the status since, and an
+    "ok" that is an equal string but not the same object counts as solved."""
+    sw = kincas.sweep(fourbar(), {"crank.angle": np.linspace(0.1, 1.0, 6)}, report=["C.x"])
+    assert sw.ok.tolist() == [True] * 6 and sw.ok.dtype == bool
+    sw.status[2] = "no assembly"
+    assert sw.ok.tolist() == [True, True, False, True, True, True]
+    sw.status[2] = "".join(["o", "k"])  # equal, not identical
+    assert sw.ok.tolist() == [True] * 6
+    sw.status[0] = None
+    assert sw.ok.tolist() == [False] + [True] * 5
+    a, b = sw.ok, sw.ok
+    a[1] = False
+    assert b[1] and sw.ok[1]  # each call a mask of its own
+
+
+def test_iterations_are_newtons_steps_with_careful_poses_too():
+    """A sweep through the four-bar's limits (coupler 4, rocker 0.8: the crank cannot turn
+    round) has poses with no assembly and poses solved on the careful path; its iteration
+    counts stay non-negative integers, and each solved pose's C lies on both circles."""
+    m = Mechanism(ground={"A": (0, 0), "D": (4, 0)},
+                  links=[Link.bar("crank", "A", "B", 1), Link.bar("coupler", "B", "C", 4),
+                         Link.bar("rocker", "D", "C", 0.8)],
+                  inputs=[Input.angle("crank")], guess={"C": (4.2, 0.77)})
+    th = np.linspace(1.5, 1.5 + 2 * np.pi, 73)
+    for _ in range(2):
+        sw = kincas.sweep(m, {"crank.angle": th}, report=["C.x", "C.y"])
+        x, y = sw["C.x"][sw.ok], sw["C.y"][sw.ok]
+        assert np.abs(np.hypot(x - np.cos(th[sw.ok]), y - np.sin(th[sw.ok])) - 4).max() < 1e-12
+        assert np.abs(np.hypot(x - 4, y) - 0.8).max() < 1e-12
+        assert sw.iterations.dtype.kind == "i" and (sw.iterations >= 0).all()
+        assert sw.ok.any() and not sw.ok.all()
+        assert (sw.ok == (sw.status == "ok")).all()
+
+
+def test_reported_angles_are_wrapped_beside_other_names():
+    """Angles among other names are still taken into (-pi, pi] (the Sweep looks for angle
+    names once over all the names): the crank driven to 3 pi reports its angle wrapped."""
+    m, th = fourbar(), np.linspace(0.0, 3 * np.pi, 50)
+    for rep in (["C.x", "crank.angle"], ["crank.angle"], ["C.x", "C.y"]):
+        sw = kincas.sweep(m, {"crank.angle": th}, report=rep)
+        if "crank.angle" in rep:
+            a = sw["crank.angle"]
+            assert (a > -np.pi).all() and (a <= np.pi).all()
+            assert np.abs(np.exp(1j * a) - np.exp(1j * th)).max() < 1e-12
+        assert np.array_equal(sw.inputs["crank.angle"], th)

@@ -83,7 +83,7 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
     if model.nq == 0 or not m.inputs or n == 0:
         return events, at
     sigma = np.asarray(sigma, float)
-    if not len(crossed) and _nothing_met(ok, signs, sigma):
+    if not len(crossed) and nothing_met(ok, signs, sigma):
         return events, at
     signs = np.nan_to_num(np.asarray(signs, float)).astype(int)
     names = group_links(model)
@@ -174,14 +174,16 @@ def sweep_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed=()):
     return _distinct(events), at
 
 
-def _nothing_met(ok, signs, sigma) -> bool:
-    """Whether the sweep met no singular position and no gap: every pose solved, every
-    group well conditioned at every pose (none near NEAR_SINGULAR or FLAG_SIGMA) and in one mode
-    throughout. The usual sweep: then none of the searches below has anything to look at."""
-    if not ok.all() or not sigma.min(initial=np.inf) > max(NEAR_SINGULAR, 1e3 * FLAG_SIGMA):  # (NaN: not)
+def nothing_met(ok, signs, sigma, every: bool | None = None) -> bool:
+    """Whether the sweep met no singular position and no gap: every pose solved (`every`,
+    if the caller knows it already), every group well conditioned at every pose (none near
+    NEAR_SINGULAR or FLAG_SIGMA) and in one mode throughout. The usual sweep: then none of
+    the searches of `sweep_events` has anything to look at."""
+    if not (ok.all() if every is None else every) or not sigma.min(initial=np.inf) > max(NEAR_SINGULAR, 1e3 * FLAG_SIGMA):  # (NaN: not)
         return False
     signs = np.asarray(signs)
-    return bool((signs == signs[:1]).all())
+    return not np.count_nonzero(signs != signs[:1])  # (NaN != NaN: a NaN sign is a change;
+    # count_nonzero costs a third of a ufunc's reduction .all())
 
 
 def _distinct(events):

@@ -29,7 +29,7 @@ from ..model.names import default_report
 from .choice import choose_assembly
 from .continuation import careful_pose
 from .resume import unlabelled_resumes
-from .events import null_derivatives, sweep_events
+from .events import nothing_met, null_derivatives, sweep_events
 from ..core.joints import check_first_pose
 from .inputs import derivative_table, input_table as _input_table
 from .prepared import model_and_prepared
@@ -142,7 +142,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     # Which pass solves which pose is the method's choice (kincas/analysis/methods.py).
     run = solver.sweep(SweepProblem(model, pm, names, report, U, Ud, Udd, p, L, careful, first, progress))
     ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
-    every = bool(ok.all())
+    every = np.count_nonzero(ok) == n  # (a ufunc's reduction costs twice as much)
     if m.gears and ok.any():  # gear centre distances at the first solved pose
         check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
     if every:
@@ -153,9 +153,12 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     flags = [None] * n
     if not every:  # after gaps the fast pass crossed (none where every pose is solved)
         events += unlabelled_resumes(model, U, p, L, Q, ok, events)
-    found, at = _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma,
-                                 getattr(run, "crossed", ()))
-    events += found
+    crossed, signs, sigma = getattr(run, "crossed", ()), run.signs, run.sigma
+    if every and not len(crossed) and nothing_met(ok, signs, sigma, every):
+        at = None  # the usual sweep: no singular position met, no gap (nothing to search)
+    else:
+        found, at = _singular_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed)
+        events += found
     values = run.values
     if Uddd is not None:  # the inputs' jerks enter only the third derivatives
         third = [i for i, nm in enumerate(report) if needs_jerk(nm)]
@@ -163,17 +166,19 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
             got = model.third_derivatives([report[i] for i in third], Q[ok], U[ok], p, Ud[ok], Udd[ok], Uddd[ok])
             values = np.array(values, dtype=float)
             values[np.ix_(third, np.flatnonzero(ok))] = got
-    if at.any():  # no wrong number at a singular pose
+    if at is not None and at.any():  # no wrong number at a singular pose
         null_derivatives(model, report, values, Q, U, p, at)
     keys = pm.keys
-    events.sort(key=lambda e: e["pose"])
-    for e in events:
-        e.setdefault("inputs", {kk: float(U[e["pose"], j]) for j, kk in enumerate(keys)})
-    out = Sweep(inputs={k: U[:, j].copy() for j, k in enumerate(keys)},
+    if events:
+        events.sort(key=lambda e: e["pose"])
+        for e in events:
+            e.setdefault("inputs", {kk: float(U[e["pose"], j]) for j, kk in enumerate(keys)})
+    out = Sweep(inputs=({keys[0]: U.ravel().copy()} if U.shape[1] == 1 else  # (one input: no view)
+                        {k: U[:, j].copy() for j, k in enumerate(keys)}),
                 rates={k: Ud[:, j] for j, k in enumerate(keys)},  # (tables of this call's own)
                 accelerations={k: Udd[:, j] for j, k in enumerate(keys)},
                 status=status, flags=flags,
-                values={nm: values[i] for i, nm in enumerate(report)},
+                values=dict(zip(report, values)),  # (each row a view, as indexing gives it)
                 q=Q, residual=res, iterations=its,
                 unknowns=model.unknown_names, size=L, events=events,
                 info={"fast pass": getattr(run, "backend", None)})

@@ -252,6 +252,7 @@ class FastSweeper(VirtualMachineSweep):
             r.values[:, slow] = ev.evaluate(r.Q[slow], r.U[slow], r.p, _take(r.Ud, slow), _take(r.Udd, slow))
         if progress is not None:
             progress(r.n, r.n)
+        r.attempted = True  # every pose: Newton's steps counted at each (no NaN to mend)
         return r
 
     def _from_guess(self, r: FastRun, k: int, placed, stop: int) -> int:

@@ -12,12 +12,13 @@ and `_take` read rates and accelerations given as a table or as one row for ever
 """
 from __future__ import annotations
 
+import ctypes
 from itertools import accumulate
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .compiled import ptr, rows, table
+from .compiled import rows, table
 from .kernel import CORRECTION, JAC_CHANGE, KERNEL_NEAR, RESIDUAL, STEP
 
 if TYPE_CHECKING:
@@ -47,7 +48,8 @@ class FastRun:
         self.n = n = U.shape[0]
         Ud, sud = _rows(np.ones(nu) if Ud is None else Ud, n, nu)
         Udd, sudd = _rows(np.zeros(nu) if Udd is None else Udd, n, nu)
-        p = np.asarray(p, dtype=float).ravel()
+        if not (type(p) is np.ndarray and p.dtype == np.float64 and p.ndim == 1):  # (a mechanism's
+            p = np.asarray(p, dtype=float).ravel()  # prepared values are: no call for them)
         # everything the kernel reads or writes of this run in one block of memory: L and
         # the thresholds, the state, Q, info, values, measures, then copies of the inputs
         # (U, rates, accelerations: a table, or one row for every pose) and the parameters
@@ -58,26 +60,52 @@ class FastRun:
         block = self._block = np.empty(o[-1])
         block[:6] = _HEAD  # the thresholds, then L in its place
         block[0] = L
-        self.L, self.thr, self._state = block[0:1], block[1:6], block[o[1]:o[2]]
-        self.Q, self.info = block[o[2]:o[3]].reshape(n, nq), block[o[3]:o[4]].reshape(5, n)
-        self.values, self.measures = block[o[4]:o[5]].reshape(no, n), block[o[5]:o[6]].reshape(nm, n)
-        self.U = block[o[6]:o[7]].reshape(n, nu)
-        self.U[...] = U
-        self.Ud = (block[o[7]:o[8]].reshape(-1, nu) if sud else block[o[7]:o[8]], sud)
-        self.Ud[0][...] = Ud
-        self.Udd = (block[o[8]:o[9]].reshape(-1, nu) if sudd else block[o[8]:o[9]], sudd)
-        self.Udd[0][...] = Udd
-        self.p = block[o[9]:o[10]]
-        self.p[...] = p
+        self._state, self.Q = block[o[1]:o[2]], block[o[2]:o[3]].reshape(n, nq)
+        per_pose = block[o[3]:o[6]].reshape(5 + no + nm, n)  # info, values, measures: one table
+        self.info, self.values, self.measures = per_pose[:5], per_pose[5:5 + no], per_pose[5 + no:]
+        # the inputs and parameters copied in by one call (views of them made when asked)
+        np.concatenate((U.ravel(), Ud.ravel(), Udd.ravel(), p), out=block[o[6]:])
+        self._sud, self._sudd, self._U, self._Ud, self._Udd, self._p = sud, sudd, None, None, None, None
         self.accepted, self.solved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
         self.first_bad, self._s, self._addr, self.recorded = 0, None, None, 0
+        self.attempted = False  # True once every pose was attempted (`FastSweeper.sweep`)
         self.backend = None  # "compiled" or "virtual machine": what `advance` ran last
 
+    @property
+    def U(self) -> np.ndarray:
+        """(N, nu) the inputs at each pose (the run's copy, which the kernel reads)."""
+        if self._U is None:
+            self._U = self._block[self._off[6]:self._off[7]].reshape(self.n, self.sweeper.nu)
+        return self._U
+
+    @property
+    def Ud(self) -> tuple:
+        """(table, row stride): the inputs' rates, one row per pose (stride nu) or one for all (0)."""
+        if self._Ud is None:
+            self._Ud = (_rows_of(self._block[self._off[7]:self._off[8]], self._sud, self.sweeper.nu), self._sud)
+        return self._Ud
+
+    @property
+    def Udd(self) -> tuple:
+        """(table, row stride): the inputs' accelerations, as `Ud`."""
+        if self._Udd is None:
+            self._Udd = (_rows_of(self._block[self._off[8]:self._off[9]], self._sudd, self.sweeper.nu), self._sudd)
+        return self._Udd
+
+    @property
+    def p(self) -> np.ndarray:
+        """The parameter values (the run's copy)."""
+        if self._p is None:
+            self._p = self._block[self._off[9]:self._off[10]]
+        return self._p
+
+    L = property(lambda self: self._block[0:1], doc="(1,) the length the residuals are relative to")
+    thr = property(lambda self: self._block[1:6], doc="(5,) the kernel's acceptance thresholds")
     residual = property(lambda self: self.info[0], doc="max |g| / L at each pose (L: each group's)")
     step = property(lambda self: self.info[1], doc="the last Newton step (negligible, applied)")
     jac_change = property(lambda self: self.info[2], doc="max per group of sum |D^-1 (A_prev^-1 A - I) D|")
     correction = property(lambda self: self.info[3], doc="max per group of ||D^-1 (q - q_pred)||_1")
-    iterations = property(lambda self: np.fmax(self.info[4], 0.0).astype(int),  # fmax: NaN -> 0
+    iterations = property(lambda self: self.info[4].astype(int) if self.attempted else _counts(self.info[4]),
                           doc="Newton steps taken at each pose (0 where none was attempted)")
     signs = property(lambda self: self.measures[:-1].T, doc="(N, groups) signs of det per group")
     sigma = property(lambda self: self.measures[-1], doc="smallest relative singular value bound")
@@ -96,9 +124,10 @@ class FastRun:
         lib = sw.backend.compiled(self.n)
         self.backend = "virtual machine" if lib is None else "compiled"
         if lib is not None:
-            if self._addr is None:  # the address of the run's block (inputs included)
-                self._addr = ptr(self._block)
-            a, o, sud, sudd, nq, nu = self._addr, self._off, self.Ud[1], self.Udd[1], sw.nq, sw.nu
+            if self._addr is None:  # the address of the run's block (inputs included): a
+                # ctypes view of the (writable, contiguous) block costs a third of `ptr`'s
+                self._addr = ctypes.addressof(ctypes.c_char.from_buffer(self._block))
+            a, o, sud, sudd, nq, nu = self._addr, self._off, self._sud, self._sudd, sw.nq, sw.nu
             k = start + lib.kincas_sweep(
                 stop - start, a + 8 * (o[6] + start * nu), a + 8 * o[9], a, a + 8, sw.max_evals, a + 8 * o[1],
                 a + 8 * (o[2] + start * nq), a + 8 * (o[3] + start), self.n, a + 8 * (o[7] + start * sud), sud,
@@ -131,6 +160,17 @@ def _rows(a, n: int, width: int) -> tuple[np.ndarray, int]:
     if a.size == width and width:
         return np.ascontiguousarray(a.reshape(width)), 0
     return rows(a, n, width)
+
+
+def _counts(steps: np.ndarray) -> np.ndarray:
+    """Newton's steps per pose as integers, NaN (a pose not attempted) as 0 (np.fmax calls
+    libm per number: a run whose every pose was attempted skips it)."""
+    return np.fmax(steps, 0.0).astype(int)
+
+
+def _rows_of(a: np.ndarray, stride: int, width: int) -> np.ndarray:
+    """A table's rows in the run's block: (N, width) with stride `width`, one row with 0."""
+    return a.reshape(-1, width) if stride else a
 
 
 def _take(table, idx):
