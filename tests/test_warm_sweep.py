@@ -186,3 +186,20 @@ def test_reported_angles_are_wrapped_beside_other_names():
             assert (a > -np.pi).all() and (a <= np.pi).all()
             assert np.abs(np.exp(1j * a) - np.exp(1j * th)).max() < 1e-12
         assert np.array_equal(sw.inputs["crank.angle"], th)
+
+
+
+def test_the_first_pose_solved_once_per_inputs_and_guess_is_never_served_elsewhere():
+    """The careful path's first pose (a search from a rough guess) is kept per placement:
+    sweeps starting at other inputs, from the other branch's guess, or of a mechanism one
+    length apart must each get their own, and a caller changing its arrays changes nothing."""
+    m, m2 = fourbar(), fourbar(3.6)
+    for k, t0 in enumerate([0.0, 0.3, 0.0, 0.3] * 2):
+        th = np.linspace(t0, t0 + 2 * np.pi, 37)
+        mech, b = (m, 3.5) if k < 4 else (m2, 3.6)
+        sw = kincas.sweep(mech, {"crank.angle": th}, report=REPORT, guess={"C": (2.5, 1.0)})
+        check(sw, th, b, 1.0)  # (a rough guess: the kernel leaves pose 0 to the careful path)
+        sw["C.x"][:] = np.nan  # the caller's own arrays: nothing kept is touched
+        low = kincas.sweep(mech, {"crank.angle": th}, report=["C.y"], guess={"C": (2.5, -1.0)})
+        C_low = closed_forms.fourbar((0, 0), (4, 0), 1.0, b, 3.0, th, -1)[1].T
+        assert low.ok.all() and np.abs(low["C.y"] - C_low[1]).max() < 1e-12

@@ -134,6 +134,9 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
 
     def careful(k, j, run):
         """Pose k, which the fast pass did not accept, from the last solved pose j."""
+        placed = first(k) if j is None else None  # the first pose: a function of inputs and guess,
+        if placed is not None:                    # solved once per placement (warm calls reuse it)
+            return placed.solved(lambda: careful_pose(model, m, U, p, L, g, k, j, run, events))
         return careful_pose(model, m, U, p, L, g, k, j, run, events)
 
     # The fast pass (compiled, checked pose by pose) solves what it can; every pose it does
