@@ -29,10 +29,11 @@ import math
 
 import numpy as np
 
-from ..core.assembly import Placement, ambiguous, assemble
+from ..core.assembly import ambiguous, assemble
 from ..core.caches import Memo
 from ..core.fast import sweeper_for
 from ..core.guessed import guessed_start
+from ..core.numeric import Solution
 from ..model.mechanism import Mechanism, check_guess
 
 _PLAIN = (float, int, np.float64)  # numbers a guess gives as they are (not bool: not a number)
@@ -129,6 +130,33 @@ class Prepared:
         if q0 is not None and np.all(np.isfinite(q0)):
             return Placement(q0, model.scales(u, self.p)[1])
         return None
+
+
+# --- where a sweep's first pose starts, and its careful answer ---
+
+
+class Placement:
+    """Where the careful path starts Newton for a sweep's first pose: `q0` (the unknowns
+    placed from the guessed points, or assembled group by group without a guess) and `qs`,
+    each unknown's scale in its own group (`Model.scales`), both read-only; `kernel` is
+    left to the fast kernel to keep its state at q0 in (it depends on q0 alone), and `solved`
+    (`first_pose`) keeps the careful path's answer from the same guess at the same inputs,
+    which depends on nothing else (a rough guess makes it a search: 2 ms in 3D)."""
+
+    __slots__ = ("q0", "qs", "kernel", "_solved")
+
+    def __init__(self, q0, qs):
+        self.q0, self.qs, self.kernel, self._solved = q0, qs, None, None
+        q0.flags.writeable = qs.flags.writeable = False
+
+    def solved(self, solve) -> Solution:
+        """`solve()` (the careful path's first pose from this placement's guess and inputs),
+        computed once; each caller gets its own copy of the arrays."""
+        sol = self._solved
+        if sol is None:  # (two threads may both solve it: the same answer, either is kept)
+            sol = self._solved = solve()
+        return Solution(sol.q.copy(), sol.residual, sol.iterations, sol.ok,
+                        None if sol.J is None else sol.J.copy())
 
 
 def prepared(model, m: Mechanism) -> Prepared:

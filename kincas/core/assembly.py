@@ -348,30 +348,6 @@ def refine(model, q, u, p, L):
 # --- the first pose: from the guess, or group by group ---
 
 
-class Placement:
-    """Where the careful path starts Newton for a sweep's first pose: `q0` (the unknowns
-    placed from the guessed points, or assembled group by group without a guess) and `qs`,
-    each unknown's scale in its own group (`Model.scales`), both read-only; `kernel` is
-    left to the fast kernel to keep its state at q0 in (it depends on q0 alone), and `solved`
-    (`first_pose`) keeps the careful path's answer from the same guess at the same inputs,
-    which depends on nothing else (a rough guess makes it a search: 2 ms in 3D)."""
-
-    __slots__ = ("q0", "qs", "kernel", "_solved")
-
-    def __init__(self, q0, qs):
-        self.q0, self.qs, self.kernel, self._solved = q0, qs, None, None
-        q0.flags.writeable = qs.flags.writeable = False
-
-    def solved(self, solve) -> Solution:
-        """`solve()` (the careful path's first pose from this placement's guess and inputs),
-        computed once; each caller gets its own copy of the arrays."""
-        sol = self._solved
-        if sol is None:  # (two threads may both solve it: the same answer, either is kept)
-            sol = self._solved = solve()
-        return Solution(sol.q.copy(), sol.residual, sol.iterations, sol.ok,
-                        None if sol.J is None else sol.J.copy())
-
-
 def no_assembly(model, q) -> Solution:
     return Solution(np.array(q, float), np.inf, 0, False, None)
 

@@ -205,7 +205,7 @@ class FastSweeper(VirtualMachineSweep):
         unknowns or no inputs, every pose goes to `careful`.
 
         `first(k)`, if given, places pose k while no pose is solved yet: a `Placement`
-        (kincas/core/assembly.py) of the unknowns the careful path would start Newton from
+        (kincas/analysis/prepared.py) of the unknowns the careful path would start Newton from
         (the guessed points) and each unknown's scale in its own group, or None. The kernel
         then solves pose k from q0 (`_from_guess`), and the careful path only where the
         kernel's answer is not certainly the careful path's."""
