@@ -60,7 +60,11 @@ class FastRun:
         block[0] = L
         self.L, self.thr, self._state = block[0:1], block[1:6], block[o[1]:o[2]]
         self.Q, self.info = block[o[2]:o[3]].reshape(n, nq), block[o[3]:o[4]].reshape(5, n)
-        self.values, self.measures = block[o[4]:o[5]].reshape(no, n), block[o[5]:o[6]].reshape(nm, n)
+        self.values = block[o[4]:o[5]].reshape(no, n)
+        # the measures pose by pose (the kernel writes one pose's together: a row per measure
+        # of 100,000 poses would be 41 streams of writes on 40 chained four-bars, 1.7 us a
+        # pose), seen as (groups + 1, N)
+        self.measures = block[o[5]:o[6]].reshape(n, nm).T
         self.U = block[o[6]:o[7]].reshape(n, nu)
         self.U[...] = U
         self.Ud = (block[o[7]:o[8]].reshape(-1, nu) if sud else block[o[7]:o[8]], sud)
@@ -102,7 +106,7 @@ class FastRun:
             k = start + lib.kincas_sweep(
                 stop - start, a + 8 * (o[6] + start * nu), a + 8 * o[9], a, a + 8, sw.max_evals, a + 8 * o[1],
                 a + 8 * (o[2] + start * nq), a + 8 * (o[3] + start), self.n, a + 8 * (o[7] + start * sud), sud,
-                a + 8 * (o[8] + start * sudd), sudd, a + 8 * (o[4] + start), a + 8 * (o[5] + start))
+                a + 8 * (o[8] + start * sudd), sudd, a + 8 * (o[4] + start), a + 8 * (o[5] + start * (len(sw.blocks) + 1)))
         else:
             k = sw._vm_advance(self, start, stop, s)
         self.accepted[start:k] = self.solved[start:k] = True
