@@ -186,7 +186,9 @@ def other_benchmarks(quick: bool, deadline: float, log) -> list[tuple[str, str, 
     for i, path in enumerate(scripts):
         takes_quick = "--quick" in path.read_text(encoding="utf-8", errors="replace")
         cmd = [sys.executable, str(path)] + (["--quick"] if quick and takes_quick else [])
-        timeout = max(30.0, (deadline - time.perf_counter()) / (len(scripts) - i))
+        # each script gets its share of what is left, and never less than MIN_SHARE: a loaded
+        # machine that slowed the studies above must not leave the scripts seconds each
+        timeout = max(30.0 if quick else MIN_SHARE, (deadline - time.perf_counter()) / (len(scripts) - i))
         before = {f: f.stat().st_mtime_ns for f in HERE.glob("results_*.md")}
         t0 = time.perf_counter()
         try:
@@ -198,7 +200,7 @@ def other_benchmarks(quick: bool, deadline: float, log) -> list[tuple[str, str, 
             else:
                 text = p.stdout if p.returncode == 0 else "```\n" + (p.stdout + "\n" + p.stderr)[-4000:] + "\n```"
         except subprocess.TimeoutExpired:
-            status, text = f"stopped after {timeout:.0f} s (its share of the time limit)", ""
+            status, text = f"stopped after {timeout:.0f} s (its share of the time limit)", _earlier(path)
         log(f"  {path.name}: {status}")
         out.append((path.name, status, text))
     if quick:
@@ -210,6 +212,18 @@ def other_benchmarks(quick: bool, deadline: float, log) -> list[tuple[str, str, 
     return out
 
 
+def _earlier(script: Path) -> str:
+    """A stopped script's report from an earlier run (bench_X.py writes results_X.md), said so
+    with the commit that last changed it; "" where there is none."""
+    f = HERE / ("results_" + script.stem.removeprefix("bench_") + ".md")
+    if not f.exists():
+        return ""
+    commit = subprocess.run(["git", "-C", str(ROOT), "log", "-1", "--format=%h, %cs", "--", str(f)],
+                            capture_output=True, text=True).stdout.strip() or "not committed"
+    return (f"*Not measured in this run: the script was stopped. Its report from an earlier run "
+            f"({f.name}, commit {commit}) follows.*\n\n" + _demote(f.read_text(encoding="utf-8")))
+
+
 def _demote(md_text: str) -> str:
     """Headings three levels down, so that a script's report nests under its own heading."""
     return "\n".join("###" + ln if ln.startswith("#") else ln for ln in md_text.splitlines())
@@ -217,6 +231,8 @@ def _demote(md_text: str) -> str:
 
 # --- the whole run ---
 
+
+MIN_SHARE = 240.0  # seconds every other bench_*.py script gets at least (full run)
 
 CONFIG = {
     "full": {"n": 720, "repeats": 5, "n_stiff": 360, "chain": [1, 2, 5, 10, 20, 40], "chain_poses": 100,
