@@ -11,11 +11,14 @@ equations hang on (their values, Newton steps dz_B and tangents T_z):
     tangent      T_B  = -A^-1 (g_B,u + C T_z)
 
 which is the block forward substitution of `kincas.core.blocks.block_solve`, so kN and kF
-compute the same numbers as the flat expressions (to rounding). Groups whose functions are
-the same expression up to the numbering of their inputs (every four-bar of a chain but the
-first) share one casadi function, code-generated once and called for each of them; kN and kF
-are then small MX functions that route vectors between those calls. The reported quantities
-are their own function (flat: a point far down a chain needs the whole chain's velocities).
+compute the same numbers as the flat expressions (to rounding). The functions take runs of
+`per` consecutive groups (kincas/core/kernel.py: GROUP_RUN), with the flat kernel's
+arithmetic within a run: each angle's sine and cosine once, no call between its groups.
+Runs whose functions are the same expression up to the numbering of their inputs (every run
+of four-bars of a chain but the first) share one casadi function, code-generated once and
+called for each of them; kN and kF are then small MX functions that route vectors between
+those calls. The reported quantities are their own function (flat: a point far down a
+chain needs the whole chain's velocities).
 
 >>> import kincas
 >>> links = [kincas.Link.bar("crank", "O", "A", 1)]
