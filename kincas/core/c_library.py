@@ -1,7 +1,8 @@
 """Compiled libraries built and cached on disk: casadi functions code-generated with a C loop.
 
 `Library` code-generates casadi functions together with a hand-written C driver that calls
-them, pairs each angle's sine and cosine into one call (`pair_sincos`), compiles the whole
+them, pairs each angle's sine and cosine into one call (`pair_sincos`), keeps max and min
+inline (`inline_minmax`), compiles the whole
 with the C compiler ($CC, else gcc or cc) and keeps the result in the cache directory
 (`cache_dir`) under a hash of its source, the compiler, its flags and casadi's version: a
 second process, or a second run, loads it without compiling. The cache keeps the MAX_CACHED
@@ -85,7 +86,7 @@ class Library:
         work = {"SZ_ARG": [f.sz_arg() for f in functions], "SZ_RES": [f.sz_res() for f in functions],
                 "SZ_IW": [f.sz_iw() for f in functions], "SZ_W": [f.sz_w() for f in functions]}
         defines = {**{k: max([1, *v]) for k, v in work.items()}, **defines}
-        self.source = (_PRELUDE + pair_sincos(cg.dump())
+        self.source = (_PRELUDE + inline_minmax(pair_sincos(cg.dump()))
                        + "".join(f"#define {k} {v}\n" for k, v in defines.items()) + driver)
         self.cc = os.environ.get("CC") or shutil.which("gcc") or shutil.which("cc")
         key = hashlib.sha256("\n".join([self.source, str(self.cc), *_FLAGS, ca.__version__]).encode())
@@ -262,6 +263,10 @@ _PRELUDE = """#define _GNU_SOURCE
 #else
 #define kincas_sincos(x, s, c) (*(s) = sin(x), *(c) = cos(x))
 #endif
+/* C99's fmax and fmin (a NaN argument gives the other one), written out so that they stay
+   inline: libm's are calls, and every call spills the live registers */
+static inline double kincas_fmax(double x, double y) { return x != x ? y : y != y ? x : x > y ? x : y; }
+static inline double kincas_fmin(double x, double y) { return x != x ? y : y != y ? x : x < y ? x : y; }
 """
 _TRIG = re.compile(r"^(\s*)(a\w+)=(sin|cos)\((a\w+)\);$")
 
@@ -295,6 +300,21 @@ def pair_sincos(source: str) -> str:
             if "{" in lines[j] or "}" in lines[j] or re.match(rf"^\s*{a}=", lines[j]):
                 break
     return "\n".join(lines)
+
+
+def inline_minmax(source: str) -> str:
+    """Casadi's `casadi_fmax` and `casadi_fmin` helpers calling the prelude's inline
+    `kincas_fmax` / `kincas_fmin` instead of libm's `fmax` / `fmin`: the same values (C99's
+    rule: a NaN argument gives the other one; only the sign of a zero maximum may differ,
+    and every comparison treats -0 as 0), without a library call per maximum. The kernel's
+    residual and step tests take a maximum per equation and unknown: as calls they cost a
+    fifth of a chained mechanism's pose (the call clobbers every floating-point register).
+
+    >>> inline_minmax("  return fmax(x, y);")
+    '  return kincas_fmax(x, y);'
+    """
+    return source.replace("return fmax(x, y);", "return kincas_fmax(x, y);").replace(
+        "return fmin(x, y);", "return kincas_fmin(x, y);")
 
 
 def _prune(folder: Path) -> None:

@@ -61,8 +61,12 @@ class FastRun:
         block[:6] = _HEAD  # the thresholds, then L in its place
         block[0] = L
         self._state, self.Q = block[o[1]:o[2]], block[o[2]:o[3]].reshape(n, nq)
-        per_pose = block[o[3]:o[6]].reshape(5 + no + nm, n)  # info, values, measures: one table
-        self.info, self.values, self.measures = per_pose[:5], per_pose[5:5 + no], per_pose[5 + no:]
+        per_pose = block[o[3]:o[5]].reshape(5 + no, n)  # info, values: one table
+        self.info, self.values = per_pose[:5], per_pose[5:]
+        # the measures pose by pose (the kernel writes one pose's together: a row per measure
+        # of 100,000 poses would be 41 streams of writes on 40 chained four-bars, 1.7 us a
+        # pose), seen as (groups + 1, N)
+        self.measures = block[o[5]:o[6]].reshape(n, nm).T
         # the inputs and parameters copied in by one call (views of them made when asked)
         np.concatenate((U.ravel(), Ud.ravel(), Udd.ravel(), p), out=block[o[6]:])
         self._sud, self._sudd, self._U, self._Ud, self._Udd, self._p = sud, sudd, None, None, None, None
@@ -131,7 +135,7 @@ class FastRun:
             k = start + lib.kincas_sweep(
                 stop - start, a + 8 * (o[6] + start * nu), a + 8 * o[9], a, a + 8, sw.max_evals, a + 8 * o[1],
                 a + 8 * (o[2] + start * nq), a + 8 * (o[3] + start), self.n, a + 8 * (o[7] + start * sud), sud,
-                a + 8 * (o[8] + start * sudd), sudd, a + 8 * (o[4] + start), a + 8 * (o[5] + start))
+                a + 8 * (o[8] + start * sudd), sudd, a + 8 * (o[4] + start), a + 8 * (o[5] + start * (len(sw.blocks) + 1)))
         else:
             k = sw._vm_advance(self, start, stop, s)
         self.accepted[start:k] = self.solved[start:k] = True

@@ -11,11 +11,14 @@ equations hang on (their values, Newton steps dz_B and tangents T_z):
     tangent      T_B  = -A^-1 (g_B,u + C T_z)
 
 which is the block forward substitution of `kincas.core.blocks.block_solve`, so kN and kF
-compute the same numbers as the flat expressions (to rounding). Groups whose functions are
-the same expression up to the numbering of their inputs (every four-bar of a chain but the
-first) share one casadi function, code-generated once and called for each of them; kN and kF
-are then small MX functions that route vectors between those calls. The reported quantities
-are their own function (flat: a point far down a chain needs the whole chain's velocities).
+compute the same numbers as the flat expressions (to rounding). The functions take runs of
+`per` consecutive groups (kincas/core/kernel.py: GROUP_RUN), with the flat kernel's
+arithmetic within a run: each angle's sine and cosine once, no call between its groups.
+Runs whose functions are the same expression up to the numbering of their inputs (every run
+of four-bars of a chain but the first) share one casadi function, code-generated once and
+called for each of them; kN and kF are then small MX functions that route vectors between
+those calls. The reported quantities are their own function (flat: a point far down a
+chain needs the whole chain's velocities).
 
 >>> import kincas
 >>> links = [kincas.Link.bar("crank", "O", "A", 1)]
@@ -34,7 +37,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-from .blocks import _small_solve, block_measures
+from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size
 from .structure import Block
 
 OPTS = {"cse": True}  # one sin and cos per angle within a group's function
@@ -46,13 +49,19 @@ def _max_abs(v):
 
 
 class _Group:
-    """One group's inputs: own unknowns `cols`, the earlier unknowns `hang` its equations
-    use, the parameters `params` they use; its residual g in local symbols (x, z, u, p)
-    with its numeric constants lifted into one more symbol c (`values` holds them), and
-    `key`: equal for groups that differ only in those constants."""
+    """A run of consecutive Assur groups solved by one function: own unknowns `cols` (the
+    groups' in solve order), the earlier unknowns `hang` their equations use, the parameters
+    `params` they use, the groups in the run's own numbering (`local`); its residual g in
+    local symbols (x, z, u, p) with its numeric constants lifted into one more symbol c
+    (`values` holds them), and `key`: equal for runs that differ only in those constants."""
 
-    def __init__(self, sym, blk: Block):
-        self.cols, rows = [int(j) for j in blk.cols], [int(i) for i in blk.rows]
+    def __init__(self, sym, blks: list[Block]):
+        self.cols = [int(j) for b in blks for j in b.cols]
+        rows = [int(i) for b in blks for i in b.rows]
+        self.local, r0, c0 = [], 0, 0
+        for b in blks:
+            self.local.append(Block(np.arange(r0, r0 + len(b.rows)), np.arange(c0, c0 + len(b.cols)), ()))
+            r0, c0 = r0 + len(b.rows), c0 + len(b.cols)
         gB = sym.g[rows]
         own = set(self.cols)
         used = sorted({int(c) for c in ca.jacobian(gB, sym.q).sparsity().get_col()})
@@ -74,21 +83,25 @@ class _Group:
         g = ca.substitute([gB], [old[k] for k in keep], [new[k] for k in keep])[0]
         shape, self.values = _lift_constants(ca.Function("g", [x, z, u, p], [g]))
         self.is_length = sym.is_length[self.cols]
-        self.key = (shape.serialize(), tuple(self.is_length))
+        layout = tuple((len(b.rows), len(b.cols)) for b in blks)
+        self.key = (shape.serialize(), tuple(self.is_length), layout)
         self.x, self.z, self.u, self.p, self.c = shape.sx_in()
         self.g = shape.call(shape.sx_in())[0]
+        self.nj = diagonal_size(self.local)
 
 
 class GroupFunctions:
-    """Per group, the casadi functions of its Newton step and final evaluation, one per kind.
+    """Per run of `per` consecutive groups, the casadi functions of its Newton step and final
+    evaluation, one per kind of run. Within a run the arithmetic is the flat kernel's (one
+    sine and cosine per angle, the block forward substitution); between runs, MX calls.
 
-    `newton_kinds` / `final_kinds`: the distinct functions; `kind[i]`: group i's index in
-    them. A kind is called with group i's inputs (`groups[i]`) and then its constants
+    `newton_kinds` / `final_kinds`: the distinct functions; `kind[i]`: run i's index in
+    them. A kind is called with run i's inputs (`groups[i]`) and then its constants
     (`groups[i].values`)."""
 
-    def __init__(self, sym, blocks):
+    def __init__(self, sym, blocks, per: int = 1):
         self.sym, self.blocks = sym, blocks
-        self.groups = [_Group(sym, b) for b in blocks]
+        self.groups = [_Group(sym, blocks[i:i + per]) for i in range(0, len(blocks), per)]
         self.newton_kinds, self.final_kinds, self.kind, seen = [], [], [], {}
         for grp in self.groups:
             if grp.key not in seen:
@@ -98,38 +111,43 @@ class GroupFunctions:
             self.kind.append(seen[grp.key])
 
     @staticmethod
+    def _scales(grp, Lb):
+        """(D, Lg): each unknown's scale (its group's length, or 1 for an angle) and each
+        equation's group length."""
+        Lq, Lg = group_scales(Lb, grp.local, grp.x.numel(), grp.g.numel())
+        return ca.if_else(ca.DM(grp.is_length.astype(float)), Lq, 1), Lg
+
+    @staticmethod
     def _newton(grp, name):
         """(x, z, dz, u, p, Lb, c) -> (dx, [max |g| / Lb, max |dx / D|])."""
-        dz, Lb = ca.SX.sym("dz", grp.z.numel()), ca.SX.sym("Lb")
+        dz, Lb = ca.SX.sym("dz", grp.z.numel()), ca.SX.sym("Lb", len(grp.local))
         A, C = ca.jacobian(grp.g, grp.x), ca.jacobian(grp.g, grp.z)
-        D = ca.if_else(ca.DM(grp.is_length.astype(float)), Lb, 1)
+        D, Lg = GroupFunctions._scales(grp, Lb)
         rhs = grp.g - ca.mtimes(C, dz) if grp.z.numel() else grp.g
-        dx = _small_solve(A, rhs)
-        rs = ca.vertcat(_max_abs(grp.g / Lb), _max_abs(dx / D))
+        dx = block_solve(A, rhs, grp.local)
+        rs = ca.vertcat(_max_abs(grp.g / Lg), _max_abs(dx / D))
         return ca.Function(name, [grp.x, grp.z, dz, grp.u, grp.p, Lb, grp.c], [ca.densify(dx), rs], OPTS)
 
     @staticmethod
     def _final(grp, name):
         """(x, z, dz, Tz, u, p, Lb, L, A0, xp, c) -> (A, T, rs, [change, correction],
-        [sign, sigma], dx): kF's measures for this group."""
+        [sign per group, sigma], dx): kF's measures for this run."""
         n, m, nu = grp.x.numel(), grp.z.numel(), grp.u.numel()
-        dz, Tz, Lb, L = ca.SX.sym("dz", m), ca.SX.sym("Tz", m, nu), ca.SX.sym("Lb"), ca.SX.sym("L")
-        A0, xp = ca.SX.sym("A0", n * n), ca.SX.sym("xp", n)
+        dz, Tz, Lb, L = ca.SX.sym("dz", m), ca.SX.sym("Tz", m, nu), ca.SX.sym("Lb", len(grp.local)), ca.SX.sym("L")
+        A0, xp = ca.SX.sym("A0", grp.nj), ca.SX.sym("xp", n)
         A, C = ca.jacobian(grp.g, grp.x), ca.jacobian(grp.g, grp.z)
         Gu = ca.jacobian(grp.g, grp.u)
-        isl = ca.DM(grp.is_length.astype(float))
-        D = ca.if_else(isl, Lb, 1)
-        cs = ca.if_else(isl, 1, 1 / L)  # columns to O(1): 1 (lengths), 1/L (angles)
-        dx = _small_solve(A, grp.g - ca.mtimes(C, dz) if m else grp.g)
-        T = -_small_solve(A, Gu + ca.mtimes(C, Tz) if m else Gu)
-        rs = ca.vertcat(_max_abs(grp.g / Lb), _max_abs(dx / D))
-        M = (_small_solve(ca.reshape(A0, n, n), A) - ca.DM.eye(n)) * ca.repmat(D.T, n, 1) / ca.repmat(D, 1, n)
-        change = ca.sum1(ca.sum2(ca.fabs(M)))
-        corr = ca.sum1(ca.fabs((grp.x - xp) / D))
-        sign, sigma = block_measures(A, cs, [Block(np.arange(n), np.arange(n), ())])
+        D, Lg = GroupFunctions._scales(grp, Lb)
+        cs = ca.if_else(ca.DM(grp.is_length.astype(float)), 1, 1 / L)  # columns to O(1): 1 (lengths), 1/L (angles)
+        dx = block_solve(A, grp.g - ca.mtimes(C, dz) if m else grp.g, grp.local)
+        T = -block_solve(A, Gu + ca.mtimes(C, Tz) if m else Gu, grp.local)
+        rs = ca.vertcat(_max_abs(grp.g / Lg), _max_abs(dx / D))
+        change = block_change(A0, A, D, grp.local)
+        corr = group_correction((grp.x - xp) / D, grp.local)
+        signs, sigma = block_measures(A, cs, grp.local)
         return ca.Function(name, [grp.x, grp.z, dz, Tz, grp.u, grp.p, Lb, L, A0, xp, grp.c],
-                           [ca.densify(ca.vec(A)), ca.densify(T), rs, ca.vertcat(change, corr),
-                            ca.vertcat(sign, sigma), ca.densify(dx)], OPTS)
+                           [diagonal_blocks(A, grp.local), ca.densify(T), rs, ca.vertcat(change, corr),
+                            ca.vertcat(signs, sigma), ca.densify(dx)], OPTS)
 
     # --- kN and kF: MX functions routing vectors between the groups' calls ---
     def kernel(self, report_function):
@@ -142,10 +160,12 @@ class GroupFunctions:
         pick = lambda v, idx: v[idx] if idx else ca.MX(0, 1)
         rows = lambda parts, idx: ca.vertcat(*[parts[j] for j in idx]) if idx else ca.MX(0, 1)
         # kN
-        dxs, r = [None] * nq, []
-        for i, (grp, kd) in enumerate(zip(self.groups, self.kind)):
-            f, c = self.newton_kinds[kd], ca.DM(grp.values)
-            dx, rs = f(pick(q, grp.cols), pick(q, grp.hang), rows(dxs, grp.hang), u, pick(p, grp.params), Lb[i], c)
+        dxs, r, b0 = [None] * nq, [], 0
+        for grp, kd in zip(self.groups, self.kind):
+            f, c, nb = self.newton_kinds[kd], ca.DM(grp.values), len(grp.local)
+            dx, rs = f(pick(q, grp.cols), pick(q, grp.hang), rows(dxs, grp.hang), u, pick(p, grp.params),
+                       Lb[b0:b0 + nb], c)
+            b0 += nb
             for k, j in enumerate(grp.cols):
                 dxs[j] = dx[k]
             r.append(rs)
@@ -153,22 +173,22 @@ class GroupFunctions:
         rs = _max_rows(r)
         kN = ca.Function("kN", [q, u, p, Lb], [step, rs])
         # kF
-        dxs, Ts, r, A, ch, co, sg, sig, at = [None] * nq, [None] * nq, [], [], [], [], [], [], 0
-        for i, (grp, kd) in enumerate(zip(self.groups, self.kind)):
-            f, c = self.final_kinds[kd], ca.DM(grp.values)
-            n = len(grp.cols)
+        dxs, Ts, r, A, ch, co, sg, sig, at, b0 = [None] * nq, [None] * nq, [], [], [], [], [], [], 0, 0
+        for grp, kd in zip(self.groups, self.kind):
+            f, c, nb = self.final_kinds[kd], ca.DM(grp.values), len(grp.local)
             Tz = ca.vertcat(*[Ts[j] for j in grp.hang]) if grp.hang else ca.MX(0, nu)
             a, T, rs, mc, ms, dx = f(pick(q, grp.cols), pick(q, grp.hang), rows(dxs, grp.hang), Tz, u,
-                                     pick(p, grp.params), Lb[i], L, J0[at:at + n * n], pick(qp, grp.cols), c)
-            at += n * n
+                                     pick(p, grp.params), Lb[b0:b0 + nb], L, J0[at:at + grp.nj],
+                                     pick(qp, grp.cols), c)
+            at, b0 = at + grp.nj, b0 + nb
             for k, j in enumerate(grp.cols):
                 dxs[j], Ts[j] = dx[k], T[k, :]
             r.append(rs)
             A.append(a)
             ch.append(mc[0])
             co.append(mc[1])
-            sg.append(ms[0])
-            sig.append(ms[1])
+            sg.extend(ca.vertsplit(ms[:nb]))
+            sig.append(ms[nb])
         step = ca.vertcat(*dxs) if nq else ca.MX(0, 1)
         T = ca.vertcat(*Ts) if nq else ca.MX(0, nu)
         # q' = (dq/du) u' from the tangent just computed: no solve through the chain again
@@ -214,6 +234,25 @@ def kernel_sizes(functions) -> tuple[int, int]:
         return code, work
     out = [count(f) for f in functions]
     return sum(c for c, _ in out), sum(w for _, w in out)
+
+
+def group_scales(Lb, blocks, nq, ng):
+    """(per unknown, per equation) the length of the group it belongs to."""
+    Lq, Lg = [ca.SX(1)] * nq, [ca.SX(1)] * ng
+    for i, b in enumerate(blocks):
+        for j in b.cols:
+            Lq[int(j)] = Lb[i]
+        for r in b.rows:
+            Lg[int(r)] = Lb[i]
+    return ca.vertcat(*Lq) if nq else ca.SX(0, 1), ca.vertcat(*Lg) if ng else ca.SX(0, 1)
+
+
+def group_correction(dx, blocks):
+    """max over the Assur groups of ||D^-1 (q - q_pred)||_1 restricted to the group: each
+    group's Newton wanders on its own (the system is block triangular), so the bound is per
+    group, and a chain of 40 groups is held to what one group is."""
+    parts = [ca.norm_1(dx[[int(c) for c in b.cols]]) for b in blocks if len(b.cols)]
+    return ca.mmax(ca.vertcat(*parts)) if parts else ca.SX(0)
 
 
 def _max_rows(parts):

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import casadi as ca
 
-from .group_kernel import GroupFunctions, _max_abs
+from .group_kernel import GroupFunctions, _max_abs, group_correction, group_scales
 from .structure import Structure
 from ..model.names import parse_quantity
 from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size, is_tall
@@ -40,12 +40,16 @@ RESIDUAL = ACCEPT  # max |g| / L at an accepted pose, as on the careful path
 # largest entry, not a sum, so that rounding in a long chain of groups does not add up past it
 STEP = TOL
 # JAC_CHANGE, CORRECTION, MAX_EVALS and KERNEL_NEAR: kincas/core/tolerances.py
-# From this many groups on, kN and kF call one small function per kind of group
-# (kincas/core/group_kernel.py) instead of being one expression. Measured on 40 chained
-# four-bars: gcc -O3 takes 1.6 s of CPU instead of 6.3, a pose 7.4 us instead of 5.0 (the
-# calls and copies between groups, and no sine shared across groups); below about 16 groups
-# the flat kernel compiles in well under 2 s, and runs faster.
+# From this many groups on, kN and kF call one small function per kind of run of GROUP_RUN
+# consecutive groups (kincas/core/group_kernel.py) instead of being one expression: the C
+# compiler's time grows faster than the size of one function (gcc -O3 on 40 chained
+# four-bars, flat: 6.3 s of CPU against 1.6 s). Within a run the arithmetic is the flat
+# kernel's (one sine and cosine per angle); between runs, calls and copies. Measured on 40
+# chained four-bars, 3,600 poses, kernel only, interleaved (bit-identical results): runs of
+# 1 group 4.9 us a pose, 4 groups 4.0, 8 groups 4.0, 20 groups 4.1, flat 4.0; compiled in
+# 7.5 s (4 groups), 8.8 s (1) and 23 s (flat) of a loaded machine's wall clock.
 GROUPS_APART = 16
+GROUP_RUN = 4  # consecutive groups per function written group by group (measured above)
 
 
 # --- the casadi functions ---
@@ -83,10 +87,10 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
         # one small function per kind of group, the quantities apart
         qd = ca.SX.sym("qd", nq)
         kY = ca.Function("kY", [q, u, p, ud, udd, qd], [ca.densify(given((q, u, p, ud, udd), qd))], o) if report else None
-        return [kP, *GroupFunctions(sym, blocks).kernel(kY), kL]
+        return [kP, *GroupFunctions(sym, blocks, GROUP_RUN).kernel(kY), kL]
     Lb = ca.SX.sym("Lb", len(blocks))  # each group's length
     is_length = ca.DM(sym.is_length.astype(float))
-    Lq, Lg = _group_scales(Lb, blocks, sym.nq, sym.ng)
+    Lq, Lg = group_scales(Lb, blocks, sym.nq, sym.ng)
     D = ca.if_else(is_length, Lq, 1)  # the scale of each unknown: its group's length or 1
     cs = ca.if_else(is_length, 1, 1 / L)  # g_q's columns to O(1): 1 (lengths), 1/L (angles)
     g, Jq, Ju = ca.Function("G", [sym.q, sym.u, sym.p], [sym.g, sym.Jq, sym.Ju])(q, u, p)
@@ -98,7 +102,7 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
     change = block_change(J0, Jq, D, blocks, cs if tall else None)
     signs, sigma = block_measures(Jq, cs, blocks)
     kF = ca.Function("kF", [q, u, p, L, ud, udd, J0, qp, Lb],
-                     [diagonal_blocks(Jq, blocks), d(T), rs, ca.vertcat(change, _group_correction((q - qp) / D, blocks)),
+                     [diagonal_blocks(Jq, blocks), d(T), rs, ca.vertcat(change, group_correction((q - qp) / D, blocks)),
                       ca.vertcat(signs, sigma), y, d(step), *((Jq, D) if tall else ())], o)
     if tall:
         kF = _exact_where_needed(kF, blocks)
@@ -122,17 +126,6 @@ def _exact_where_needed(kF, blocks) -> ca.Function:
     bound, corr = outs[3][0], outs[3][1]  # index 0 (the bound above JAC_CHANGE, or NaN): exact
     outs[3] = ca.vertcat(change(bound <= JAC_CHANGE, bound, ins[6], Jq, D), corr)
     return ca.Function("kF", ins, outs)
-
-
-def _group_scales(Lb, blocks, nq, ng):
-    """(per unknown, per equation) the length of the group it belongs to."""
-    Lq, Lg = [ca.SX(1)] * nq, [ca.SX(1)] * ng
-    for i, b in enumerate(blocks):
-        for j in b.cols:
-            Lq[int(j)] = Lb[i]
-        for r in b.rows:
-            Lg[int(r)] = Lb[i]
-    return ca.vertcat(*Lq) if nq else ca.SX(0, 1), ca.vertcat(*Lg) if ng else ca.SX(0, 1)
 
 
 def state_function(sym, blocks) -> ca.Function:
@@ -230,14 +223,6 @@ def _expanded(f: ca.Function) -> ca.Function:
         return f
 
 
-def _group_correction(dx, blocks):
-    """max over the Assur groups of ||D^-1 (q - q_pred)||_1 restricted to the group: each
-    group's Newton wanders on its own (the system is block triangular), so the bound is per
-    group, and a chain of 40 groups is held to what one group is."""
-    parts = [ca.norm_1(dx[[int(c) for c in b.cols]]) for b in blocks if len(b.cols)]
-    return ca.mmax(ca.vertcat(*parts)) if parts else ca.SX(0)
-
-
 # --- the C loop around them (NQ, NU, NO, NM, NJ: sizes, NM - 1 groups; state s = q, g_q's
 # diagonal blocks, T = dq/du, u at the last pose, then T and u at the one before; matrices
 # column-major; L the whole mechanism's length, for the singular measures' column scale) ---
@@ -285,7 +270,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     if (conv) for (i = 0; i < NQ; ++i) q[i] -= dq[i];
     for (i = 0; i < NQ; ++i) Q[k*NQ + i] = q[i];
     for (i = 0; i < NO; ++i) vals[i*ld + k] = y[i];  /* one contiguous row per quantity */
-    if (meas) for (i = 0; i < NM; ++i) meas[i*ld + k] = ms[i];
+    if (meas) for (i = 0; i < NM; ++i) meas[k*NM + i] = ms[i];  /* one pose's measures together */
     info[k] = rf[0]; info[ld + k] = rf[1]; info[2*ld + k] = mc[0]; info[3*ld + k] = mc[1];
     info[4*ld + k] = (casadi_real) it;
     if (!(conv && mc[0] <= thr[2] && mc[1] <= thr[3])) break;
