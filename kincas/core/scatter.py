@@ -39,20 +39,13 @@ def _step_function(model) -> ca.Function:
         if sym.ng > sym.nq:  # a tall consistent system (redundant joints: Bennett, a double
             # Cardan): the Gauss-Newton step, each equation over its scale, which is Newton's
             # step wherever the equations are consistent and g_q has full column rank. The
-            # normal matrix is dense: solved numerically (MX, a QR at evaluation), not as an
-            # expression (a symbolic 21 x 21 solve made each call of 512 starts 0.24 s)
+            # normal matrix is dense: this function gives it, and numpy solves it for every
+            # start at once (a symbolic 21 x 21 solve made each call of 512 starts 0.24 s; a
+            # numeric solver inside casadi failed the whole call at one start's singular matrix)
             Js, gs = sym.Jq / ca.repmat(eq, 1, sym.nq), sym.g / eq
-            normal = ca.Function("normal", [sym.q, sym.u, sym.p, eq],
-                                 [ca.mtimes(Js.T, Js), ca.mtimes(Js.T, gs), sym.g / eq])
-            q, u, p = (ca.MX.sym(nm, x.shape[0]) for nm, x in (("q", sym.q), ("u", sym.u), ("p", sym.p)))
-            eqm, qsm = ca.MX.sym("eq", sym.ng), ca.MX.sym("qs", sym.nq)
-            A, b, g = normal(q, u, p, eqm)
-            dq = -ca.solve(A, b, "qr")
-            size = ca.mmax(ca.fabs(dq) / qsm)
-            shrink = ca.fmax(1, size / MAX_STEP)
-            return ca.Function("newton_step", [q, u, p, eqm, qsm], [q + dq / shrink, ca.mmax(ca.fabs(g)), size])
-        else:
-            dq = -ca.solve(sym.Jq, sym.g)
+            return ca.Function("normal", [sym.q, sym.u, sym.p, eq, qs],
+                               [ca.mtimes(Js.T, Js), ca.mtimes(Js.T, gs), ca.mmax(ca.fabs(gs))])
+        dq = -ca.solve(sym.Jq, sym.g)
         size = ca.mmax(ca.fabs(dq) / qs) if sym.nq else ca.SX(0)
         shrink = ca.fmax(1, size / MAX_STEP)
         r = ca.mmax(ca.fabs(sym.g / eq)) if sym.nq else ca.SX(0)
@@ -87,6 +80,8 @@ def newton_starts(model, Q, u, p, iterations: int):
     if model.nq == 0:
         return Q, np.full(n, np.abs(model.residual(np.zeros(0), u, p) / eq).max(initial=0.0))
     step = _step_function(model).map(n)
+    if model.sym.ng > model.sym.nq:
+        step = _gauss_newton(step, model.sym.nq, n)
     U, P = np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)
     X, last, live = Q.T.copy(), np.full(n, np.inf), np.ones(n, dtype=bool)
     for _ in range(iterations):
@@ -102,3 +97,28 @@ def newton_starts(model, Q, u, p, iterations: int):
     r = np.asarray(step(X, U, P, eq, qs)[1]).ravel()  # at the iterates returned
     r = np.where(np.all(np.isfinite(X), axis=0), r, np.nan)
     return X.T, r
+
+
+def _gauss_newton(normal, nq: int, n: int):
+    """The step function of a tall system from its mapped normal equations: (X, U, P, eq, qs)
+    -> (X after one shortened Gauss-Newton step, relative residual, step size), as
+    `_step_function` gives a square system's. Each start's (J'J) dq = -J'g solved by numpy at
+    once; a start whose normal matrix is singular (or not finite) gets a NaN step: dropped."""
+    def step(X, U, P, eq, qs):
+        A, b, r = (np.asarray(v) for v in normal(X, U, P, eq, qs))
+        A = A.reshape(nq, n, nq).transpose(1, 0, 2)  # (start, row, column)
+        b = b.T[:, :, None]
+        try:
+            dq = -np.linalg.solve(A, b)[:, :, 0]
+        except np.linalg.LinAlgError:  # one start's matrix is singular: each on its own
+            dq = np.full((n, nq), np.nan)
+            for k in range(n):
+                try:
+                    dq[k] = -np.linalg.solve(A[k], b[k])[:, 0]
+                except np.linalg.LinAlgError:
+                    pass
+        qsv = np.asarray(qs, float).ravel()
+        size = np.max(np.abs(dq) / qsv, axis=1) if nq else np.zeros(n)
+        shrink = np.fmax(1.0, size / MAX_STEP)
+        return X + (dq / shrink[:, None]).T, r, size
+    return step
