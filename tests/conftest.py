@@ -4,10 +4,18 @@ from __future__ import annotations
 import json
 import math
 import re
+import signal
 import sys
 from pathlib import Path
 
 import numpy as np
+
+# A test runner started in the background by a shell without job control (`cmd &` in a script)
+# inherits SIGINT ignored, and so would every process it starts: the Ctrl-C tests (they send
+# SIGINT to kincas commands and to this process) need Python's own handler, which an exec'd
+# child then gets back as the default disposition.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 TESTS = Path(__file__).resolve().parent
 ROOT = TESTS.parent
