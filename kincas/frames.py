@@ -25,7 +25,7 @@ import importlib
 
 import numpy as np
 
-from .model.names import derivative_order
+from .model.names import attr_base, derivative_order
 from .result_base import Result
 
 
@@ -54,7 +54,7 @@ def unit_of(name: str, length: str = "", angle: str = "rad", time: str = "s") ->
     order = derivative_order(attr) if attr else None
     if order is None:
         return length if "." not in name else ""  # a parameter driven by an input: a length
-    angular = attr.rstrip("0123456789").split("_")[0] in ("angle", "omega", "alpha", "jerk")
+    angular = attr_base(attr) in ("angle", "omega", "alpha", "jerk")
     base = angle if angular else length
     if not base:
         return ""

@@ -38,6 +38,16 @@ _ORDERS = {**dict.fromkeys(("x", "y", "z", "s", "angle"), 0), **dict.fromkeys(("
 _ROTATION = re.compile(r"^(q[wxyz]|R[123][123])$")
 
 
+def attr_base(attr: str) -> str:
+    """A quantity attribute without its axis or coordinate number: `omega_x` -> `omega`,
+    `alpha2` -> `alpha`, `vz` -> `vz` (2D and 3D names read alike).
+
+    >>> attr_base("omega_x"), attr_base("alpha2"), attr_base("vz")
+    ('omega', 'alpha', 'vz')
+    """
+    return attr.rstrip("0123456789").split("_")[0]
+
+
 def derivative_order(attr: str) -> int | None:
     """How many times a quantity's attribute is differentiated in time: 0 for a position, an
     angle or a coordinate, 1 for a rate, 2 an acceleration, 3 a jerk; None where it has no
@@ -47,8 +57,7 @@ def derivative_order(attr: str) -> int | None:
     >>> [derivative_order(a) for a in ("x", "vz", "omega_x", "alpha2", "jerk", "a1", "R11")]
     [0, 1, 1, 2, 3, 2, None]
     """
-    base = attr.rstrip("0123456789").split("_")[0]
-    return _ORDERS.get(base)
+    return _ORDERS.get(attr_base(attr))
 
 
 def is_rotation_entry(attr: str) -> bool:

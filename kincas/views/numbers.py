@@ -36,7 +36,7 @@ def snap(v, scale: float) -> np.ndarray:
 def scale_of(name: str, scene, sweep) -> float:
     """The natural scale of quantity `name` in the scene's units (0 when unknown: then only
     the column's own largest value sets it)."""
-    from ..model.names import derivative_order, parse_quantity
+    from ..model.names import attr_base, derivative_order, parse_quantity
     try:
         kind, obj, attr = parse_quantity(name)
     except Exception:  # a quantity kind this module does not know
@@ -47,7 +47,7 @@ def scale_of(name: str, scene, sweep) -> float:
     order = derivative_order(attr)
     if order is None or order > 2:
         return 0.0
-    angular = attr.rstrip("0123456789").split("_")[0] in ("angle", "omega", "alpha")
+    angular = attr_base(attr) in ("angle", "omega", "alpha")
     base = (180 / math.pi if scene.study.deg else 1.0) if angular else L
     w, a = _input_rates(scene, sweep, L)
     return base * (1.0, w, w * w + a)[order]
