@@ -92,9 +92,13 @@ class SpatialSymbolic(Symbolic):
         # coordinates relative to the first ground point: far from the global origin, the
         # residuals (differences of nearby points) and the steps keep their relative accuracy
         self.origin = self._xyz(m.ground[0][1]) if m.ground else [ca.SX(0)] * 3
-        self.points = {g: self._rel(xyz) for g, xyz in m.ground}
-        self.frames = {GROUND: ([ca.SX(0)] * 3, [ca.SX(c) for c in IDENTITY], [ca.SX(0)] * 3)}
         exempt = m.exempt()
+        # a ground point that is the point of a cylindrical, prismatic or planar joint with the
+        # ground first marks where the line or plane is drawn; the point itself is the second
+        # body's (it slides), so the ground's copy does not hold it
+        self._ground = {g: self._rel(xyz) for g, xyz in m.ground}
+        self.points = {g: v for g, v in self._ground.items() if (g, GROUND) not in exempt}
+        self.frames = {GROUND: ([ca.SX(0)] * 3, [ca.SX(c) for c in IDENTITY], [ca.SX(0)] * 3)}
         for b in m.bodies:
             if b.two_point:
                 continue
@@ -143,7 +147,12 @@ class SpatialSymbolic(Symbolic):
                 eqs.append(self._input_equation(i.target, u))
         self.angles = {}
         self.points = {k: [v[i] + self.origin[i] for i in range(3)] for k, v in self.points.items()}
+        self._ground = {k: [v[i] + self.origin[i] for i in range(3)] for k, v in self._ground.items()}
         self._finish(qs, eqs)
+
+    def ground_at(self, g: str) -> list:
+        """Where ground point `g` is drawn, also where it is the anchor of a slide joint."""
+        return self._ground[g]
 
     # --- numbers, frames ---
     def _xyz(self, xyz):
