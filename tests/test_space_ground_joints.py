@@ -125,3 +125,12 @@ def test_pictures_of_the_slider_with_its_point_in_ground(tmp_path, capsys):
     code, _, err = run_cli(capsys, "solve", scene, "--svg", tmp_path / "s.svg", "--html", tmp_path / "s.html")
     assert code == 0, err
     assert (tmp_path / "s.svg").stat().st_size > 0 and (tmp_path / "s.html").stat().st_size > 0
+
+
+def test_a_bars_rotation_is_refused_saying_why(tmp_path, capsys):
+    """A two-point bar's spin is not a freedom: it has no rotation to report; the line says so."""
+    for q in ("rod.qw", "rod.omega_x", "rod.R11"):
+        scene = write_scene(tmp_path, SLIDER.replace('report = ["slot.s"', f'report = ["{q}", "slot.s"'))
+        code, _, err = run_cli(capsys, "solve", scene)
+        assert code == 2 and "Traceback" not in err, err
+        assert q in err and "two-point bar" in err and "[output] report" in err, err

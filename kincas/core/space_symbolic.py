@@ -295,6 +295,10 @@ class SpatialSymbolic(Symbolic):
             elif n.replace(" ", "").startswith("reaction("):  # optional in 3D (contract), not built
                 out.append(f"{where}: {n!r}: joint reactions are not built for spatial scenes in this "
                            f"version (efforts, effort(KEY), and shaking.x .. shaking.mz are)")
+            elif b in BODY_Q and any(lk.two_point and lk.name == a for lk in self.mech.bodies):
+                out.append(f"{where}: {n!r}: {a} is a two-point bar: its spin about its own axis is "
+                           f"not defined, so it has no rotation, quaternion or angular rate (report "
+                           f"its ends' positions and velocities, or make it a body with points)")
             elif self.position_expr(a, b)[0] is None and self.extra(n)[0] is None:
                 out.append(f"{where}: unknown quantity {n!r} (expected P.x .. P.z, P.vx, P.ax, P.jx .., "
                            f"L.qw .. L.qz, L.R11 .. L.R33, L.omega_x .., L.alpha_x .., J.angle, "
