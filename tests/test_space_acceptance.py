@@ -1,4 +1,7 @@
-"""Cylindrical, prismatic and planar joints whose point is ALSO listed in `[ground]`, as a
+"""Scenes written from the contract alone (docs/scene-format.md, "Spatial mechanisms"), as an
+outsider's acceptance scene would be, each against a closed form written here.
+
+Cylindrical, prismatic and planar joints whose point is ALSO listed in `[ground]`, as a
 scene written from the contract does when it leaves `bodies` out ("it may be left out when
 exactly two bodies (the ground counting as one) carry `point`; then the first is the
 ground"). The point then belongs to the second body (it slides along the ground's line or
@@ -134,3 +137,53 @@ def test_a_bars_rotation_is_refused_saying_why(tmp_path, capsys):
         code, _, err = run_cli(capsys, "solve", scene)
         assert code == 2 and "Traceback" not in err, err
         assert q in err and "two-point bar" in err and "[output] report" in err, err
+
+
+BARS = """
+title = "point on a plane held by two bars of which one is driven in length"
+space = "3d"
+[parameters]
+l1 = 5
+[ground]
+A = [0, 0, 0]
+B = [6, 0, 0]
+[links]
+b1 = { points = ["A", "P"], length = "l1" }
+b2 = { points = ["B", "P"], length = 5 }
+[[slides]]
+name = "floor"
+point = "P"
+along = "ground"
+plane = { through = [0, 0, 1], normal = [0, 0, 1] }
+[[inputs]]
+parameter = "l1"
+sweep = { from = 4, to = 6, steps = 5 }
+[guess]
+P = [3, 4, 1]
+[output]
+report = ["P.x", "P.y", "P.z", "P.vx", "P.vy"]
+"""
+
+
+def test_a_parameter_input_with_a_plane_slide_and_a_point_of_bars(tmp_path, capsys):
+    """P on the plane z = 1 with |AP| = l1 and |BP| = 5: x = (l1^2 + 11) / 12 and
+    y = sqrt(l1^2 - x^2 - 1); dx/dl1 = l1 / 6. Once a traceback (a 3D slide has no angle, read
+    when labelling the parameter input's unit). Its range: the plane's circle about B of radius
+    sqrt(24) meets A's sphere while the in-plane distance d from (0, 0, 1) is 6 -+ sqrt(24),
+    l1 = sqrt(d^2 + 1)."""
+    scene = write_scene(tmp_path, BARS)
+    code, out, err = run_cli(capsys, "solve", scene, "--json")
+    assert code == 0, err
+    for k, l1 in enumerate(out["inputs"]["l1"]):
+        x = (l1 ** 2 + 11) / 12
+        v = {name: col[k] for name, col in out["values"].items()}
+        assert abs(v["P.x"] - x) < 1e-12 and abs(v["P.z"] - 1) < 1e-12
+        assert abs(v["P.y"] - math.sqrt(l1 ** 2 - x * x - 1)) < 1e-12
+        assert abs(v["P.vx"] - l1 / 6) < 1e-12
+    code, out, err = run_cli(capsys, "range", scene, "--json")
+    assert code == 0, err
+    lo, hi = (math.sqrt(d * d + 1) for d in (6 - math.sqrt(24), 6 + math.sqrt(24)))
+    r = out["ranges"]["l1"]
+    assert abs(r["from"] - lo) < 1e-9 and abs(r["to"] - hi) < 1e-9, r
+    code, out, err = run_cli(capsys, "modes", scene)
+    assert code == 0 and "angles:" not in out, out  # no angle to show: no empty "angles:" line
