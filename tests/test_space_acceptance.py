@@ -187,3 +187,14 @@ def test_a_parameter_input_with_a_plane_slide_and_a_point_of_bars(tmp_path, caps
     assert abs(r["from"] - lo) < 1e-9 and abs(r["to"] - hi) < 1e-9, r
     code, out, err = run_cli(capsys, "modes", scene)
     assert code == 0 and "angles:" not in out, out  # no angle to show: no empty "angles:" line
+
+
+def test_too_few_inputs_on_a_cylinder_listed_in_ground_says_the_count(tmp_path, capsys):
+    """A cylindrical joint has two freedoms; one input is one short. The count once held the
+    ground's copy of the point as a ball (3 equations): the declaration let it through and the
+    solver said '7 unknowns but 6 equations'. 7 unknowns (one body), 5 equations (its norm and
+    the joint's 4): 2 freedoms."""
+    scene = write_scene(tmp_path, CYLINDER.replace('[[inputs]]\njoint = "c.s"\nsweep = { from = 0.5, to = 2, steps = 4 }\n', ""))
+    code, _, err = run_cli(capsys, "solve", scene)
+    assert code == 2 and "Traceback" not in err, err
+    assert "[inputs]" in err and "2 degree(s) of freedom" in err and "1 input(s)" in err, err
