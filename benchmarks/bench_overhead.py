@@ -30,6 +30,7 @@ sys.path[:0] = [str(Path(__file__).resolve().parent), str(Path(__file__).resolve
 
 import cases  # noqa: E402
 from peers import closed_form, kincas_runs, pylinkage_peer  # noqa: E402
+from peers.measure import errors  # noqa: E402
 
 CASES = {"fourbar": cases.fourbar, "jansen": cases.jansen,
          "chain10": lambda n: cases.chain(10, n), "chain40": lambda n: cases.chain(40, n)}
@@ -67,13 +68,28 @@ def tools(case, against=None):
     return out
 
 
+def agreement(case, answers) -> float:
+    """The worst difference between the tools' answers (warm-up calls) and the closed form's
+    at 30 digits, positions over L and velocities over omega L, inf if a tool left a pose
+    unsolved: every tool timed here must have solved the same sweep."""
+    P, V = closed_form.reference(case) if len(case.theta) <= 400 else closed_form.solve_numpy(case)
+    worst = 0.0
+    for run in answers.values():
+        if not run.ok.all():
+            return float("inf")
+        worst = max(worst, *errors(case, run, P, V))
+    return worst
+
+
 def measure(case, repeats, clock=time.process_time, against=None):
+    """{tool: median us per pose}, and "agree": `agreement` of their answers."""
     runs = tools(case, against)
     kincas_runs.prepare_method(case, "sweep, method=fast, compile=True")()  # the library, as a
     # second process finds it cached (the default sweeps use it from then on)
-    for f in runs.values():  # warm-up: JIT, caches
+    answers = {}
+    for k, f in runs.items():  # warm-up: JIT, caches
         f()
-        f()
+        answers[k] = f()
     times = {k: [] for k in runs}
     for _ in range(repeats):
         for k, f in runs.items():
@@ -81,7 +97,7 @@ def measure(case, repeats, clock=time.process_time, against=None):
             f()
             times[k].append(clock() - t0)
     n = len(case.theta)
-    return {k: 1e6 * statistics.median(v) / n for k, v in times.items()}
+    return {**{k: 1e6 * statistics.median(v) / n for k, v in times.items()}, "agree": agreement(case, answers)}
 
 
 def first_use(tool: str, name: str, calls: list[int]) -> list[float]:
@@ -145,7 +161,7 @@ def main(argv=None):
     import kincas  # noqa: F401  (this checkout's, before any other is loaded)
     against = load_against(a.against) if a.against else None
     print(f"{'case':10} {'poses':>7} {'kincas us/pose':>15} {'pylinkage':>10} {'closed':>8} {'x pyl':>6} "
-          f"{'x closed':>8}" + (f" {'against':>8} {'x against':>9}" if against else ""))
+          f"{'x closed':>8} {'agree':>8}" + (f" {'against':>8} {'x against':>9}" if against else ""))
     for name in a.cases.split(","):
         for n in map(int, a.poses.split(",")):
             case = CASES[name](n)
@@ -155,7 +171,8 @@ def main(argv=None):
                         time.perf_counter if a.wall else time.process_time, against)
             k, pl, cf = t["kincas"], t.get("pylinkage", float("nan")), t["closed form"]
             extra = f" {t['against']:8.3f} {k / t['against']:9.2f}" if against else ""
-            print(f"{name:10} {n:7d} {k:15.3f} {pl:10.3f} {cf:8.3f} {k / pl:6.2f} {k / cf:8.2f}{extra}", flush=True)
+            print(f"{name:10} {n:7d} {k:15.3f} {pl:10.3f} {cf:8.3f} {k / pl:6.2f} {k / cf:8.2f} {t['agree']:8.1e}{extra}",
+                  flush=True)
 
 
 def report(path: Path = Path(__file__).resolve().parent / "results_overhead.md") -> None:
@@ -165,9 +182,11 @@ def report(path: Path = Path(__file__).resolve().parent / "results_overhead.md")
              "Warm: CPU time per pose, median of interleaved calls in one process (the library built "
              "first); positions and velocities of the compared points. First use: wall time in a fresh "
              "process with kincas's cache empty, from setup to the end of the n-th 360-pose sweep "
-             "(compiles and JIT included; numba's cache as installed).", "",
-             "| case | poses | kincas µs/pose | pylinkage (numba) | closed form (numpy) | × pylinkage | × closed form |",
-             "|---|---:|---:|---:|---:|---:|---:|"]
+             "(compiles and JIT included; numba's cache as installed). Agreement: the worst difference of any "
+             "tool's positions (over L) or velocities (over ωL) from the closed form at 30 digits (numpy's beyond "
+             "400 poses), every pose solved by every tool.", "",
+             "| case | poses | kincas µs/pose | pylinkage (numba) | closed form (numpy) | × pylinkage | × closed form | agreement |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|"]
     for name in CASES:
         for n in (360, 3_600, 100_000):
             case = CASES[name](n)
@@ -175,7 +194,7 @@ def report(path: Path = Path(__file__).resolve().parent / "results_overhead.md")
                 case = case.with_theta(cases.sweep_angles(n))
             t = measure(case, 40 if n <= 4000 else 5)
             k, pl, cf = t["kincas"], t.get("pylinkage", float("nan")), t["closed form"]
-            lines.append(f"| {name} | {n:,} | {k:.3f} | {pl:.3f} | {cf:.3f} | {k / pl:.2f} | {k / cf:.2f} |")
+            lines.append(f"| {name} | {n:,} | {k:.3f} | {pl:.3f} | {cf:.3f} | {k / pl:.2f} | {k / cf:.2f} | {t['agree']:.1e} |")
             print(lines[-1], flush=True)
     calls = [1, 100, 1000]
     lines += ["", "| case | tool | " + " | ".join(f"{c:,} calls (s)" for c in calls) + " |",

@@ -177,3 +177,34 @@ def test_antiparallelogram_is_the_crossed_coupler():
     alts = [solve_numpy(case, steps=s)[0]["C"] for s in cases.alternatives(case)]
     near = np.min([np.linalg.norm(a - (B + w), axis=1) for a in alts], axis=0)
     assert near.max() < 1e-12 * case.size
+
+
+def test_chain_is_no_parallelogram_and_stays_far_from_change_points():
+    """The growth and overhead chains (benchmarks/cases.py `chain`): every unit a four-bar
+    whose crank and rocker differ (no shortcut: each point a circle-circle intersection),
+    assembled at every driven angle with the coupler and the rocker at least 50 deg from in
+    line, and the numpy closed form equal to the 30-digit one."""
+    case = cases.chain(40, 241)
+    assert all(st[0] == "rrr" for st in case.steps)
+    lengths = {p: ls[0] for _, p, ls in case.links}
+    prev_r = case.crank[2]
+    for k in range(1, 41):
+        r = lengths[(f"G{k}", f"T{k}")]
+        assert abs(r - prev_r) > 0.1  # crank and rocker of unit k differ
+        prev_r = r
+    P, _ = solve_numpy(case)
+    prev = P["A"]
+    for k in range(1, 41):
+        T, G = P[f"T{k}"], np.array(case.ground[f"G{k}"])
+        assert np.isfinite(T).all()
+        u, v = T - prev, T - G
+        sin_t = (u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]) / np.linalg.norm(u, axis=1) / np.linalg.norm(v, axis=1)
+        assert np.abs(sin_t).min() > math.sin(math.radians(50)), k
+        prev = T
+    assert constraint_violation(case, P) < 1e-13
+    small = cases.chain(40, 5)
+    Pr, Vr = reference(small)
+    Pn, Vn = solve_numpy(small)
+    for p in small.moving:
+        assert np.abs(Pn[p] - Pr[p]).max() < 1e-13 * small.size
+        assert np.abs(Vn[p] - Vr[p]).max() < 1e-11 * small.size * small.omega

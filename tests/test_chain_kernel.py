@@ -17,28 +17,38 @@ from kincas.core.fast import sweeper_for
 from kincas.core.kernel import GROUP_RUN, GROUPS_APART
 
 
-def chain(n, c, r, t0):
-    links = [kincas.Link.bar("crank", "O", "A", 1.0)]
+def _unit(v, k):
+    """Unit k's length: v, or v's entries in turn."""
+    return v[(k - 1) % len(v)] if np.ndim(v) else v
+
+
+def chain(n, c, r, t0, scale=1.0, origin=(0.0, 0.0)):
+    """(c, r: one length for every unit, or lengths taken in turn; every length times
+    `scale`, every point moved by `origin`)."""
+    ox, oy = origin
+    links = [kincas.Link.bar("crank", "O", "A", scale)]
     for k in range(1, n + 1):
-        links += [kincas.Link.bar(f"cp{k}", "A" if k == 1 else f"T{k - 1}", f"T{k}", c),
-                  kincas.Link.bar(f"rk{k}", f"G{k}", f"T{k}", r)]
-    ground = {"O": (0.0, 0.0), **{f"G{k}": (4.0 * k, 0.0) for k in range(1, n + 1)}}
-    P, _ = closed_form(n, c, r, np.array([t0]), 1.0)
+        links += [kincas.Link.bar(f"cp{k}", "A" if k == 1 else f"T{k - 1}", f"T{k}", scale * _unit(c, k)),
+                  kincas.Link.bar(f"rk{k}", f"G{k}", f"T{k}", scale * _unit(r, k))]
+    ground = {"O": (ox, oy), **{f"G{k}": (ox + 4.0 * k * scale, oy) for k in range(1, n + 1)}}
+    P, _ = closed_form(n, c, r, np.array([t0]), 1.0, scale, origin)
     guess = {f"T{k}": tuple(P[k][0]) for k in range(1, n + 1)}
     return kincas.Mechanism(ground=ground, links=links, inputs=[kincas.Input.angle("crank")], guess=guess)
 
 
-def closed_form(n, c, r, t, w):
+def closed_form(n, c, r, t, w, scale=1.0, origin=(0.0, 0.0)):
     """{k: (N, 2)} positions and velocities of T_k (k = 0: A) at crank angles t, rate w."""
-    P = {0: np.stack([np.cos(t), np.sin(t)], 1)}
-    V = {0: w * np.stack([-np.sin(t), np.cos(t)], 1)}
+    o = np.asarray(origin, dtype=float)
+    P = {0: o + scale * np.stack([np.cos(t), np.sin(t)], 1)}
+    V = {0: w * scale * np.stack([-np.sin(t), np.cos(t)], 1)}
     for k in range(1, n + 1):
-        A1, V1, A2 = P[k - 1], V[k - 1], np.array([4.0 * k, 0.0])
+        c_, r_ = scale * _unit(c, k), scale * _unit(r, k)
+        A1, V1, A2 = P[k - 1], V[k - 1], o + np.array([4.0 * k * scale, 0.0])
         d_ = A2 - A1
         d = np.hypot(d_[:, 0], d_[:, 1])
         e = d_ / d[:, None]
-        along = (d * d + c * c - r * r) / (2 * d)
-        h = np.sqrt(c * c - along * along)
+        along = (d * d + c_ * c_ - r_ * r_) / (2 * d)
+        h = np.sqrt(c_ * c_ - along * along)
         T = A1 + along[:, None] * e + h[:, None] * np.stack([-e[:, 1], e[:, 0]], 1)  # on the left
         a, b = T - A1, T - A2  # (T - A1).(V - V1) = 0, (T - A2).V = 0
         ra, det = (a * V1).sum(1), a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
@@ -126,3 +136,31 @@ def test_kernel_and_careful_path_agree_on_every_pose_of_a_chain(c, r, lo, hi):
         assert np.abs(a[both] - b[both]).max(initial=0.0) <= 1e-9 * max(1.0, np.abs(b[both]).max(initial=0.0)), name
     if r == 1.0:
         assert fast.flags[12] == "change point" and math.isclose(t[12], math.pi)
+
+
+@pytest.mark.parametrize("scale, origin", [(1e-6, (0.0, 0.0)), (1e6, (0.0, 0.0)), (1.0, (1e6, -1e6)),
+                                           (1e-6, (1e-3, 2e-3))])
+def test_chain_of_four_bars_that_are_no_parallelograms_at_any_scale(scale, origin, monkeypatch):
+    """The benchmarks' chain (rockers 1.1 and 1 in turn, couplers 4, pivots 4 apart: every
+    point a circle intersection), tiny, huge, and far from the origin (1e6 away with links of
+    1: positions carry 6 fewer digits, relative to the size), written group by group: every
+    pose taken by the kernel, with its third-order prediction taking the dense poses with no
+    Newton step, at the closed form's positions and velocities."""
+    monkeypatch.setattr("kincas.core.kernel.GROUPS_APART", 4)  # in runs of groups, compiled fast
+    n, w = 6, 3.0
+    t = np.radians(np.linspace(60, 120, 3601))
+    rk = (1.1, 1.0)
+    m = chain(n, 4.0, rk, t[0], scale, origin)
+    P, V = closed_form(n, 4.0, rk, t, w, scale, origin)
+    assert all(np.isfinite(P[k]).all() for k in P)
+    assert sweeper_for(kincas.model_of(m), tuple(names(n)), True).functions[2].is_a("MXFunction")
+    sw = kincas.sweep(m, {"crank.angle": t}, rates={"crank.angle": w}, report=names(n), compile=True)
+    assert sw.info["fast pass"] == "compiled" and sw.ok.all() and all(f is None for f in sw.flags)
+    size = 4.0 * n * scale
+    far = 1.0 + math.hypot(*origin) / size  # rounding of coordinates that large
+    for k in range(1, n + 1):
+        got = np.stack([sw[f"T{k}.x"], sw[f"T{k}.y"]], 1)
+        assert np.abs(got - P[k]).max() <= 1e-12 * size * far, k
+        vel = np.stack([sw[f"T{k}.vx"], sw[f"T{k}.vy"]], 1)
+        assert np.abs(vel - V[k]).max() <= 1e-11 * np.abs(V[k]).max() * far, k
+    assert (sw.iterations[3:] == 0).mean() > 0.9  # kF at the prediction (see test_fast_predict.py)

@@ -110,7 +110,7 @@ def test_placement_is_kept_per_mechanism_and_inputs():
 
 
 def test_chain_first_pose_in_kernel_with_per_group_correction(monkeypatch):
-    """Eight chained parallelogram four-bars from a guess a little off every assembly: each
+    """Eight chained four-bars (benchmarks/cases.py) from a guess a little off every assembly: each
     group's Newton moves about 0.1 of its scale, so the sum over the chain (about 1) exceeds
     CORRECTION while each group stays within it. The bound must be per group (the chain is
     block triangular): the kernel then takes the first pose, and its answer is the careful

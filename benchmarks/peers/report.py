@@ -316,7 +316,9 @@ def write_report(out: Path, *, quick, cfg, installs, machine, main, stability, g
           "![throughput](bench_throughput.png)", ""] + main_tables(main, front)
     L += ["## 3. Stability: stiff and extreme cases", ""] + stability_tables(stability)
     L += ["## 4. Growth with the mechanism's size", "",
-          "N parallelogram four-bars chained through shared links (each rocker is the next crank), "
+          "N four-bars chained through shared links (each rocker is the next crank; rockers 1.1 and 1 "
+          "in turn, couplers 4 between pivots 4 apart: no unit is a parallelogram, so the closed form, "
+          "like every dyad method, intersects two circles per unit), "
           f"{cfg['chain_poses']} poses over 60–120°, 2N unknowns. The `mechanism` package is left out "
           "here (its Python vector loops make the large sizes cost minutes); the others are all the "
           "general solvers of section 2 and the closed form.", "",

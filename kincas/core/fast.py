@@ -2,8 +2,9 @@
 
 The careful path (`kincas.solve`) spends about 70 us per pose in Python. Here one call solves
 a whole stretch of a sweep: pose k is predicted from the last solved pose along the exact
-tangent, q_pred = q_prev + dq/du (u_k - u_prev) with dq/du = -g_q^-1 g_u, plus a second-order
-term from how the tangent changed since the pose before, then corrected by Newton,
+tangent, q_pred = q_prev + dq/du (u_k - u_prev) with dq/du = -g_q^-1 g_u, plus second- and
+third-order terms from the pose before and its tangent (the cubic through both poses with
+both tangents, kincas/core/kernel.py), then corrected by Newton,
 q <- q - g_q^-1 g, until the next step would be negligible (on a dense sweep the prediction
 usually is already). A pose is *accepted* only when it is verified in the same pass:
 
@@ -105,7 +106,7 @@ class FastSweeper(VirtualMachineSweep):
             self._group_of[np.asarray(b.cols, dtype=np.intp)] = i
         self._one_group = len(self.blocks) == 1 and not self._group_of.any()
         self.nj = diagonal_size(self.blocks)  # g_q's diagonal blocks, all the state keeps of it
-        self.state_size = self.nq + self.nj + 2 * (self.nq * self.nu + self.nu)
+        self.state_size = 2 * self.nq + self.nj + 2 * (self.nq * self.nu + self.nu)
         self._functions, self._size, self._poses, self._calls = None, None, 0, 0  # swept so far
         self._lock = threading.RLock()
         self._local = threading.local()  # the virtual machine's buffers, one set per thread
@@ -155,8 +156,8 @@ class FastSweeper(VirtualMachineSweep):
                 "NJ": self.nj}
 
     def state(self, q, u, p, out=None) -> np.ndarray:
-        """(q, J, T = dq/du, u, T, u) at a solved pose, matrices column-major as in casadi
-        (the second T, u stand for the pose before: the first prediction is linear), in
+        """(q, J, T = dq/du, u, T, u, q) at a solved pose, matrices column-major as in casadi
+        (the second T, u, q stand for the pose before: the first prediction is linear), in
         `out` if given. At a singular start T is not finite, and the next pose fails the
         branch test."""
         nq, nu, nj = self.nq, self.nu, self.nj
@@ -164,7 +165,8 @@ class FastSweeper(VirtualMachineSweep):
         s[:nq], s[nq + nj + nq * nu:][:nu] = np.ravel(q), np.ravel(u)
         f = self._state_call()
         f(s[:nq], s[nq + nj + nq * nu:][:nu], np.ravel(p), s[nq:nq + nj], s[nq + nj:][:nq * nu])
-        s[nq + nj + nq * nu + nu:] = s[nq + nj:nq + nj + nq * nu + nu]
+        s[nq + nj + nq * nu + nu:][:nq * nu + nu] = s[nq + nj:nq + nj + nq * nu + nu]
+        s[nq + nj + 2 * (nq * nu + nu):] = s[:nq]
         return s
 
     def diagonal(self, J: np.ndarray) -> np.ndarray:

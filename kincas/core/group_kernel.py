@@ -29,15 +29,15 @@ chain needs the whole chain's velocities).
 ...     links=links, inputs=[kincas.Input.angle("crank")])
 >>> model = kincas.model_of(m)
 >>> kinds = GroupFunctions(model.sym, list(model.blocks))
->>> len(model.blocks), len(kinds.newton_kinds)  # the first four-bars differ from the rest
-(5, 3)
+>>> len(model.blocks), len(kinds.newton_kinds)  # the first four-bar differs from the rest
+(5, 2)
 """
 from __future__ import annotations
 
 import casadi as ca
 import numpy as np
 
-from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size
+from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size, reciprocal
 from .structure import Block
 
 OPTS = {"cse": True}  # one sin and cos per angle within a group's function
@@ -125,7 +125,7 @@ class GroupFunctions:
         D, Lg = GroupFunctions._scales(grp, Lb)
         rhs = grp.g - ca.mtimes(C, dz) if grp.z.numel() else grp.g
         dx = block_solve(A, rhs, grp.local)
-        rs = ca.vertcat(_max_abs(grp.g / Lg), _max_abs(dx / D))
+        rs = ca.vertcat(_max_abs(grp.g * reciprocal(Lg)), _max_abs(dx * reciprocal(D)))
         return ca.Function(name, [grp.x, grp.z, dz, grp.u, grp.p, Lb, grp.c], [ca.densify(dx), rs], OPTS)
 
     @staticmethod
@@ -138,10 +138,10 @@ class GroupFunctions:
         A, C = ca.jacobian(grp.g, grp.x), ca.jacobian(grp.g, grp.z)
         Gu = ca.jacobian(grp.g, grp.u)
         D, Lg = GroupFunctions._scales(grp, Lb)
-        cs = ca.if_else(ca.DM(grp.is_length.astype(float)), 1, 1 / L)  # columns to O(1): 1 (lengths), 1/L (angles)
+        cs = ca.if_else(ca.DM(grp.is_length.astype(float)), 1, reciprocal(L))  # columns to O(1): 1 (lengths), 1/L (angles)
         dx = block_solve(A, grp.g - ca.mtimes(C, dz) if m else grp.g, grp.local)
         T = -block_solve(A, Gu + ca.mtimes(C, Tz) if m else Gu, grp.local)
-        rs = ca.vertcat(_max_abs(grp.g / Lg), _max_abs(dx / D))
+        rs = ca.vertcat(_max_abs(grp.g * reciprocal(Lg)), _max_abs(dx * reciprocal(D)))
         change = block_change(A0, A, D, grp.local)
         corr = group_correction((grp.x - xp) / D, grp.local)
         signs, sigma = block_measures(A, cs, grp.local)

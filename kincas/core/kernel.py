@@ -3,7 +3,7 @@
 Three functions, every linear solve done Assur group by Assur group (kincas/core/blocks.py),
 so their size grows with the number of groups, not with nq^3:
 
-- kP: the prediction from the last solved pose (tangent, second-order term);
+- kP: the prediction from the last two solved poses (tangent, second- and third-order terms);
 - kN: at q, the Newton step g_q^-1 g (Gauss-Newton's (g_q'g_q)^-1 g_q' g for a tall group:
   redundant joints, kincas/core/blocks.py) and the measures that stop Newton (max |g| / L and the
   step's size in radians or lengths / L, each equation and unknown against its own Assur
@@ -32,7 +32,7 @@ import casadi as ca
 from .group_kernel import GroupFunctions, _max_abs, group_correction, group_scales
 from .structure import Structure
 from ..model.names import parse_quantity
-from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size, is_tall
+from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size, reciprocal, is_tall
 from .tolerances import ACCEPT, CORRECTION, JAC_CHANGE, KERNEL_NEAR, MAX_EVALS, TOL  # noqa: F401
 
 RESIDUAL = ACCEPT  # max |g| / L at an accepted pose, as on the careful path
@@ -60,18 +60,32 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
     `structure` (the `Structure` whose blocks these are, built from `sym` if not given)
     gives the groups' lengths.
 
-    The prediction is of second order: with the tangents T0 at the last pose (input u0) and
-    T1 at the one before (u1), dT = T0 - T1 ~ H[u0 - u1, .] for the second derivative H of
-    q(u), so along a step u - u0 = l (u0 - u1), H[u - u0, u - u0] ~ l dT (u - u0); its error
-    is O(h^3) on a straight sweep and still O(h^2) where the sweep turns."""
+    The prediction is of third order: with the unknowns q0, q1 and tangents T0, T1 at the
+    last pose (input u0) and the one before (u1), and a step u - u0 = l (u0 - u1) along the
+    line through them, q(u0 + t (u0 - u1)) is extrapolated by the cubic through both poses
+    with both tangents (Hermite's), written as the second-order prediction
+    q0 + T0 (u - u0) + l/2 (T0 - T1)(u - u0) (dT = T0 - T1 ~ H[u0 - u1, .] for the second
+    derivative H of q(u)) plus l^2 (l + 3/2) E, where E = (T0 + T1)(u0 - u1) - 2 (q0 - q1)
+    is the trapezoid rule's defect over the last step, the cubic's t^3 coefficient, O(h^3).
+    Its error is O(h^4) on a straight sweep and still O(h^2) where the sweep turns. On a
+    dense sweep of a mechanism whose q(u) is not linear the prediction is then converged to
+    STEP where the second-order one needed a Newton step: on chained four-bars that are not
+    parallelograms (benchmarks/cases.py `chain`), from 3,600 poses a turn on, kF alone (no kN)."""
     nq, nu = sym.nq, sym.nu
     solve = lambda A, b: block_solve(A, b, blocks)
     q, qp, J0 = ca.SX.sym("q", nq), ca.SX.sym("qp", nq), ca.SX.sym("J0", diagonal_size(blocks))
     T0, u0, u = ca.SX.sym("T0", nq, nu), ca.SX.sym("u0", nu), ca.SX.sym("u", nu)
-    T1, u1 = ca.SX.sym("T1", nq, nu), ca.SX.sym("u1", nu)
+    T1, u1, q1 = ca.SX.sym("T1", nq, nu), ca.SX.sym("u1", nu), ca.SX.sym("q1", nq)
     du, dup = u - u0, u0 - u1
-    lam = ca.if_else(ca.dot(dup, dup) > 0, ca.dot(du, dup) / ca.dot(dup, dup), 0)
-    pred = q + ca.mtimes(T0, du) + 0.5 * lam * ca.mtimes(T0 - T1, du)
+    # lam = du.dup / dup.dup, 0 where dup = 0 (a first step), written without if_else: casadi
+    # would carry an if_else into every unknown's expression that lam multiplies
+    dd = ca.dot(dup, dup)
+    lam = ca.dot(du, dup) / (dd + (dd == 0))
+    # q0 + T0 du + lam/2 (T0 - T1) du + c3 E with E = (T0 + T1) dup - 2 (q0 - q1), gathered
+    # per tangent: the scalars once, then 7 operations an unknown (with nu = 1)
+    c3 = lam * lam * (lam + 1.5)
+    v0, v1 = du * (1 + 0.5 * lam) + c3 * dup, c3 * dup - (0.5 * lam) * du
+    pred = q + ca.mtimes(T0, v0) + ca.mtimes(T1, v1) - (2 * c3) * (q - q1)
     p, L, ud, udd = ca.SX.sym("p", sym.np), ca.SX.sym("L"), ca.SX.sym("ud", nu), ca.SX.sym("udd", nu)
     # the reported quantities take q' = (dq/du) u' from the tangent kF computes anyway: one
     # linear solve through the chain fewer per pose. Not with a sensitivity d(Q)/d(p): it
@@ -82,7 +96,7 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
     given = (lambda a, qd: qf(*a, qd)) if tangent else (lambda a, qd: qf(*a))
     d, o = ca.densify, {"cse": True}  # cse: one sin and cos per angle, shared by everything
     kL = (structure or Structure(sym)).length_function()
-    kP = ca.Function("kP", [q, T0, u0, u, T1, u1], [d(pred)], o)
+    kP = ca.Function("kP", [q, T0, u0, u, T1, u1, q1], [d(pred)], o)
     if not is_tall(blocks) and (grouped or (grouped is None and len(blocks) >= GROUPS_APART)):
         # one small function per kind of group, the quantities apart
         qd = ca.SX.sym("qd", nq)
@@ -92,10 +106,10 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
     is_length = ca.DM(sym.is_length.astype(float))
     Lq, Lg = group_scales(Lb, blocks, sym.nq, sym.ng)
     D = ca.if_else(is_length, Lq, 1)  # the scale of each unknown: its group's length or 1
-    cs = ca.if_else(is_length, 1, 1 / L)  # g_q's columns to O(1): 1 (lengths), 1/L (angles)
+    cs = ca.if_else(is_length, 1, reciprocal(L))  # g_q's columns to O(1): 1 (lengths), 1/L (angles)
     g, Jq, Ju = ca.Function("G", [sym.q, sym.u, sym.p], [sym.g, sym.Jq, sym.Ju])(q, u, p)
     step = solve(Jq, g)
-    rs = ca.vertcat(_max_abs(g / Lg), _max_abs(step / D))
+    rs = ca.vertcat(_max_abs(g * reciprocal(Lg)), _max_abs(step * reciprocal(D)))
     T = -solve(Jq, Ju)
     y = ca.densify(given((q, u, p, ud, udd), ca.mtimes(T, ud))) if report else ca.SX(0, 1)
     tall = is_tall(blocks)
@@ -159,7 +173,8 @@ def vm_step(kP, kN, kF, kL, nq, nu, max_evals, skip: bool = True) -> ca.Function
     u, p, L, thr = X.sym("u", nu), X.sym("p", kN.size1_in(2)), X.sym("L"), X.sym("t", 5)
     Lb, near = X.sym("Lb", kL.size1_out(0)), X.sym("near")
     ud, udd, T1, u1 = X.sym("ud", nu), X.sym("udd", nu), X.sym("T1", nq, nu), X.sym("u1", nu)
-    qp = kP(q0, T0, u0, u, T1, u1)
+    q1 = X.sym("q1", nq)
+    qp = kP(q0, T0, u0, u, T1, u1, q1)
     converged = lambda rs: ca.logic_and(rs[0] <= thr[0], rs[1] <= thr[1])
     if skip:
         Y = ca.MX if kN.is_a("MXFunction") else ca.SX
@@ -208,8 +223,8 @@ def vm_step(kP, kN, kF, kL, nq, nu, max_evals, skip: bool = True) -> ca.Function
     q = ca.if_else(conv, q - dq, q)
     info = ca.vertcat(rs, mc, evals, conv)
     near_next = ca.logic_or(evals == 0, mc[1] <= thr[1])
-    return ca.Function("kS", [q0, J0, T0, u0, T1, u1, near, u, p, L, thr, ud, udd, Lb],
-                       [q, J, T, u, T0, u0, near_next, info, y, meas])
+    return ca.Function("kS", [q0, J0, T0, u0, T1, u1, q1, near, u, p, L, thr, ud, udd, Lb],
+                       [q, J, T, u, T0, u0, q0, near_next, info, y, meas])
 
 
 def _expanded(f: ca.Function) -> ca.Function:
@@ -224,7 +239,7 @@ def _expanded(f: ca.Function) -> ca.Function:
 
 
 # --- the C loop around them (NQ, NU, NO, NM, NJ: sizes, NM - 1 groups; state s = q, g_q's
-# diagonal blocks, T = dq/du, u at the last pose, then T and u at the one before; matrices
+# diagonal blocks, T = dq/du, u at the last pose, then T, u and q at the one before; matrices
 # column-major; L the whole mechanism's length, for the singular measures' column scale) ---
 
 SWEEP_C = """
@@ -245,7 +260,8 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     const casadi_real* u = U + k*NU;
     int conv = 0;
     arg[0] = s; arg[1] = s + NQ + NJ; arg[2] = s + NQ + NJ + NQ*NU; arg[3] = u;
-    arg[4] = s + NQ + NJ + NQ*NU + NU; arg[5] = s + NQ + NJ + 2*NQ*NU + NU; res[0] = qp;
+    arg[4] = s + NQ + NJ + NQ*NU + NU; arg[5] = s + NQ + NJ + 2*NQ*NU + NU;
+    arg[6] = s + NQ + NJ + 2*(NQ*NU + NU); res[0] = qp;
     if (kP(arg, res, iw, w, 0)) break;
     for (i = 0; i < NQ; ++i) q[i] = qp[i];
     if (near) {  /* kF at the prediction first: where its (next) step is negligible, no kN */
@@ -276,6 +292,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     if (!(conv && mc[0] <= thr[2] && mc[1] <= thr[3])) break;
     near = it == 0 || mc[1] <= thr[1];
     for (i = 0; i < NQ*NU + NU; ++i) s[NQ + NJ + NQ*NU + NU + i] = s[NQ + NJ + i];
+    for (i = 0; i < NQ; ++i) s[NQ + NJ + 2*(NQ*NU + NU) + i] = s[i];
     for (i = 0; i < NQ; ++i) s[i] = q[i];
     for (i = 0; i < NJ; ++i) s[NQ + i] = J[i];
     for (i = 0; i < NQ*NU; ++i) s[NQ + NJ + i] = T[i];

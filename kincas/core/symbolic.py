@@ -91,6 +91,13 @@ class Symbolic:
             self.unknowns.append((name, kind))
             return qs[-1]
 
+        # Each point also as (the ground point it hangs from, the sum of link vectors from
+        # there): a loop closure is written as the difference of the two ground points (exact
+        # for numbers) plus the difference of the two sums, so its rounding is that of the
+        # links' lengths, not of the coordinates. A point 160 from the origin (the 40th of
+        # chained four-bars 4 apart) would otherwise carry rounding of 160 ulps into g, and
+        # the next Newton step's floor above STEP (the fast kernel's acceptance).
+        rel = {g: (g, (ca.SX(0), ca.SX(0))) for g, _ in m.ground}
         for lname, at in m.structure.order:
             lk = m.link(lname)
             loc = {p: (self.val(x), self.val(y)) for p, (x, y) in lk.points}
@@ -98,18 +105,22 @@ class Symbolic:
             c, s = ca.cos(th), ca.sin(th)
             if at is None:  # floating: its origin is unknown too
                 ox, oy = new(f"{lname}.x", "length"), new(f"{lname}.y", "length")
+                base, (rx, ry) = None, (ox, oy)
             else:  # hangs on point `at`: origin = P - R(th) p_local
                 (px, py), (lx, ly) = self.points[at], loc[at]
                 ox, oy = px - (c * lx - s * ly), py - (s * lx + c * ly)
+                base, (ax, ay) = rel[at]
+                rx, ry = ax - (c * lx - s * ly), ay - (s * lx + c * ly)
             self.frames[lname] = (ox, oy, th)
             for p, (lx, ly) in loc.items():
                 w = (ox + c * lx - s * ly, oy + s * lx + c * ly)
                 if p == at:
                     continue
+                off = (rx + c * lx - s * ly, ry + s * lx + c * ly)
                 if p in self.points:  # loop closure: both bodies put p at the same place
-                    eqs += [w[0] - self.points[p][0], w[1] - self.points[p][1]]
+                    eqs += self._closure(base, off, *rel[p])
                 else:
-                    self.points[p] = w
+                    self.points[p], rel[p] = w, (base, off)
         self.slide_s = {}
         for sl in m.slides:
             ox, oy, th = self.frames[sl.along]
@@ -127,6 +138,14 @@ class Symbolic:
                 eqs.append(self.slide_s[i.target] - self.u[k])
         self.angles = {lk.name: self.frames[lk.name][2] for lk in m.links}
         self._finish(qs, eqs)
+
+    def _closure(self, base_a, off_a, base_b, off_b) -> list:
+        """Both coordinates of (a - b) for points a, b given as (ground point or None for the
+        origin, vector from it): (B_a - B_b) + (off_a - off_b)."""
+        at = lambda b, i: ca.SX(0) if b is None else self.points[b][i]
+        if base_a == base_b:
+            return [off_a[i] - off_b[i] for i in range(2)]
+        return [(at(base_a, i) - at(base_b, i)) + (off_a[i] - off_b[i]) for i in range(2)]
 
     def _finish(self, qs, eqs):
         """The unknowns q and residual g from their lists, g's Jacobians and the Functions
