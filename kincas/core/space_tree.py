@@ -1,0 +1,86 @@
+"""The spatial model's tree reduction (docs/spatial.md, "Formulation"): which rigid body hangs
+on which revolute (cylindrical, prismatic) joint of an already placed body, so that it takes
+that joint's coordinates as its unknowns (angle; angle and s; s), or none where inputs drive
+them, instead of a reference point and a quaternion.
+
+Order, deterministic: the ground is placed; then, repeated until nothing changes, each rigid
+body not yet placed (in declaration order) that shares a revolute, cylindrical or prismatic
+joint with a placed body hangs on it and is placed; among several such joints, one driven by an input first, else the
+first declared. Where nothing more hangs, the first body left (declaration order) floats
+(its 7 unknowns) and is placed, and the hanging resumes from it. A body's other joints to
+placed bodies stay equations: they close the loops. Bars carry no axis joint: never placed.
+
+The hanging joint's angle keeps its convention, the rotation of its second body relative to
+its first about the axis a (in the first body's axes, equal to global ones at the drawing pose
+where every orientation is the identity): with h = (cos(theta/2), sin(theta/2) a), the second
+body's quaternion is e1 (x) h when the first is the parent, e2 (x) conj(h) gives the first's
+when the second is. A slide s along the axis moves the joint's point along the first body's
+line (the point drawn on the second body): X = X1 + s R1 a.
+
+>>> from kincas import SpatialMechanism, Body, Joint, Input
+>>> m = SpatialMechanism(ground={"A": (0, 0, 0), "D": (4, 0, 0)},
+...     bodies=[Body("crank", {"A": (0, 0, 0), "B": (1, 0, 0)}), Body.bar("coupler", "B", "C", 4.5),
+...             Body("rocker", {"D": (4, 0, 0), "C": (4, 0, 3)})],
+...     joints=[Joint("revolute", "A", axis=(0, 0, 1)), Joint("revolute", "D", axis=(1, 0, 0))],
+...     inputs=[Input.joint("A")])
+>>> [(b, h.joint, h.parent, h.driven) for b, h in placement(m)]
+[('crank', 'A', 'ground', 0), ('rocker', 'D', 'ground', None)]
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..model.mobility import GROUND
+
+HANGING = ("revolute", "cylindrical", "prismatic")  # the joints a body hangs on
+
+
+@dataclass(frozen=True)
+class Hang:
+    """How a body hangs: on `joint` (of `type`) of the placed body `parent` (the joint's
+    first body when `parent_first`), its angle the input numbered `driven` and its slide `s`
+    the input numbered `driven_s` (None: an unknown; a revolute has no s, a prismatic joint
+    no angle)."""
+
+    joint: str
+    parent: str
+    parent_first: bool
+    point: str
+    driven: int | None
+    type: str = "revolute"
+    driven_s: int | None = None
+
+
+def placement(m) -> list[tuple[str, Hang | None]]:
+    """Every rigid body in the order the model places it, with how it hangs (None: it
+    floats, with its reference point and quaternion as unknowns). Module text."""
+    rigid = [b.name for b in m.bodies if not b.two_point]
+    driven = {i.target: k for k, i in enumerate(m.inputs) if i.kind == "joint"}
+    links = []  # (joint, first body, second body) of every joint a body may hang on
+    for j in m.joints:
+        if j.type in HANGING:
+            b1, b2 = m.joint_bodies(j)
+            links.append((j, b1, b2))
+    placed, out = {GROUND}, []
+    while len(out) < len(rigid):
+        changed = True
+        while changed:
+            changed = False
+            for b in rigid:
+                if b in placed:
+                    continue
+                cands = [(j, b1 if b == b2 else b2, b == b2) for j, b1, b2 in links
+                         if b in (b1, b2) and b1 != b2 and (b1 if b == b2 else b2) in placed]
+                if not cands:
+                    continue
+                j, parent, first = min(cands, key=lambda c: not any(  # stable: driven first
+                    f"{c[0].name}.{k}" in driven for k in ("angle", "s")))
+                out.append((b, Hang(j.name, parent, first, j.point, driven.get(f"{j.name}.angle"), j.type,
+                                    driven.get(f"{j.name}.s"))))
+                placed.add(b)
+                changed = True
+        rest = [b for b in rigid if b not in placed]
+        if rest:
+            out.append((rest[0], None))
+            placed.add(rest[0])
+    return out
