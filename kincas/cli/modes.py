@@ -126,8 +126,9 @@ def _print_modes(sc, modes, user_in, user_ang, args):
                + (f" ({box['flag']})" if box["flag"] else "") + (f"; {box['note']}" if "note" in box else "")
                if box else "")
         print(f"\nmode {k} of {n}: residual {md.residual:.1e}, orientation {md.orientation:+d}{box}{mark}")
-        print("  angles: " + ", ".join(f"{lk} {a:.6g}" for lk, a in ang.items())
-              + f" {units.get('angle', 'deg')}")
+        if ang:  # (a mechanism of bars and points alone has no angle to show)
+            print("  angles: " + ", ".join(f"{lk} {a:.6g}" for lk, a in ang.items())
+                  + f" {units.get('angle', 'deg')}")
         print(md.guess_block(), end="")
     if getattr(modes, "positive_dimension", False):
         print("infinitely many assemblies at this pose: a link is free to turn (no finite list)")

@@ -41,6 +41,8 @@ def scale_of(name: str, scene, sweep) -> float:
         kind, obj, attr = parse_quantity(name)
     except Exception:  # a quantity kind this module does not know
         return 0.0
+    if name.startswith("shaking."):  # a force or moment (not a position named x, y, z)
+        return 0.0
     L = _size(scene)
     if kind == "sens":
         return scale_of(obj, scene, sweep) / L if L > 0 else 0.0
