@@ -24,7 +24,7 @@ CARDAN = EXAMPLES / "space_double_cardan.toml"
 
 def rotations(md, body, m):
     """The body's rotation matrix at the mode, read as its quantities L.R11 .. L.R33 (a body
-    hung on a revolute has no quaternion among the unknowns: kincas/core/space_tree.py)."""
+    hung on a revolute has no quaternion among the unknowns: kincas/model/space_tree.py)."""
     model = kincas.model_of(m)
     names = tuple(f"{body}.R{i}{k}" for i in (1, 2, 3) for k in (1, 2, 3))
     u = np.array([[md.inputs[i.key] for i in m.inputs]])

@@ -1,4 +1,4 @@
-"""The spatial model's tree reduction (kincas/core/space_tree.py, docs/spatial.md): a body hung
+"""The spatial model's tree reduction (kincas/model/space_tree.py, docs/spatial.md): a body hung
 on a revolute of a placed body has the joint's angle as its one unknown (none where an input
 drives it). Counts as the mechanisms say; a planar four-bar drawn in a tilted plane (no axis
 a coordinate axis), far from the origin and tiny, against its closed form through three

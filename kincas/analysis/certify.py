@@ -158,7 +158,7 @@ def certify_modes(m: Mechanism, inputs=None, *, threads: int = 1,
         halfwidth = max((P.subs(value).spread(box) for xy in S.points.values() for P in xy), default=0.0)
         md = mode_at(m_r, model, q, u_r, p, L, picked, kind=CertifiedMode, halfwidth=halfwidth, note=note)
         # a root that breaks an equation the numerical model holds by construction (a spatial
-        # body hung on its joint: kincas/core/space_tree.py) is off its unknowns' map
+        # body hung on its joint: kincas/model/space_tree.py) is off its unknowns' map
         off = S.off_model(c) if S.off_model is not None else 0.0
         off = off if off > ACCEPT + CERTIFY_OFF_MODEL * S.perturbation else 0.0
         if max(md.residual, off) > ACCEPT:  # the rule for an assembly (every real root should pass)

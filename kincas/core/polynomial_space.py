@@ -27,7 +27,7 @@ The scene's numbers enter as the shortest decimals of their floats (`exact`: wha
 wrote; small coefficients make msolve several times faster than the floats' dyadic rationals).
 
 The system keeps every body's (r, R), whatever the numerical model's tree reduction
-(kincas/core/space_tree.py: a body hung on a revolute has its joint angle as its unknown
+(kincas/model/space_tree.py: a body hung on a revolute has its joint angle as its unknown
 there). A solution maps back to kincas's unknowns through the model's map from the bodies'
 poses (`unknowns_from_poses`, kincas/core/space_model.py): a floating body's r as it is, e
 from R (Shepperd's method) with qw >= 0; a hung body's angle from its rotation relative to its

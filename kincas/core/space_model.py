@@ -26,7 +26,7 @@ import numpy as np
 
 from ..model.mobility import GROUND
 from .quaternions import rotation
-from .space_tree import placement
+from ..model.space_tree import placement
 from .tolerances import IDENTITY_PULL, TINY
 
 
@@ -124,7 +124,7 @@ class SpatialFirstPose:
 
     def _placing(self):
         """What `initial_q` reads of the structure, once per model: per rigid body, in the
-        order the model places it (kincas/core/space_tree.py), its name, point names, how it
+        order the model places it (kincas/model/space_tree.py), its name, point names, how it
         hangs (None: it floats) and where its unknowns sit in q (a floating body's r and e;
         a hung body's coordinates that are unknowns, by name); per point only bars carry,
         where its coordinates sit; whether any input drives a joint."""

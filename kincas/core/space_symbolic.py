@@ -5,7 +5,7 @@ Formulation (docs/spatial.md): absolute coordinates with unit quaternions, reduc
 tree of revolutes from the ground. A floating rigid body has unknowns r (3, its reference
 point: at the drawing pose the centroid c of its drawn points) and e = (w, x, y, z) (4), with
 e.e - 1 = 0; its point P (drawn at P0) is r + R(e) (P0 - c), R(e) the quadratic rotation
-matrix of e. A body hung on a revolute of an already placed body (kincas/core/space_tree.py)
+matrix of e. A body hung on a revolute of an already placed body (kincas/model/space_tree.py)
 has one unknown instead, the joint's angle theta (the input where one drives it: none), with
 e = e_parent (x) (cos(theta/2), sin(theta/2) a) and r the joint's point where the parent
 carries it (c its drawn position): its norm, the joint's point and axis equations hold
@@ -53,7 +53,7 @@ from ..model.mobility import GROUND
 from ..model.names import parse_quantity
 from ..model.space_names import BODY_Q, POINT_Q3, SLIDE_Q, joint_attrs
 from ..model.space_parts import ON_SECOND
-from .space_tree import placement
+from ..model.space_tree import placement
 from .quaternions import apply, apply_t, conj, cross, dot, qmul, rotation  # noqa: F401
 from .symbolic import Symbolic
 from .tolerances import PROJECTION
@@ -123,7 +123,7 @@ class SpatialSymbolic(Symbolic):
                 r = [new(f"{name}.r{a}", "length") for a in "xyz"]
                 e = [new(f"{name}.q{a}", "quaternion") for a in "wxyz"]
                 eqs.append(Ls * (dot(e[1:], e[1:]) + e[0] * e[0] - 1))
-            else:  # hung on a placed body's joint: its coordinates only (kincas/core/space_tree.py)
+            else:  # hung on a placed body's joint: its coordinates only (kincas/model/space_tree.py)
                 r, e, c = self._hang(hang, loc, new)
             self.frames[name] = (r, e, c)
             for p, P0 in loc.items():
@@ -169,7 +169,7 @@ class SpatialSymbolic(Symbolic):
         self._finish(qs, eqs)
 
     def _hang(self, hang, loc, new):
-        """(r, e, c) of a body hung on a placed body's joint (kincas/core/space_tree.py), its
+        """(r, e, c) of a body hung on a placed body's joint (kincas/model/space_tree.py), its
         coordinates the inputs driving them, else unknowns (in `self.hung` by name):
         e = e_parent (x) h (conj(h) when the parent is the joint's second body), h =
         (cos(theta/2), sin(theta/2) a) for a revolute or cylindrical joint, e = e_parent for a

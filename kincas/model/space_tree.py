@@ -17,20 +17,22 @@ body's quaternion is e1 (x) h when the first is the parent, e2 (x) conj(h) gives
 when the second is. A slide s along the axis moves the joint's point along the first body's
 line (the point drawn on the second body): X = X1 + s R1 a.
 
+An arm on a driven ground revolute, a link on the arm whose joint names the link first (its
+parent is the joint's second body) and a second input:
+
 >>> from kincas import SpatialMechanism, Body, Joint, Input
->>> m = SpatialMechanism(ground={"A": (0, 0, 0), "D": (4, 0, 0)},
-...     bodies=[Body("crank", {"A": (0, 0, 0), "B": (1, 0, 0)}), Body.bar("coupler", "B", "C", 4.5),
-...             Body("rocker", {"D": (4, 0, 0), "C": (4, 0, 3)})],
-...     joints=[Joint("revolute", "A", axis=(0, 0, 1)), Joint("revolute", "D", axis=(1, 0, 0))],
-...     inputs=[Input.joint("A")])
->>> [(b, h.joint, h.parent, h.driven) for b, h in placement(m)]
-[('crank', 'A', 'ground', 0), ('rocker', 'D', 'ground', None)]
+>>> m = SpatialMechanism(ground={"O": (0, 0, 0)},
+...     bodies=[Body("arm", {"O": (0, 0, 0), "K": (1, 0, 0)}), Body("link", {"K": (1, 0, 0), "P": (2, 0, 0)})],
+...     joints=[Joint("revolute", "O", axis=(0, 0, 1)), Joint("revolute", "K", axis=(0, 1, 0), bodies=("link", "arm"))],
+...     inputs=[Input.joint("O"), Input.joint("K")])
+>>> [(b, h.joint, h.parent, h.parent_first, h.driven) for b, h in placement(m)]
+[('arm', 'O', 'ground', True, 0), ('link', 'K', 'arm', False, 1)]
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..model.mobility import GROUND
+from .mobility import GROUND
 
 HANGING = ("revolute", "cylindrical", "prismatic")  # the joints a body hangs on
 
@@ -84,3 +86,27 @@ def placement(m) -> list[tuple[str, Hang | None]]:
             out.append((rest[0], None))
             placed.add(rest[0])
     return out
+
+
+def solved_unknowns(m) -> int:
+    """The size of the spatial model's q, from the declarations (no model built): 7 per
+    floating body, a hung body's joint coordinates that no input drives, 3 per point only
+    bars carry.
+
+    >>> from kincas import SpatialMechanism, Body, Joint, Input
+    >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (2, 0, 0)})],
+    ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+    >>> solved_unknowns(m)
+    0
+    """
+    n = 0
+    for _, hang in placement(m):
+        if hang is None:
+            n += 7
+            continue
+        n += (hang.type != "prismatic" and hang.driven is None) + (hang.type != "revolute" and hang.driven_s is None)
+    exempt = m.exempt()
+    carried = {p for b in m.bodies if not b.two_point for p in b.point_names}
+    carried |= {g for g, _ in m.ground if (g, GROUND) not in exempt}
+    return n + 3 * sum(p not in carried for p in m.moving_points)
+
