@@ -85,9 +85,17 @@ def test_unknowns_and_equations_after_the_reduction():
     from kincas.cli.scene import load
     from conftest import EXAMPLES
     m = load(EXAMPLES / "space_double_cardan.toml").mechanism
-    names, ng, red = counts(m)  # the shafts hang on their revolutes; the middle shaft floats
-    assert names == ["out.angle"] + [f"mid.{c}" for c in ("rx", "ry", "rz", "qw", "qx", "qy", "qz")]
-    assert (ng, red) == (1 + 3 + 3 + 1 + 1, 1)  # norm, O1, O2, the two crosses; one redundant
+    # the shafts hang on their revolutes; the middle shaft on the input's cross at O1 (a ball:
+    # its rotation only): its norm, the point O2, the two crosses; one redundant
+    assert counts(m) == (["out.angle"] + [f"mid.{c}" for c in ("qw", "qx", "qy", "qz")], 1 + 3 + 1 + 1, 1)
+    # the suspension: the wishbones on their revolutes (the lower one driven), the upright on
+    # the lower's ball LB: the upper's ball UB (3) and the tie rod (1) close it, with the norm
+    m = load(EXAMPLES / "space_suspension.toml").mechanism
+    assert counts(m) == (["UA.angle"] + [f"upright.{c}" for c in ("qw", "qx", "qy", "qz")], 3 + 1 + 1, 0)
+    from kincas.model.mobility import solved_unknowns
+    for f in sorted(EXAMPLES.glob("space_*.toml")):  # the declarations' count is the model's
+        m = load(f).mechanism
+        assert solved_unknowns(m) == kincas.model_of(m).nq, f.name
 
 
 @pytest.mark.parametrize("scale, offset", [(1.0, (1e6, -2e6, 3e5)), (1e-6, (3e-6, 1e-6, -2e-6))])

@@ -135,6 +135,8 @@ class SpatialFirstPose:
             for name, hang in placement(m):
                 if hang is None:
                     slots = ([index[f"{name}.r{a}"] for a in "xyz"], [index[f"{name}.q{a}"] for a in "wxyz"])
+                elif hang.type == "ball":
+                    slots = {"e": [index[f"{name}.q{a}"] for a in "wxyz"]}
                 else:
                     slots = {k: index[f"{hang.joint}.{k}"] for k in ("angle", "s") if f"{hang.joint}.{k}" in index}
                 bodies.append((name, m.link(name).point_names, hang, slots))
@@ -188,7 +190,15 @@ class SpatialFirstPose:
         the joint's axis a nearest its fitted rotation relative to its parent's placed one
         (R1' R2 = Rot(a, theta)) and its fitted point's distance along the first body's
         line; its pose then set from the parent's (a revolute's point where the parent
-        carries it, a slide's moved along the line by s)."""
+        carries it, a slide's moved along the line by s). A body on a ball keeps its fitted
+        rotation ({"e": its quaternion}), its point where the parent carries it."""
+        if hang.type == "ball":
+            rp, Rp, cp = pose[hang.parent]
+            _, R, c = pose[name]
+            X = gv[hang.point] if hang.parent == GROUND else \
+                rp + Rp @ (drawn[hang.parent][m.link(hang.parent).point_names.index(hang.point)] - cp)
+            pose[name] = (X - R @ (drawn[name][names.index(hang.point)] - c), R, c)
+            return {"e": quat_of(R)}
         j = m.joint(hang.joint)
         a = np.asarray(j.axis, float)
         rp, Rp, cp = pose[hang.parent]
@@ -289,8 +299,9 @@ class SpatialFirstPose:
         q = np.zeros(self.nq)
         for name, hang in placement(m):
             r, R = poses[name]
-            if hang is None:
-                q[[index[f"{name}.r{a}"] for a in "xyz"]] = r
+            if hang is None or hang.type == "ball":  # (on a ball: its rotation only)
+                if hang is None:
+                    q[[index[f"{name}.r{a}"] for a in "xyz"]] = r
                 q[[index[f"{name}.q{a}"] for a in "wxyz"]] = quat_of(R)
                 continue
             j = m.joint(hang.joint)

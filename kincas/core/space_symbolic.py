@@ -123,12 +123,16 @@ class SpatialSymbolic(Symbolic):
                 r = [new(f"{name}.r{a}", "length") for a in "xyz"]
                 e = [new(f"{name}.q{a}", "quaternion") for a in "wxyz"]
                 eqs.append(Ls * (dot(e[1:], e[1:]) + e[0] * e[0] - 1))
+            elif hang.type == "ball":  # on a placed point: its unit quaternion, r where the point is
+                e = [new(f"{name}.q{a}", "quaternion") for a in "wxyz"]
+                eqs.append(Ls * (dot(e[1:], e[1:]) + e[0] * e[0] - 1))
+                r, c = self._carried(hang), loc[hang.point]
             else:  # hung on a placed body's joint: its coordinates only (kincas/model/space_tree.py)
                 r, e, c = self._hang(hang, loc, new)
             self.frames[name] = (r, e, c)
             for p, P0 in loc.items():
-                if (p, name) in exempt or (hang is not None and hang.type == "revolute" and p == hang.point):
-                    continue  # a hanging revolute's point: where the parent carries it, identically
+                if (p, name) in exempt or (hang is not None and hang.type in ("revolute", "ball") and p == hang.point):
+                    continue  # a hanging revolute's or ball's point: where the parent carries it, identically
                 w = self.world(name, P0)
                 if p in self.points:  # a ball joint (or the point of a revolute, universal)
                     eqs += [w[i] - self.points[p][i] for i in range(3)]
@@ -186,9 +190,7 @@ class SpatialSymbolic(Symbolic):
             h = h if hang.parent_first else conj(h)
             e = h if hang.parent == GROUND else qmul(ep, h)
         if j.type == "revolute":
-            X = self.points[hang.point] if hang.parent == GROUND else \
-                self.world(hang.parent, self._rel(m.link(hang.parent).local(hang.point)))
-            return list(X), e, loc[hang.point]
+            return self._carried(hang), e, loc[hang.point]
         s = self.hung[f"{j.name}.s"] = coord("s", hang.driven_s, "length")
         owner = m.joint_bodies(j)[1]  # the point is drawn on the second body
         P0 = self._rel(dict(m.ground)[j.point] if owner == GROUND else m.link(owner).local(j.point))
@@ -196,6 +198,12 @@ class SpatialSymbolic(Symbolic):
         Ra = apply(rotation(ep), list(j.axis)) if hang.parent != GROUND else list(j.axis)
         sign = 1 if hang.parent_first else -1
         return [Xp[i] + sign * s * Ra[i] for i in range(3)], e, P0
+
+    def _carried(self, hang) -> list:
+        """Where the placed parent carries the point a body hangs on (relative coordinates)."""
+        if hang.parent == GROUND:
+            return list(self.points[hang.point])
+        return self.world(hang.parent, self._rel(self.mech.link(hang.parent).local(hang.point)))
 
     def ground_at(self, g: str) -> list:
         """Where ground point `g` is drawn, also where it is the anchor of a slide joint."""

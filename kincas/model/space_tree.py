@@ -6,8 +6,11 @@ them, instead of a reference point and a quaternion.
 Order, deterministic: the ground is placed; then, repeated until nothing changes, each rigid
 body not yet placed (in declaration order) that shares a revolute, cylindrical or prismatic
 joint with a placed body hangs on it and is placed; among several such joints, one driven by an input first, else the
-first declared. Where nothing more hangs, the first body left (declaration order) floats
-(its 7 unknowns) and is placed, and the hanging resumes from it. A body's other joints to
+first declared. Where nothing more hangs, the first body left (declaration order) that
+shares a point with a placed body (a ball: a spherical or universal joint, or a point merely
+shared) hangs on that point: its rotation stays unknown (quaternion and norm), its reference
+point is where the placed body carries the point (3 unknowns and 3 equations fewer); else the
+first body left floats (its 7 unknowns); either is placed and the hanging resumes from it. A body's other joints to
 placed bodies stay equations: they close the loops. Bars carry no axis joint: never placed.
 
 The hanging joint's angle keeps its convention, the rotation of its second body relative to
@@ -49,7 +52,7 @@ class Hang:
     parent_first: bool
     point: str
     driven: int | None
-    type: str = "revolute"
+    type: str = "revolute"  # or "cylindrical", "prismatic", "ball" (no joint: `joint` is "")
     driven_s: int | None = None
 
 
@@ -82,16 +85,36 @@ def placement(m) -> list[tuple[str, Hang | None]]:
                 placed.add(b)
                 changed = True
         rest = [b for b in rigid if b not in placed]
-        if rest:
+        ball = next(((b, hit) for b in rest for hit in [_ball(m, b, [GROUND] + [o for o, _ in out])] if hit), None)
+        if ball is not None:  # a ball on a placed point: its rotation only, the point where placed
+            (b, (parent, point)) = ball
+            out.append((b, Hang("", parent, True, point, None, "ball")))
+            placed.add(b)
+        elif rest:
             out.append((rest[0], None))
             placed.add(rest[0])
     return out
 
 
+def _ball(m, b, placed):
+    """(parent, point): the first point of body b (in its declaration order) that a placed
+    body carries (the ground first, then in placing order), neither copy exempt; None."""
+    exempt = m.exempt()
+    ground = {g for g, _ in m.ground}
+    for p in m.link(b).point_names:
+        if (p, b) in exempt:
+            continue
+        for o in placed:
+            has = p in ground if o == GROUND else p in m.link(o).point_names
+            if has and (p, o) not in exempt:
+                return o, p
+    return None
+
+
 def solved_unknowns(m) -> int:
     """The size of the spatial model's q, from the declarations (no model built): 7 per
-    floating body, a hung body's joint coordinates that no input drives, 3 per point only
-    bars carry.
+    floating body, 4 per body on a ball (its quaternion), a hung body's joint coordinates that no
+    input drives, 3 per point only bars carry.
 
     >>> from kincas import SpatialMechanism, Body, Joint, Input
     >>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (2, 0, 0)})],
@@ -101,8 +124,8 @@ def solved_unknowns(m) -> int:
     """
     n = 0
     for _, hang in placement(m):
-        if hang is None:
-            n += 7
+        if hang is None or hang.type == "ball":
+            n += 7 if hang is None else 4
             continue
         n += (hang.type != "prismatic" and hang.driven is None) + (hang.type != "revolute" and hang.driven_s is None)
     exempt = m.exempt()
