@@ -187,3 +187,71 @@ def test_a_parameter_input_with_a_plane_slide_and_a_point_of_bars(tmp_path, caps
     assert abs(r["from"] - lo) < 1e-9 and abs(r["to"] - hi) < 1e-9, r
     code, out, err = run_cli(capsys, "modes", scene)
     assert code == 0 and "angles:" not in out, out  # no angle to show: no empty "angles:" line
+
+
+def test_too_few_inputs_on_a_cylinder_listed_in_ground_says_the_count(tmp_path, capsys):
+    """A cylindrical joint has two freedoms; one input is one short. The count once held the
+    ground's copy of the point as a ball (3 equations): the declaration let it through and the
+    solver said '7 unknowns but 6 equations'. 7 unknowns (one body), 5 equations (its norm and
+    the joint's 4): 2 freedoms."""
+    scene = write_scene(tmp_path, CYLINDER.replace('[[inputs]]\njoint = "c.s"\nsweep = { from = 0.5, to = 2, steps = 4 }\n', ""))
+    code, _, err = run_cli(capsys, "solve", scene)
+    assert code == 2 and "Traceback" not in err, err
+    assert "[inputs]" in err and "2 degree(s) of freedom" in err and "1 input(s)" in err, err
+
+
+CARDAN = """
+title = "single Cardan joint, shafts at 30 deg, driven by the cross's angle"
+space = "3d"
+units = { length = "mm", angle = "deg", time = "s" }
+[ground]
+A = [0, 0, 0]
+[links]
+s1 = { points = { A = [0, 0, 0], K = [0, 0, 0], P = [-100, 0, 0] } }
+s2 = { points = { K = [0, 0, 0], Q = [86.60254037844386, 50, 0] } }
+[[joints]]
+type = "revolute"
+name = "in"
+point = "A"
+axis = [1, 0, 0]
+[[joints]]
+type = "universal"
+name = "x"
+point = "K"
+axes = [[0, 1, 0], [0, 0, 1]]
+[[joints]]
+type = "revolute"
+name = "out"
+point = "Q"
+axis = [0.8660254037844386, 0.5, 0]
+bodies = ["ground", "s2"]
+[[inputs]]
+joint = "x.angle1"
+sweep = { from = 0, to = 20, steps = 3 }
+rate = 2
+[output]
+report = ["in.angle", "out.angle", "x.angle1", "x.omega1"]
+"""
+
+
+def test_a_universal_joints_angle_as_input_is_in_degrees_everywhere(tmp_path, capsys):
+    """`joint = "x.angle1"` drives an angle: its values, rate and range are in the scene's
+    degrees (they were shown in radians, the range labelled mm). The cross turns about the
+    input yoke's axis by at most the shafts' angle: limits at -30 and 30 deg. The reported
+    x.angle1 equals the input, x.omega1 its rate."""
+    scene = write_scene(tmp_path, CARDAN)
+    code, out, err = run_cli(capsys, "solve", scene, "--json")
+    assert code == 0, err
+    assert np.allclose(out["inputs"]["x.angle1"], [0, 10, 20], atol=1e-12)
+    assert out["rates"]["x.angle1"] == 2
+    assert np.allclose(out["values"]["x.angle1"], [0, 10, 20], atol=1e-9)
+    assert np.allclose(out["values"]["x.omega1"], 2, atol=1e-9)
+    code, text, err = run_cli(capsys, "solve", scene)
+    assert code == 0 and "x.angle1 rate 2 deg/s" in text, text
+    assert text.splitlines()[4].split()[0] == "10", text
+    code, out, err = run_cli(capsys, "range", scene, "--json")
+    assert code == 0, err
+    r = out["ranges"]["x.angle1"]
+    assert abs(r["from"] + 30) < 1e-7 and abs(r["to"] - 30) < 1e-7, r
+    code, text, err = run_cli(capsys, "range", scene)
+    assert "deg" in text and "mm" not in text, text

@@ -19,6 +19,8 @@ import math
 
 import numpy as np
 
+from ..model.names import is_angle_name
+
 EPS = 1e-11  # relative to a quantity's scale: below it, a value is zero to the solve's accuracy
 
 
@@ -72,7 +74,7 @@ def _input_rates(scene, sweep, L: float) -> tuple[float, float]:
     that is a length counts as rate / L. At least 1: the scale must not vanish."""
     w = a = 0.0
     for k in sweep.inputs:
-        per = 1.0 if k.endswith(".angle") else (1.0 / L if L > 0 else 0.0)
+        per = 1.0 if is_angle_name(k) else (1.0 / L if L > 0 else 0.0)
         r = np.asarray(sweep.rates.get(k, 0.0), float)
         acc = np.asarray(sweep.accelerations.get(k, 0.0), float)
         w = max(w, float(np.nanmax(np.abs(r))) * per if r.size else 0.0)
