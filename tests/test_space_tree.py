@@ -242,3 +242,25 @@ def test_slider_crank_hangs_its_slider_on_the_prismatic_joint():
         Bh = lambda t: 40.0 * np.stack([np.cos(t), np.sin(t), 0 * t], 1)
         sh = lambda t: -((C0 - Bh(t)) @ d) + np.sqrt(((C0 - Bh(t)) @ d) ** 2 - ((C0 - Bh(t)) ** 2).sum(1) + L ** 2)
         assert np.abs(sw["slide.v"] - (sh(u + h) - sh(u - h)) / (2 * h)).max() < 1e-6
+
+
+def test_a_revolute_whose_point_the_ground_lacks_is_not_hung_on():
+    # a single Cardan joint whose output revolute names the ground although the ground has no
+    # point Q (it holds the output shaft's axis only, tests/test_space_acceptance.py): the
+    # output shaft is not hung on it but on the cross's ball K: its quaternion and norm, the
+    # revolute's axis (2) and the cross (1); the input shaft on its revolute A
+    m = SpatialMechanism(
+        ground={"A": (0, 0, 0)},
+        bodies=[Body("s1", {"A": (0, 0, 0), "K": (0, 0, 0), "P": (-100, 0, 0)}),
+                Body("s2", {"K": (0, 0, 0), "Q": (86.60254037844386, 50, 0)})],
+        joints=[Joint("revolute", "A", axis=(1, 0, 0), name="in"),
+                Joint("universal", "K", axes=((0, 1, 0), (0, 0, 1)), name="x"),
+                Joint("revolute", "Q", axis=(0.8660254037844386, 0.5, 0), bodies=("ground", "s2"), name="out")],
+        inputs=[Input.joint("in")])
+    model = kincas.model_of(m)
+    assert model.unknown_names == ["s2.qw", "s2.qx", "s2.qy", "s2.qz"] and model.sym.ng == 4
+    # Cardan: tan(out) = tan(in) / cos(beta), beta = 30 deg between the shafts
+    th = np.linspace(-1.2, 1.2, 9)
+    sw = kincas.sweep(m, {"in.angle": th}, report=["out.angle"])
+    assert sw.ok.all()
+    assert np.abs(wrap(np.tan(sw["out.angle"]) - np.tan(th) / math.cos(math.radians(30)))).max() < 1e-10

@@ -8,7 +8,9 @@ SVD of sum b_i a_i', with det R = +1), which is the drawing pose itself where no
 guessed; a point only bars carry starts at its guess. Then each input on a joint's angle or
 translation turns or moves that joint's second body, about the joint's axis through its
 point, by the difference between the input and the coordinate at the fitted pose, so that
-Newton starts near the driven pose rather than a whole input away from it.
+Newton starts near the driven pose rather than a whole input away from it. A body hung on a
+joint (kincas/model/space_tree.py) then takes, in placing order, the input or the coordinate
+of its fit relative to its parent's placed pose, and its pose from its parent's.
 
 >>> import numpy as np
 >>> from kincas import SpatialMechanism, Body, Joint, Input, model_of

@@ -65,7 +65,10 @@ def placement(m) -> list[tuple[str, Hang | None]]:
     for j in m.joints:
         if j.type in HANGING:
             b1, b2 = m.joint_bodies(j)
-            links.append((j, b1, b2))
+            # a revolute's point on both bodies, a slide's on its second (one whose point a body
+            # lacks holds by its axis only: its equations stay)
+            if _carries(m, b2, j.point) and (j.type != "revolute" or _carries(m, b1, j.point)):
+                links.append((j, b1, b2))
     placed, out = {GROUND}, []
     while len(out) < len(rigid):
         changed = True
@@ -96,17 +99,20 @@ def placement(m) -> list[tuple[str, Hang | None]]:
     return out
 
 
+def _carries(m, body, point) -> bool:
+    """Whether `body` (or the ground) has `point` among its drawn points."""
+    return any(g == point for g, _ in m.ground) if body == GROUND else point in m.link(body).point_names
+
+
 def _ball(m, b, placed):
     """(parent, point): the first point of body b (in its declaration order) that a placed
     body carries (the ground first, then in placing order), neither copy exempt; None."""
     exempt = m.exempt()
-    ground = {g for g, _ in m.ground}
     for p in m.link(b).point_names:
         if (p, b) in exempt:
             continue
         for o in placed:
-            has = p in ground if o == GROUND else p in m.link(o).point_names
-            if has and (p, o) not in exempt:
+            if _carries(m, o, p) and (p, o) not in exempt:
                 return o, p
     return None
 
