@@ -5,8 +5,8 @@ its variables, the user's expressions in them, the max()/min() samples and the I
 Variables: the varied parameters (scaled by their size), the unknowns q_k at every sample
 (lengths divided by the mechanism's size), and for each max()/min() an extra sample (q*, u*).
 Equality constraints: g(q_k, u_k, p) / L = 0 at every sample; at an extra sample also its
-closure and dE/du = 0. Inequalities: sign_k det(g_q(q_k)) >= 0, which keeps every sample on
-the initial design's assembly branch (and off singular positions); then the user's
+closure and dE/du = 0. Inequalities: s_kb det(B_b(q_k)) >= 0 for each Assur group's block B_b of
+g_q, which keeps every sample on the initial design's assembly branch (and off singular positions); then the user's
 constraints. Everything is one CasADi SX graph, so IPOPT gets exact gradients and Hessians.
 
 >>> SampledNLP.solve.__doc__.split(".")[0]
@@ -192,17 +192,22 @@ class SampledNLP:
             G.append(g)
             lbg.append(np.full(g.numel(), a))
             ubg.append(np.full(g.numel(), b))
-        # The branch is kept at every sample: det(g_q) keeps the initial design's sign there
-        # (a polynomial in q, so its derivatives are exact too; it also keeps the samples off
-        # singular positions, where det(g_q) = 0).
+        # The branch is kept at every sample: each Assur group's block of g_q keeps the sign
+        # its determinant has on the initial design (a polynomial in q, so its derivatives are
+        # exact; it also keeps the samples off singular positions, where it is 0). Group by
+        # group, as sweeps tell branches: det(g_q) of the whole would miss two groups flipping
+        # together, and expanding it symbolically grows with the whole system (a suspension's
+        # 21 x 21: a minute to build, another for IPOPT's derivatives) where the groups are small.
         poses = [(self.Q[:, k], self.u_at(k), self.ref[k]) for k in range(K)]
         poses += [(e["x"][0] * ca.DM(self.qs), e["x"][1], e["sign"]) for e in ext]
+        dets = self.model.memo("nlp.group_determinants", lambda: group_determinants(self.model))
         for q, u, sign in poses:
-            if sign and sym.nq:
-                J = sym.f_resjac(q, u, self.P)[1] * ca.repmat(ca.DM(self.qs).T, sym.nq, 1) / self.L
-                G.append(sign * ca.det(J))
-                lbg.append(np.zeros(1))
-                ubg.append(np.full(1, np.inf))
+            for s, (fdet, cols_b) in zip(sign, dets):
+                if s:  # (0: a tall group, or a sample that did not assemble)
+                    scale = float(np.prod(self.qs[cols_b] / self.L))  # columns O(1), as in Newton
+                    G.append(s * scale * fdet(q, u, self.P))
+                    lbg.append(np.zeros(1))
+                    ubg.append(np.full(1, np.inf))
         self.n_fixed = sum(np.size(b) for b in lbg)  # closure, extremes, branch rows
         self.row_sizes = [g.numel() for _, (_, g) in rows]
         for c, (_, g) in rows:
@@ -222,3 +227,47 @@ class SampledNLP:
         f0 = float(fg(x0)[0][0])
         return self.check(np.asarray(out["x"]).ravel(), fg, f0, rows, stats, check_path)
 
+
+
+def group_determinants(model) -> list:
+    """Per Assur group of g_q: (det of its block as a Function of (q, u, p), its columns); None
+    for a tall group. Built once per model; every sample calls it."""
+    sym, out = model.sym, []
+    for b in model.blocks:
+        if b.rows.size != b.cols.size:
+            out.append((None, b.cols))
+            continue
+        d = determinant(sym.Jq[b.rows.tolist(), b.cols.tolist()])
+        out.append((ca.Function("group_det", [sym.q, sym.u, sym.p], [d]), b.cols))
+    return out
+
+
+def determinant(M):
+    """det(M) of a square SX matrix, expanded along its rows with every minor built once: the
+    minor on the last k rows and a set S of k columns is
+        D(S) = sum over j in S of (-1)^(number of columns of S before j) M[n-k, j] D(S - {j}),
+    so at most n 2^n products, far fewer where M is sparse (a zero entry or minor is skipped).
+    A polynomial in M's entries (no division: exact derivatives, no pole where a pivot
+    vanishes). CasADi's own SX det expands without sharing minors: a 12 x 12 block of a
+    suspension took seconds per sample and a graph IPOPT's Hessian could hardly build.
+
+    >>> import casadi as ca
+    >>> x = ca.SX.sym("x", 3)
+    >>> M = ca.vertcat(ca.horzcat(x[0], 1, 0), ca.horzcat(2, x[1], 0), ca.horzcat(0, 0, x[2]))
+    >>> ca.Function("d", [x], [determinant(M)])([1, 3, 5])  # (1 * 3 - 2) * 5
+    DM(5)
+    """
+    n = M.shape[0]
+    minors = {0: ca.SX(1)}  # a set of columns as a bit mask -> its minor on the last rows
+    for k in range(1, n + 1):
+        row, nxt = n - k, {}
+        for S, d in minors.items():
+            for j in range(n):
+                if S >> j & 1 or M[row, j].is_zero():
+                    continue
+                T = S | 1 << j
+                before = bin(T & ((1 << j) - 1)).count("1")  # columns of T left of j
+                term = M[row, j] * d if before % 2 == 0 else -(M[row, j] * d)
+                nxt[T] = nxt[T] + term if T in nxt else term
+        minors = nxt
+    return minors.get((1 << n) - 1, ca.SX(0))

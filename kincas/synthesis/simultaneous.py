@@ -117,8 +117,9 @@ class Problem(Checks, SampledNLP):
         angle = ~model.is_length
         Q0[:, angle] = wrap_angle(Q0[:, angle])  # expressions see angles as reported
         self.Q0, self.initial_status = Q0, list(sw0.status)
-        self.ref = np.array([self.sign(Q0[k], self.U[k], self.p0) if ok[k] else 0.0
-                             for k in range(K)])
+        none = np.zeros(len(self.model.blocks))
+        self.ref = np.array([self.sign(Q0[k], self.U[k], self.p0) if ok[k] else none
+                             for k in range(K)]).reshape(K, -1)
         self.make_sample_unknowns()
         self.make_path()
         self._dense0 = None
@@ -148,11 +149,14 @@ class Problem(Checks, SampledNLP):
         """The input at sample k: a number, or the variable when the inputs are fitted."""
         return self.U[k] if self.Uv is None else self.Uv[k] * self.us
 
-    def sign(self, q, u, p) -> float:
-        """Sign of det(g_q) with columns scaled to O(1): it tells the assembly branch."""
-        if not self.model.nq:
-            return 1.0
-        return float(np.sign(np.linalg.det(self.model.jac(q, u, p) * (1.0 / self.qs))))
+    def sign(self, q, u, p) -> np.ndarray:
+        """Per Assur group (`model.blocks`), the sign of its block's determinant: the assembly
+        branch group by group, as sweeps tell it (two groups flipping together keep det(g_q)'s
+        sign but are another assembly). 0 for a tall group (redundant joints: no determinant;
+        the rank rules keep it)."""
+        J = self.model.jac(q, u, p)
+        return np.array([np.sign(np.linalg.det(J[np.ix_(b.rows, b.cols)])) if b.rows.size == b.cols.size
+                         else 0.0 for b in self.model.blocks])
 
     def dense(self, mech, guess=None):
         U, Ud, Udd = self.path
@@ -183,7 +187,7 @@ class Problem(Checks, SampledNLP):
             if not sol.ok:
                 problems.append(f"sample {k + 1}: the optimised design does not assemble "
                                 f"(residual {sol.residual:.2g} of its size)")
-            elif self.ref[k] and self.sign(sol.q, self.U[k], p) != self.ref[k]:
+            elif self.ref[k].any() and np.any(self.sign(sol.q, self.U[k], p) != self.ref[k]):
                 problems.append(f"sample {k + 1}: the optimised design is on another assembly "
                                 f"branch than the initial one")
         xs = [x[:nv], (Q / self.qs).ravel(), *([self.U[:, 0] / self.us] if self.Uv is not None else [])]
