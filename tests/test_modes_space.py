@@ -18,15 +18,18 @@ import kincas
 import kincas.cli.scene
 from conftest import EXAMPLES, run_cli
 from kincas.analysis.modes import find_modes
-from kincas.core.space_model import rot_of
 
 CARDAN = EXAMPLES / "space_double_cardan.toml"
 
 
-def rotations(md, body):
-    k = md.unknowns.index(f"{body}.qw")
-    e = np.asarray(md.q[k:k + 4], float)
-    return rot_of(e / np.linalg.norm(e))
+def rotations(md, body, m):
+    """The body's rotation matrix at the mode, read as its quantities L.R11 .. L.R33 (a body
+    hung on a revolute has no quaternion among the unknowns: kincas/model/space_tree.py)."""
+    model = kincas.model_of(m)
+    names = tuple(f"{body}.R{i}{k}" for i in (1, 2, 3) for k in (1, 2, 3))
+    u = np.array([[md.inputs[i.key] for i in m.inputs]])
+    p = np.array([v for _, v in m.parameters], float)
+    return model.quantities(names, np.asarray(md.q, float)[None], u, p, 0 * u, 0 * u)[:, 0].reshape(3, 3)
 
 
 def test_double_cardan_four_modes_told_apart_by_orientation():
@@ -37,7 +40,7 @@ def test_double_cardan_four_modes_told_apart_by_orientation():
     d /= np.linalg.norm(d)
     seen = set()
     for md in found:
-        Rm, Ro = rotations(md, "mid"), rotations(md, "shaft_out")
+        Rm, Ro = rotations(md, "mid", m), rotations(md, "shaft_out", m)
         # the independent answer: R_mid a rotation by 0 or pi about d, R_out by 0 or pi about x
         phi = next(a for a in (0.0, np.pi) if np.allclose(Rm, kincas.core.space_model.axis_rotation(d, a), atol=1e-9))
         psi = next(a for a in (0.0, np.pi) if np.allclose(Ro, kincas.core.space_model.axis_rotation([1, 0, 0], a), atol=1e-9))

@@ -63,23 +63,22 @@ def test_tall_block_sigma_bounds_the_smallest_singular_value():
 
 def test_spatial_watch_measure_is_scale_free_and_ignores_equation_factors():
     # A quaternion's norm equation (2 L e) and a revolute's axis equations carry factors of
-    # their own: a group of two quaternion unknowns of the RSSR measured 0.5 at every pose
-    # (a regular group at the WATCH border). The watch measure scales each block's columns
-    # and rows to unit length: independent of the unknowns' units and of L, above
-    # WATCH for that group at every pose (not watched), 0 where the block is singular.
+    # their own: the suspension's group (the upper wishbone's angle, the upright's r and e)
+    # measures ~0.1 at every pose (the RSSR's quaternion group measured 0.5 before the tree
+    # reduction). The watch measure scales each block's columns and rows to unit length:
+    # independent of the unknowns' units and of L, above the raw measure, 0 where the block
+    # is singular.
     from kincas.analysis.continuation import watch_conditioning
     from kincas.core.assembly import modes
-    from kincas.core.tolerances import WATCH
-    from test_space import rssr
-    m = rssr()
+    m = load(EXAMPLES / "space_suspension.toml").mechanism
     model = kincas.model_of(m)
-    th = np.linspace(0, 2 * np.pi, 13)
-    sw = kincas.sweep(m, {"A.angle": th}, report=["C.x"], method="careful")
+    th = np.radians(np.linspace(-8, 8, 9))
+    sw = kincas.sweep(m, {m.inputs[0].key: th}, report=["W.x"], method="careful")
     p = np.array([v for _, v in m.parameters], float)
     J = np.array([model.jac(q, np.array([t]), p) for q, t in zip(sw.q, th)])
     w = watch_conditioning(model, J, m.size())
-    quat = [i for i, b in enumerate(model.blocks) if len(b.cols) == 2]
-    assert np.allclose(modes(model, J, m.size())[1][:, quat], 0.5) and (w[:, quat] > WATCH).all()
+    quat = [i for i, b in enumerate(model.blocks) if "quaternion" in [model.unknown_kinds[j] for j in b.cols]]
+    assert quat and (w[:, quat] > 2 * modes(model, J, m.size())[1][:, quat]).all()
     rng = np.random.default_rng(5)
     Jr = J * rng.uniform(0.1, 10, size=(1, 1, J.shape[2]))  # other units for the unknowns, another L
     assert np.allclose(watch_conditioning(model, Jr, 7.0), w, rtol=1e-10)
@@ -87,3 +86,22 @@ def test_spatial_watch_measure_is_scale_free_and_ignores_equation_factors():
     Js = J[0].copy()
     Js[np.ix_(b.rows, [b.cols[-1]])] = Js[np.ix_(b.rows, [b.cols[-2]])]  # a column copied: singular
     assert watch_conditioning(model, Js[None], m.size())[0, list(model.blocks).index(b)] < 1e-12
+
+
+def test_rssr_reduced_to_its_rocker_angle_is_watched_as_a_planar_group():
+    # one 1 x 1 group: d/dphi of the bar's (|C - B|^2 - lc^2) / lc, over the size (125): by hand
+    # with C = D + R (0, -sin phi, cos phi), B = r (cos th, sin th, 0)
+    from kincas.analysis.continuation import watch_conditioning
+    from test_space import D, LC, R_CRANK, R_ROCK, rssr
+    m = rssr()
+    model = kincas.model_of(m)
+    th = np.linspace(0, 2 * np.pi, 13)
+    sw = kincas.sweep(m, {"A.angle": th}, report=["D.angle"], method="careful")
+    J = np.array([model.jac(q, np.array([t]), np.array([LC])) for q, t in zip(sw.q, th)])
+    phi = sw["D.angle"]
+    C = D + R_ROCK * np.stack([0 * phi, -np.sin(phi), np.cos(phi)], 1)
+    B = R_CRANK * np.stack([np.cos(th), np.sin(th), 0 * th], 1)
+    dC = R_ROCK * np.stack([0 * phi, -np.cos(phi), -np.sin(phi)], 1)
+    assert m.size() == LC and [len(b.cols) for b in model.blocks] == [1]
+    want = np.abs(2 * ((C - B) * dC).sum(1) / LC) / LC
+    assert np.allclose(watch_conditioning(model, J, m.size())[:, 0], want, rtol=1e-12)

@@ -73,11 +73,9 @@ def signature(model, Q, u, p, L) -> np.ndarray:
     """
     Q = np.atleast_2d(np.asarray(Q, float))
     rows = [model.points_many(Q, u, p)]
-    for j, nm in enumerate(model.unknown_names):
-        if nm.endswith(".qw"):  # a spatial body's unit quaternion: its rotation, scaled by L
-            from ..core.space_model import rot_of
-            E = Q[:, j:j + 4] / np.linalg.norm(Q[:, j:j + 4], axis=1, keepdims=True)
-            rows.append(L * np.moveaxis(rot_of(E.T), -1, 0).reshape(len(Q), 9))
+    rotations = getattr(model, "rotations_many", None)  # a model of rigid bodies in space
+    if rotations is not None and len(Q):
+        rows.append(L * rotations(Q, u, p))
     return np.hstack(rows)
 
 

@@ -72,7 +72,7 @@ def square(m, u):
     drawn = first_pose(model, model.drawing_inputs(p), p, L, guess)
     if not drawn.ok:
         raise NotPolynomial(REFUSED.format(why=" (and its drawing pose does not assemble)"))
-    x0 = free.from_unknowns(drawn.q)
+    x0 = free.from_unknowns(drawn.q, model.drawing_inputs(p))  # q at the drawing pose's inputs
     scale = np.where(free.length, L, 1.0)
     keep = [free.equations[k] for k in independent(free.equations, x0, len(free.names), scale, RANK,
                                                    always=free.structural)]

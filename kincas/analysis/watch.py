@@ -3,8 +3,8 @@
 A step whose ends keep every group's mode may still pass a change point (two branches cross
 there with the mode unchanged), so a group that is not well conditioned at either end of a
 step is searched for a singular position inside it (`passes_singular`). The conditioning is
-`modes`' (planar) or, for a group with quaternion unknowns, its block with columns and rows
-scaled to unit length (`watch_conditioning`); a spatial group is searched only where the step
+`modes`' (planar) or, for a group of a spatial model's quaternion or joint-angle unknowns
+(the model's `watch_scaled`), its block with columns and rows scaled to unit length (`watch_conditioning`); a spatial group is searched only where the step
 could reach a singular block at all (`within_reach`, Weyl's inequality).
 
 >>> import numpy as np, kincas
@@ -34,7 +34,7 @@ def passes_singular(model: Model, q0, u0, u1, J0, sol: Solution, p, L, measured=
     (_, c0), (_, c1) = measured() if measured is not None else ((None, None), (None, None))
     c = np.minimum(watch_conditioning(model, J0, L, c0), watch_conditioning(model, sol.J, L, c1))
     watch = np.flatnonzero(c < WATCH)
-    if watch.size and "quaternion" in model.unknown_kinds:  # space: only a dip within reach
+    if watch.size and _scaled(model).any():  # space: only a dip within reach
         watch = watch[[within_reach(model, J0, sol.J, L, int(i)) for i in watch]]
     watch = watch[np.argsort(c[watch], kind="stable")]  # the likeliest crossing first: any one decides
     scales = model.scales(u0, p) if watch.size else None  # one pose's: shared by every search
@@ -47,8 +47,8 @@ def passes_singular(model: Model, q0, u0, u1, J0, sol: Solution, p, L, measured=
 
 
 def watch_conditioning(model: Model, J, L, cond=None) -> np.ndarray:
-    """Each group's conditioning as `modes` gives it, except that a group with quaternion
-    unknowns (space) has its block's columns, then its rows, scaled to unit length first: a
+    """Each group's conditioning as `modes` gives it, except that a group of two or more
+    unknowns among the model's `watch_scaled` (space: quaternions, joint angles) has its block's columns, then its rows, scaled to unit length first: a
     quaternion's norm equation (2 L e), a revolute's axis equations (a half-angle's 1/2) and
     a quaternion column against a position's (a lever over the size) carry factors of their
     own that held a regular group's sigma_min / sigma_max at 0.1-0.5 (an RSSR: every pose
@@ -57,13 +57,13 @@ def watch_conditioning(model: Model, J, L, cond=None) -> np.ndarray:
     J is g_q at one pose (ng, nq) or at many (n, ng, nq); `cond`, if given, is `modes`'
     conditioning at J."""
     cond = np.array(modes(model, J, L)[1] if cond is None else cond, float)
-    kinds = model.unknown_kinds
-    if "quaternion" not in kinds:
+    scaled = _scaled(model)
+    if not scaled.any():
         return cond
     one = J.ndim == 2
     Jn, cn = (J[None] if one else J) * model.column_scale(L), cond[None] if one else cond
     for i, b in enumerate(model.blocks):
-        if len(b.cols) < 2 or not any(kinds[j] == "quaternion" for j in b.cols):
+        if len(b.cols) < 2 or not scaled[b.cols].any():
             continue
         B = Jn[:, b.rows][:, :, b.cols]
         tiny = np.finfo(float).tiny
@@ -72,6 +72,14 @@ def watch_conditioning(model: Model, J, L, cond=None) -> np.ndarray:
         s = np.linalg.svd(B, compute_uv=False)
         cn[:, i] = s[:, -1] / np.maximum(s[:, 0], np.finfo(float).tiny)
     return cn[0] if one else cn
+
+
+def _scaled(model) -> np.ndarray:
+    """Per unknown, whether its group's equations carry factors of their own, so that the
+    watch scales the group's block (the model's `watch_scaled`: a spatial model's quaternion
+    components and joint angles; none in a planar model)."""
+    mask = getattr(model, "watch_scaled", None)
+    return np.zeros(model.nq, bool) if mask is None else mask
 
 
 def within_reach(model: Model, J0, J1, L, i: int) -> bool:

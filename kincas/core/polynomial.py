@@ -235,7 +235,9 @@ class PolySystem:
     length: list[bool] = field(default_factory=list)  # per variable: a length (else a ratio)
     at: dict = field(default_factory=dict)  # the values the equations were written at (rounded ones)
     to_unknowns: object = None  # x -> kincas's q, when not per unknown as in `unknowns` (spatial: R -> e)
-    from_unknowns: object = None  # q -> x, its inverse
+    from_unknowns: object = None  # (q[, u]) -> x, its inverse (q at inputs u: the system's own by default)
+    off_model: object = None  # x -> how far (relative) x is from from_unknowns(to_unknowns(x)): equations
+    # the numerical model satisfies by construction (spatial: a body hung on its joint) that x breaks
     perturbation: float = 0.0  # relative distance of the rationalised geometry (axes) from the scene's floats
     structural: list = field(default_factory=list)  # indices of equations kept whatever the rank (R'R = I, det R = 1)
     implied: int = 0  # equations left out as implied (an overconstrained mechanism: kincas/analysis/certify_over.py)

@@ -26,8 +26,12 @@ a direction likewise. A parameter input (a Stewart leg's length) enters exactly.
 The scene's numbers enter as the shortest decimals of their floats (`exact`: what the scene
 wrote; small coefficients make msolve several times faster than the floats' dyadic rationals).
 
-A solution maps back to kincas's unknowns: r as it is, e from R (Shepperd's method) with
-qw >= 0 (the first non-zero component positive where qw = 0).
+The system keeps every body's (r, R), whatever the numerical model's tree reduction
+(kincas/model/space_tree.py: a body hung on a revolute has its joint angle as its unknown
+there). A solution maps back to kincas's unknowns through the model's map from the bodies'
+poses (`unknowns_from_poses`, kincas/core/space_model.py): a floating body's r as it is, e
+from R (Shepperd's method) with qw >= 0; a hung body's angle from its rotation relative to its
+parent's; and forth through the model's poses at q (`body_poses`).
 
 >>> import kincas
 >>> m = kincas.SpatialMechanism(ground={"O": (0, 0, 0)},
@@ -229,7 +233,7 @@ def closure_space(m, u, driven_joints=True, snap=False) -> PolySystem:
     frames = {GROUND: (const([0, 0, 0]), [[one, zero, zero], [zero, one, zero], [zero, zero, one]], [0, 0, 0])}
     exempt = m.exempt()  # (a slide joint's point listed in [ground] too is its second body's)
     points = {g: const(rel(xyz)) for g, xyz in m.ground if (g, GROUND) not in exempt}
-    layout = []  # per kincas unknown block: ("body", r indices, R indices) or ("point", indices)
+    layout = ({}, {})  # per body its r and R indices; per point only bars carry its indices
     for b in m.bodies:
         if b.two_point:
             continue
@@ -238,7 +242,7 @@ def closure_space(m, u, driven_joints=True, snap=False) -> PolySystem:
         r = [S.var(f"{b.name}.r{a}", length=True) for a in "xyz"]
         R = [[S.var(f"{b.name}.R{i + 1}{j + 1}") for j in range(3)] for i in range(3)]
         ir = len(S.names) - 12
-        layout.append(("body", list(range(ir, ir + 3)), list(range(ir + 3, ir + 12))))
+        layout[0][b.name] = (list(range(ir, ir + 3)), list(range(ir + 3, ir + 12)))
         for i in range(3):  # R'R = I: unit, orthogonal columns
             for j in range(i, 3):
                 S.structural.append(len(S.equations))
@@ -257,7 +261,7 @@ def closure_space(m, u, driven_joints=True, snap=False) -> PolySystem:
     for p in m.moving_points:
         if p not in points:
             points[p] = [S.var(f"{p}.{a}", length=True) for a in "xyz"]
-            layout.append(("point", list(range(len(S.names) - 3, len(S.names)))))
+            layout[1][p] = list(range(len(S.names) - 3, len(S.names)))
     for b in m.bodies:
         if b.two_point:
             P, Q = (points[n] for n in b.point_names)
@@ -282,8 +286,10 @@ def closure_space(m, u, driven_joints=True, snap=False) -> PolySystem:
         else:
             S.equations.append(_dot(d, _apply(R1, _axis(S, sl.normal, f"slide {sl.name}: normal", False)[0])))
     S.points = {p: points[p] for p in m.moving_points}
-    S.to_unknowns = lambda x: _to_unknowns(layout, x)
-    S.from_unknowns = lambda q: _from_unknowns(layout, len(S.names), q)
+    S.to_unknowns = lambda x: _to_unknowns(m, layout, x)
+    S.from_unknowns = lambda q, at=None: _from_unknowns(m, layout, len(S.names), q, u if at is None else at)
+    scale = np.where(S.length, m.size(), 1.0)
+    S.off_model = lambda x: float(np.abs((S.from_unknowns(S.to_unknowns(x)) - np.asarray(x, float)) / scale).max(initial=0.0))
     return S
 
 
@@ -357,31 +363,31 @@ def _joint(S, m, j, frames, points, rel, inputs) -> list:
     return eqs
 
 
-def _to_unknowns(layout, x) -> np.ndarray:
-    out = []
-    for blk in layout:
-        if blk[0] == "body":
-            out += [x[i] for i in blk[1]]
-            R = np.array([x[i] for i in blk[2]], float).reshape(3, 3)
-            U, _, Vt = np.linalg.svd(R)  # the nearest rotation (the box's centre is one to 2^-64)
-            out += list(quaternion(U @ Vt))
-        else:
-            out += [x[i] for i in blk[1]]
-    return np.array(out, float)
+def _to_unknowns(m, layout, x) -> np.ndarray:
+    """kincas's unknowns at the variables x (the model's own map from the bodies' poses:
+    kincas/core/space_model.py `unknowns_from_poses`)."""
+    from .numeric import model_of
+    poses = {}
+    for name, (ri, Ri) in layout[0].items():
+        U, _, Vt = np.linalg.svd(np.array([x[i] for i in Ri], float).reshape(3, 3))
+        poses[name] = (np.array([x[i] for i in ri], float), U @ Vt)  # the nearest rotation (the box's
+        # centre is one to 2^-64)
+    points = {pt: np.array([x[i] for i in xi], float) for pt, xi in layout[1].items()}
+    return model_of(m, check=False).unknowns_from_poses(poses, points)
 
 
-def _from_unknowns(layout, n, q) -> np.ndarray:
-    x, k = np.zeros(n), 0
-    for blk in layout:
-        if blk[0] == "body":
-            for i, v in zip(blk[1], q[k:k + 3]):
-                x[i] = v
-            e = np.asarray(q[k + 3:k + 7], float)
-            for i, v in zip(blk[2], matrix(e / np.linalg.norm(e)).ravel()):
-                x[i] = v
-            k += 7
-        else:
-            for i, v in zip(blk[1], q[k:k + 3]):
-                x[i] = v
-            k += 3
+def _from_unknowns(m, layout, n, q, u) -> np.ndarray:
+    """The variables at kincas's unknowns q at inputs u (each body's pose from the model at
+    q, u: a body hung on a driven joint turns with its input)."""
+    from .numeric import model_of
+    model = model_of(m, check=False)
+    p = np.array([v for _, v in m.parameters], float)
+    poses = model.body_poses(np.asarray(q, float), np.asarray(u, float), p)
+    x = np.zeros(n)
+    for name, (ri, Ri) in layout[0].items():
+        r, R = poses[name]
+        x[ri], x[Ri] = r, R.ravel()
+    index = {nm: i for i, nm in enumerate(model.unknown_names)}
+    for pt, xi in layout[1].items():
+        x[xi] = [q[index[f"{pt}.{a}"]] for a in "xyz"]
     return x

@@ -8,7 +8,9 @@ SVD of sum b_i a_i', with det R = +1), which is the drawing pose itself where no
 guessed; a point only bars carry starts at its guess. Then each input on a joint's angle or
 translation turns or moves that joint's second body, about the joint's axis through its
 point, by the difference between the input and the coordinate at the fitted pose, so that
-Newton starts near the driven pose rather than a whole input away from it.
+Newton starts near the driven pose rather than a whole input away from it. A body hung on a
+joint (kincas/model/space_tree.py) then takes, in placing order, the input or the coordinate
+of its fit relative to its parent's placed pose, and its pose from its parent's.
 
 >>> import numpy as np
 >>> from kincas import SpatialMechanism, Body, Joint, Input, model_of
@@ -21,9 +23,12 @@ Newton starts near the driven pose rather than a whole input away from it.
 """
 from __future__ import annotations
 
+import casadi as ca
 import numpy as np
 
 from ..model.mobility import GROUND
+from .quaternions import rotation
+from ..model.space_tree import placement
 from .tolerances import IDENTITY_PULL, TINY
 
 
@@ -69,6 +74,13 @@ def axis_rotation(a, angle) -> np.ndarray:
     return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
 
 
+def angle_about(R, a) -> float:
+    """The angle in (-pi, pi] of the rotation about the unit axis a nearest R (a rotation):
+    2 atan2(v.a, w) of its quaternion (w, v), w >= 0."""
+    e = quat_of(R)
+    return float(2 * np.arctan2(e[1:] @ np.asarray(a, float), e[0]))
+
+
 def kabsch(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """The rotation R minimising sum |R a_i - b_i|^2 (rows of A and B, already centred).
     Where the points leave it undecided (two points, or points on a line: a turn about
@@ -84,9 +96,20 @@ class SpatialFirstPose:
     """The first pose of a spatial `Model` (kincas/core/numeric.py `SpatialModel`), which
     supplies the symbolic model and its geometry call."""
 
-    # group by group assembly (kincas/core/assembly.py) spreads starts by turning angles;
-    # a quaternion's components are not turned so: the start near the last pose, and one more
-    assembly_starts = 2
+    @property
+    def watch_scaled(self) -> np.ndarray:
+        """Per unknown, whether the careful path's watch scales its group's block to unit
+        columns and rows (kincas/analysis/watch.py): a quaternion's (its norm equation, the
+        axis equations' half angles carry factors of their own) and a joint angle's (the
+        loops' axis equations likewise); a position's group is measured as in the plane."""
+        return np.array([k != "length" for k in self.unknown_kinds], bool)
+
+    @property
+    def assembly_starts(self):
+        """Group by group assembly (kincas/core/assembly.py) spreads starts by turning angles;
+        a quaternion's components are not turned so: with a floating body, the start near the
+        last pose and one more; with joint angles only (every body hung), as many as planar."""
+        return 2 if "quaternion" in self.unknown_kinds else 10 ** 9
 
     def _drawn(self, u, p):
         """Per rigid body its drawn points (n x 3); the ground points by name."""
@@ -102,14 +125,23 @@ class SpatialFirstPose:
         return out, gv
 
     def _placing(self):
-        """What `initial_q` reads of the structure, once per model: per rigid body its name and
-        point names and where its r and e sit in q; per point only bars carry, where its
-        coordinates sit; whether any input drives a joint."""
+        """What `initial_q` reads of the structure, once per model: per rigid body, in the
+        order the model places it (kincas/model/space_tree.py), its name, point names, how it
+        hangs (None: it floats) and where its unknowns sit in q (a floating body's r and e;
+        a hung body's coordinates that are unknowns, by name); per point only bars carry,
+        where its coordinates sit; whether any input drives a joint."""
         def build():
             m, sym = self.sym.mech, self.sym
             index = {name: i for i, (name, _) in enumerate(sym.unknowns)}
-            bodies = [(b.name, b.point_names, [index[f"{b.name}.r{a}"] for a in "xyz"],
-                       [index[f"{b.name}.q{a}"] for a in "wxyz"]) for b in m.bodies if not b.two_point]
+            bodies = []
+            for name, hang in placement(m):
+                if hang is None:
+                    slots = ([index[f"{name}.r{a}"] for a in "xyz"], [index[f"{name}.q{a}"] for a in "wxyz"])
+                elif hang.type == "ball":
+                    slots = {"e": [index[f"{name}.q{a}"] for a in "wxyz"]}
+                else:
+                    slots = {k: index[f"{hang.joint}.{k}"] for k in ("angle", "s") if f"{hang.joint}.{k}" in index}
+                bodies.append((name, m.link(name).point_names, hang, slots))
             bars = [(pt, [index[f"{pt}.{a}"] for a in "xyz"]) for pt in m.moving_points if f"{pt}.x" in index]
             return bodies, bars, any(inp.kind == "joint" for inp in m.inputs)
         return self.memo("first_pose.placing", build)
@@ -136,17 +168,62 @@ class SpatialFirstPose:
             else:
                 R, r = np.eye(3), c
             pose[name] = (r, R, c)
-        if driven:
+        if driven:  # an input on a joint that closes a loop (a hung body's: its angle below)
+            hanging = {h.joint for _, _, h, _ in bodies if h is not None}
             for k, inp in enumerate(m.inputs):
-                if inp.kind == "joint":
+                if inp.kind == "joint" and inp.target.partition(".")[0] not in hanging:
                     self._drive(pose, m, inp.target, u[k], drawn)
-        for name, _, ri, ei in bodies:
-            r, R, _ = pose[name]
-            q[ri] = r - o
-            q[ei] = quat_of(R)
+        for name, names, hang, slots in bodies:
+            if hang is None:
+                r, R, _ = pose[name]
+                q[slots[0]] = r - o
+                q[slots[1]] = quat_of(R)
+            else:  # from its parent's pose as placed: its coordinates (the fit's, or the inputs)
+                coords = self._hung(pose, m, name, names, hang, u, drawn, gv)
+                for k, i in slots.items():
+                    q[i] = coords[k]
         for pt, xi in bars:
             q[xi] = np.array(guess[pt], float) - o
         return q
+
+    @staticmethod
+    def _hung(pose, m, name, names, hang, u, drawn, gv) -> dict:
+        """A hung body's coordinates {"angle": .., "s": ..}: the inputs, else the turn about
+        the joint's axis a nearest its fitted rotation relative to its parent's placed one
+        (R1' R2 = Rot(a, theta)) and its fitted point's distance along the first body's
+        line; its pose then set from the parent's (a revolute's point where the parent
+        carries it, a slide's moved along the line by s). A body on a ball keeps its fitted
+        rotation ({"e": its quaternion}), its point where the parent carries it."""
+        if hang.type == "ball":
+            rp, Rp, cp = pose[hang.parent]
+            _, R, c = pose[name]
+            X = gv[hang.point] if hang.parent == GROUND else \
+                rp + Rp @ (drawn[hang.parent][m.link(hang.parent).point_names.index(hang.point)] - cp)
+            pose[name] = (X - R @ (drawn[name][names.index(hang.point)] - c), R, c)
+            return {"e": quat_of(R)}
+        j = m.joint(hang.joint)
+        a = np.asarray(j.axis, float)
+        rp, Rp, cp = pose[hang.parent]
+        r, R, c = pose[name]
+        out, Rn = {}, Rp
+        if j.type in ("revolute", "cylindrical"):
+            th = float(u[hang.driven]) if hang.driven is not None else \
+                angle_about(Rp.T @ R if hang.parent_first else R.T @ Rp, a)
+            H = axis_rotation(a, th)
+            out["angle"], Rn = th, Rp @ (H if hang.parent_first else H.T)
+        if j.type == "revolute":
+            X = gv[hang.point] if hang.parent == GROUND else \
+                rp + Rp @ (drawn[hang.parent][m.link(hang.parent).point_names.index(hang.point)] - cp)
+            P0 = drawn[name][names.index(hang.point)]
+        else:
+            owner = m.joint_bodies(j)[1]  # the point is drawn on the second body
+            P0 = gv[hang.point] if owner == GROUND else drawn[owner][m.link(owner).point_names.index(hang.point)]
+            Xp, Xc = rp + Rp @ (P0 - cp), r + R @ (P0 - c)  # the parent's and the fit's copies
+            sign, Ra = (1.0 if hang.parent_first else -1.0), Rp @ a
+            out["s"] = float(u[hang.driven_s]) if hang.driven_s is not None else float(sign * (Xc - Xp) @ Ra)
+            X = Xp + sign * out["s"] * Ra
+        pose[name] = (X - Rn @ (P0 - c), Rn, c)
+        return out
 
     @staticmethod
     def _drive(pose, m, target, value, drawn):
@@ -171,10 +248,83 @@ class SpatialFirstPose:
             X1 = r1 + R1 @ (P0 - c1)
             pose[b2] = (r2 + (value - (X - X1) @ a) * a, R2, c2)
 
+    # --- the bodies' poses as numbers (modes' signatures, the certified map) ---
+    def _pose_function(self):
+        """A Function (q, u, p) -> per rigid body (declaration order) the centroid of its
+        drawn points (relative to the model's origin) and its rotation's 9 entries, row by
+        row (R(e) / e.e: the rotation itself, whatever e's norm)."""
+        def build():
+            sym, m = self.sym, self.sym.mech
+            out = []
+            for b in m.bodies:
+                if b.two_point:
+                    continue
+                loc = [sym._rel(xyz) for _, xyz in b.points]
+                c = [sum(v[i] for v in loc) / len(loc) for i in range(3)]
+                e = sym.frames[b.name][1]
+                n, R = e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3], rotation(e)
+                out += sym.world(b.name, c) + [R[i][k] / n for i in range(3) for k in range(3)]
+            return ca.Function("body_poses", [sym.q, sym.u, sym.p], [ca.vertcat(*out)] if out else [ca.SX(0, 1)])
+        return self.memo("space.body_poses", build)
+
+    def body_poses(self, q, u, p) -> dict:
+        """Per rigid body its (centroid relative to the model's origin, rotation matrix)."""
+        v = np.asarray(self._pose_function()(q, u, p), float).ravel()
+        names = [b.name for b in self.sym.mech.bodies if not b.two_point]
+        return {nm: (v[12 * k:12 * k + 3], v[12 * k + 3:12 * k + 12].reshape(3, 3)) for k, nm in enumerate(names)}
+
+    def rotations_many(self, Q, u, p) -> np.ndarray:
+        """Every rigid body's rotation matrix at each row of Q (one input u): one row of
+        9 entries per body per row of Q (kincas/analysis/assembly_mode.py's signature)."""
+        n = Q.shape[0]
+        f = self._pose_function().map(n)
+        V = np.asarray(f(Q.T, np.tile(np.reshape(u, (-1, 1)), n), np.tile(np.reshape(p, (-1, 1)), n)), float)
+        V = V.reshape(-1, 12, n)[:, 3:, :]  # bodies x 9 x n
+        return V.transpose(2, 0, 1).reshape(n, -1)
+
+    def unknowns_from_poses(self, poses, points) -> np.ndarray:
+        """q from every rigid body's (centroid relative to the model's origin, rotation) and
+        every point only bars carry (relative to the origin): a floating body's r and unit
+        quaternion (w >= 0); a hung body's angle from its rotation relative to its parent's,
+        its slide from its point's distance along the first body's line (an input's
+        coordinate: no unknown)."""
+        m = self.sym.mech
+        index = {name: i for i, name in enumerate(self.unknown_names)}
+        o = np.array([m.value(c) for c in m.ground[0][1]]) if m.ground else np.zeros(3)
+        rel = lambda xyz: np.array([m.value(c) for c in xyz], float) - o  # noqa: E731
+
+        def world(b, P0):
+            if b == GROUND:
+                return P0
+            r, R = poses[b]
+            return r + R @ (P0 - np.mean([rel(xyz) for _, xyz in m.link(b).points], axis=0))
+        q = np.zeros(self.nq)
+        for name, hang in placement(m):
+            r, R = poses[name]
+            if hang is None or hang.type == "ball":  # (on a ball: its rotation only)
+                if hang is None:
+                    q[[index[f"{name}.r{a}"] for a in "xyz"]] = r
+                q[[index[f"{name}.q{a}"] for a in "wxyz"]] = quat_of(R)
+                continue
+            j = m.joint(hang.joint)
+            Rp = np.eye(3) if hang.parent == GROUND else poses[hang.parent][1]
+            if f"{j.name}.angle" in index:
+                q[index[f"{j.name}.angle"]] = angle_about(Rp.T @ R if hang.parent_first else R.T @ Rp, j.axis)
+            if f"{j.name}.s" in index:
+                owner = m.joint_bodies(j)[1]
+                xyz = dict(m.ground)[j.point] if owner == GROUND else m.link(owner).local(j.point)
+                P0 = rel(xyz)
+                sign = 1.0 if hang.parent_first else -1.0
+                q[index[f"{j.name}.s"]] = sign * (world(name, P0) - world(hang.parent, P0)) @ (Rp @ np.asarray(j.axis))
+        for pt, v in points.items():
+            q[[index[f"{pt}.{a}"] for a in "xyz"]] = v
+        return q
+
     def scatter(self, m, n: int, L: float, rng) -> np.ndarray:
-        """n random starts (kincas.find_modes): each body's reference point uniform in a cube
-        of half-side L about a ground point, its quaternion uniform on the unit sphere of R^4
-        (a uniformly random rotation), a point only bars carry likewise in the cube."""
+        """n random starts (kincas.find_modes): each floating body's reference point uniform
+        in a cube of half-side L about a ground point, its quaternion uniform on the unit
+        sphere of R^4 (a uniformly random rotation), a point only bars carry likewise in the
+        cube; a hung body's joint angle uniform on the circle, its slide in (-L, L)."""
         names, sym = self.unknown_names, self.sym
         Q = np.zeros((n, len(names)))
         o = np.array([m.value(c) for c in m.ground[0][1]]) if m.ground else np.zeros(3)
@@ -184,6 +334,10 @@ class SpatialFirstPose:
             if nm.endswith((".rx", ".x")):  # a body's reference point, or a bar-only point
                 centre = ground[rng.integers(len(ground), size=n)]
                 Q[:, j:j + 3] = centre + rng.uniform(-L, L, size=(n, 3))
+            elif kind == "angle":  # a hung body's joint angle
+                Q[:, j] = rng.uniform(-np.pi, np.pi, n)
+            elif nm.endswith(".s"):  # a hung body's slide along its joint's line
+                Q[:, j] = rng.uniform(-L, L, n)
             elif nm.endswith(".qw"):
                 e = rng.standard_normal((n, 4))
                 Q[:, j:j + 4] = e / np.linalg.norm(e, axis=1, keepdims=True)

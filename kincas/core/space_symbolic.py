@@ -1,34 +1,48 @@
 """The symbolic model of a spatial mechanism: the same interface as `Symbolic` (planar), so
 that Newton, sweeps, singular flags, sensitivities and the compiled kernels use it unchanged.
 
-Formulation (docs/spatial.md): absolute coordinates with unit quaternions. A moving rigid
-body has unknowns r (3, its reference point: at the drawing pose the centroid c of its
-drawn points) and e = (w, x, y, z) (4), with e.e - 1 = 0; its point P (drawn at P0) is
-r + R(e) (P0 - c), R(e) the quadratic rotation matrix of e. Every position inside is taken
+Formulation (docs/spatial.md): absolute coordinates with unit quaternions, reduced on the
+tree of revolutes from the ground. A floating rigid body has unknowns r (3, its reference
+point: at the drawing pose the centroid c of its drawn points) and e = (w, x, y, z) (4), with
+e.e - 1 = 0; its point P (drawn at P0) is r + R(e) (P0 - c), R(e) the quadratic rotation
+matrix of e. A body hung on a revolute of an already placed body (kincas/model/space_tree.py)
+has one unknown instead, the joint's angle theta (the input where one drives it: none), with
+e = e_parent (x) (cos(theta/2), sin(theta/2) a) and r the joint's point where the parent
+carries it (c its drawn position): its norm, the joint's point and axis equations hold
+identically and are not written. On a cylindrical joint it has the angle and the slide s
+(r moved along the first body's line by s), on a prismatic one s alone (e = e_parent). Every position inside is taken
 relative to the first ground point (added back to reported positions), so a mechanism far
 from the global origin keeps its residuals' and steps' relative accuracy. A point that only two-point bars
 carry has its 3 coordinates as unknowns; a bar adds (|P - Q|^2 - L^2) / L = 0. Every
-equation is polynomial in (r, e). Equations without a length (a quaternion's norm, axes kept
+equation is polynomial in (r, e) (and in the half angles' cosines and sines). Equations
+without a length (a quaternion's norm, axes kept
 perpendicular) are multiplied by the mechanism's size `Ls`, so that every residual is a
 length and every quaternion column of g_q is a length, like an angle's in the planar model:
 the tolerances and the scales of kincas/core/numeric.py mean the same at any size.
 
 A joint's angle comes from the relative quaternion conj(e1) (x) e2 = (w, v): a rotation about
 the unit axis a by theta has v = sin(theta/2) a, w = cos(theta/2), so with s = v.a,
-theta = atan2(2 s w, w^2 - s^2), wrapped in (-pi, pi]. An input driving it adds
+theta = atan2(2 s w, w^2 - s^2), wrapped in (-pi, pi] (a hung body's: atan2(sin, cos) of its
+unknown). An input driving a joint that closes a loop adds
 s cos(u/2) - w sin(u/2) = sin((theta - u)/2) = 0: e and -e (the same rotation) both satisfy
 it, and theta = u + 2k pi only (no spurious branch). A revolute joint keeps v along a
 (v.b1 = v.b2 = 0 for b1, b2 perpendicular to a): regular at every angle (the Jacobian of
 (v.b1, v.b2) in the rotations about b1, b2 has determinant (w^2 + s^2) / 4 = 1/4), and
 without the flipped assembly R2 a = -R1 a that (R2 a).(R1 b) = 0 would admit.
 
+An RSSR: the crank hangs on its driven revolute (no unknown), the rocker on its own (its
+angle), and the bar between them is the one equation:
+
 >>> import kincas
 >>> from kincas import SpatialMechanism, Body, Joint, Input
->>> m = SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (2, 0, 0)})],
-...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")])
+>>> m = SpatialMechanism(ground={"A": (0, 0, 0), "D": (4, 0, 0)},
+...     bodies=[Body("crank", {"A": (0, 0, 0), "B": (1, 0, 0)}), Body.bar("coupler", "B", "C", 4.5),
+...             Body("rocker", {"D": (4, 0, 0), "C": (4, 0, 3)})],
+...     joints=[Joint("revolute", "A", axis=(0, 0, 1)), Joint("revolute", "D", axis=(1, 0, 0))],
+...     inputs=[Input.joint("A")])
 >>> s = SpatialSymbolic(m)
->>> s.nq, s.ng, [k for _, k in s.unknowns][:4]
-(7, 7, ['length', 'length', 'length', 'quaternion'])
+>>> s.nq, s.ng, s.unknowns
+(1, 1, [('D.angle', 'angle')])
 """
 from __future__ import annotations
 
@@ -39,6 +53,7 @@ from ..model.mobility import GROUND
 from ..model.names import parse_quantity
 from ..model.space_names import BODY_Q, POINT_Q3, SLIDE_Q, joint_attrs
 from ..model.space_parts import ON_SECOND
+from ..model.space_tree import placement
 from .quaternions import apply, apply_t, conj, cross, dot, qmul, rotation  # noqa: F401
 from .symbolic import Symbolic
 from .tolerances import PROJECTION
@@ -99,19 +114,26 @@ class SpatialSymbolic(Symbolic):
         self._ground = {g: self._rel(xyz) for g, xyz in m.ground}
         self.points = {g: v for g, v in self._ground.items() if (g, GROUND) not in exempt}
         self.frames = {GROUND: ([ca.SX(0)] * 3, [ca.SX(c) for c in IDENTITY], [ca.SX(0)] * 3)}
-        for b in m.bodies:
-            if b.two_point:
-                continue
+        self.hung = {}  # "J.angle", "J.s" of the joints bodies hang on: an unknown, or the input
+        for name, hang in placement(m):
+            b = m.link(name)
             loc = {p: self._rel(xyz) for p, xyz in b.points}
-            c = [sum(v[i] for v in loc.values()) / len(loc) for i in range(3)]
-            r = [new(f"{b.name}.r{a}", "length") for a in "xyz"]
-            e = [new(f"{b.name}.q{a}", "quaternion") for a in "wxyz"]
-            self.frames[b.name] = (r, e, c)
-            eqs.append(Ls * (dot(e[1:], e[1:]) + e[0] * e[0] - 1))
+            if hang is None:  # floating: its reference point and unit quaternion
+                c = [sum(v[i] for v in loc.values()) / len(loc) for i in range(3)]
+                r = [new(f"{name}.r{a}", "length") for a in "xyz"]
+                e = [new(f"{name}.q{a}", "quaternion") for a in "wxyz"]
+                eqs.append(Ls * (dot(e[1:], e[1:]) + e[0] * e[0] - 1))
+            elif hang.type == "ball":  # on a placed point: its unit quaternion, r where the point is
+                e = [new(f"{name}.q{a}", "quaternion") for a in "wxyz"]
+                eqs.append(Ls * (dot(e[1:], e[1:]) + e[0] * e[0] - 1))
+                r, c = self._carried(hang), loc[hang.point]
+            else:  # hung on a placed body's joint: its coordinates only (kincas/model/space_tree.py)
+                r, e, c = self._hang(hang, loc, new)
+            self.frames[name] = (r, e, c)
             for p, P0 in loc.items():
-                if (p, b.name) in exempt:
-                    continue
-                w = self.world(b.name, P0)
+                if (p, name) in exempt or (hang is not None and hang.type in ("revolute", "ball") and p == hang.point):
+                    continue  # a hanging revolute's or ball's point: where the parent carries it, identically
+                w = self.world(name, P0)
                 if p in self.points:  # a ball joint (or the point of a revolute, universal)
                     eqs += [w[i] - self.points[p][i] for i in range(3)]
                 else:
@@ -143,12 +165,45 @@ class SpatialSymbolic(Symbolic):
             u = self.u[k]
             if i.kind == "slide":
                 eqs.append(self.slide_s[i.target] - u)
-            elif i.kind == "joint":
+            elif i.kind == "joint" and i.target not in self.hung:
                 eqs.append(self._input_equation(i.target, u))
         self.angles = {}
         self.points = {k: [v[i] + self.origin[i] for i in range(3)] for k, v in self.points.items()}
         self._ground = {k: [v[i] + self.origin[i] for i in range(3)] for k, v in self._ground.items()}
         self._finish(qs, eqs)
+
+    def _hang(self, hang, loc, new):
+        """(r, e, c) of a body hung on a placed body's joint (kincas/model/space_tree.py), its
+        coordinates the inputs driving them, else unknowns (in `self.hung` by name):
+        e = e_parent (x) h (conj(h) when the parent is the joint's second body), h =
+        (cos(theta/2), sin(theta/2) a) for a revolute or cylindrical joint, e = e_parent for a
+        prismatic one. A revolute's r is its point where the parent carries it; a slide moves
+        the point drawn on the second body along the first's line by s: r = X1 + s R1 a (the
+        parent first) or X2 - s R2 a (the parent second). c: the point's drawn position."""
+        m, j = self.mech, self.mech.joint(hang.joint)
+        coord = lambda c, k, kind: self.u[k] if k is not None else new(f"{j.name}.{c}", kind)
+        ep = [ca.SX(c) for c in IDENTITY] if hang.parent == GROUND else self.frames[hang.parent][1]
+        e = ep
+        if j.type in ("revolute", "cylindrical"):
+            th = self.hung[f"{j.name}.angle"] = coord("angle", hang.driven, "angle")
+            h = [ca.cos(th / 2)] + [ca.sin(th / 2) * a for a in j.axis]
+            h = h if hang.parent_first else conj(h)
+            e = h if hang.parent == GROUND else qmul(ep, h)
+        if j.type == "revolute":
+            return self._carried(hang), e, loc[hang.point]
+        s = self.hung[f"{j.name}.s"] = coord("s", hang.driven_s, "length")
+        owner = m.joint_bodies(j)[1]  # the point is drawn on the second body
+        P0 = self._rel(dict(m.ground)[j.point] if owner == GROUND else m.link(owner).local(j.point))
+        Xp = self.world(hang.parent, P0)
+        Ra = apply(rotation(ep), list(j.axis)) if hang.parent != GROUND else list(j.axis)
+        sign = 1 if hang.parent_first else -1
+        return [Xp[i] + sign * s * Ra[i] for i in range(3)], e, P0
+
+    def _carried(self, hang) -> list:
+        """Where the placed parent carries the point a body hangs on (relative coordinates)."""
+        if hang.parent == GROUND:
+            return list(self.points[hang.point])
+        return self.world(hang.parent, self._rel(self.mech.link(hang.parent).local(hang.point)))
 
     def ground_at(self, g: str) -> list:
         """Where ground point `g` is drawn, also where it is the anchor of a slide joint."""
@@ -215,6 +270,14 @@ class SpatialSymbolic(Symbolic):
             self._sc[f"{name}.angle1"], self._sc[f"{name}.angle2"] = (s1, c1), (s2, c2)
             return eqs
         if j.type == "spherical":
+            return eqs
+        if f"{name}.angle" in self.hung or f"{name}.s" in self.hung:  # a body hangs on it:
+            if f"{name}.angle" in self.hung:  # its equations hold identically
+                th = self.hung[f"{name}.angle"]
+                self.joint_q[f"{name}.angle"] = ca.atan2(ca.sin(th), ca.cos(th))
+                self._half[f"{name}.angle"] = (ca.cos(th / 2), ca.sin(th / 2))
+            if f"{name}.s" in self.hung:
+                self.joint_q[f"{name}.s"] = self.hung[f"{name}.s"]
             return eqs
         a = list(j.axis)
         b1v, b2v = (list(v) for v in perpendiculars(a))

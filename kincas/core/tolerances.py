@@ -104,6 +104,9 @@ PROJECTION = 1e-9  # a unit axis projected on a plane shorter than this is norma
 CERTIFY_DENOMINATOR = 2 ** 20  # a driven or line angle's half-angle tangent rounded to a rational of this denominator at most (angle within ~1e-12 rad)
 CERTIFY_BITS = 64  # msolve's precision of the isolating boxes (bits; boxes far smaller than a float's rounding)
 CERTIFY_ROUNDING = 2.0 ** -46  # relative rounding error of a residual evaluated in floats (64 ulps), for a refined point's error bound
+CERTIFY_OFF_MODEL = 100.0  # a certified root farther than ACCEPT + this x the geometry's rationalisation
+# (`PolySystem.perturbation`) from the numerical model's map of it breaks an equation the model holds
+# by construction (a spatial body hung on its joint): not an assembly (kincas/analysis/certify.py)
 CERTIFY_TIMEOUT = 120.0  # seconds msolve may take before the certificate is given up
 CERTIFY_SPLIT = 1e-2  # roots a multiple root splits into are counted within this (scaled) distance of it, at most
 CERTIFY_NUDGE = 1e-7  # input change (rad, or times the size) that splits coinciding assemblies to count them

@@ -98,6 +98,9 @@ def solved_unknowns(m: Mechanism) -> int:
     >>> m.structure.n_unknowns, solved_unknowns(m)
     (1, 0)
     """
+    spatial = getattr(m, "solved_unknowns", None)  # a spatial mechanism's own (its tree reduction)
+    if spatial is not None:
+        return spatial()
     links = {lk.name for lk in m.links}
     driven = {i.target for i in m.inputs if i.kind == "angle" and i.target in links}
     return m.structure.n_unknowns - len(driven)

@@ -75,6 +75,25 @@ class SpatialLookups(Lookups):
         from .mechanism import Mechanism
         return Mechanism.redundant.fget(self)
 
+    def solved_unknowns(self) -> int:
+        """The size of the spatial model's q (kincas/model/space_tree.py: 7 per floating
+        body, 4 per body on a ball, a hung body's joint coordinates that no input drives, 3
+        per point only bars carry), counted from the declarations.
+
+        Returns
+        -------
+        int
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, Body, Joint, Input
+        >>> SpatialMechanism(ground={"O": (0, 0, 0)}, bodies=[Body("arm", {"O": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("revolute", "O", axis=(0, 0, 1))], inputs=[Input.joint("O")]).solved_unknowns()
+        0
+        """
+        from .space_tree import solved_unknowns
+        return solved_unknowns(self)
+
     def joint(self, name: str) -> Joint:
         """The joint of that name.
 
