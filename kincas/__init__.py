@@ -14,27 +14,32 @@ Jacobians, sensitivities to every named parameter. Angles are radians in Python.
 >>> pose.status, round(pose["C.x"], 6)
 ('ok', 2.987219)
 """
-from . import _aliases
-from .errors import KincasError, ModelError, SceneError
-from .model import Input, Link, Load, Mechanism, Param, Slide
-from .model.space import SpatialMechanism
-from .model.space_parts import Body, Joint, SpatialSlide
-from .results import Pose, Sweep
-from .core.numeric import model_of
-from .analysis.sweeps import solve, sweep
-from .analysis.methods import Careful, Fast, SweepMethod
-from . import views
-from .model import mechanism as _mechanism
-from .core.numeric import redundant_equations as _redundant_equations
-# sweep_designs and study are loaded on first use (kincas._aliases): `kincas solve` and
-# plain sweeps do not pay for their imports (thread pools, logging, dask hooks)
+try:  # Ctrl-C while Python loads kincas (about a second): the command says one line, not a traceback
+    from . import _aliases
+    from .errors import KincasError, ModelError, SceneError
+    from .model import Input, Link, Load, Mechanism, Param, Slide
+    from .model.space import SpatialMechanism
+    from .model.space_parts import Body, Joint, SpatialSlide
+    from .results import Pose, Sweep
+    from .core.numeric import model_of
+    from .analysis.sweeps import solve, sweep
+    from .analysis.methods import Careful, Fast, SweepMethod
+    from . import views
+    from .model import mechanism as _mechanism
+    from .core.numeric import redundant_equations as _redundant_equations
+    # sweep_designs and study are loaded on first use (kincas._aliases): `kincas solve` and
+    # plain sweeps do not pay for their imports (thread pools, logging, dask hooks)
 
-_aliases.install()  # `import kincas.modes` and other paths of the flat 0.1 layout
-# the face wires the floors together: the model and the results never import the solver or
-# their views, and no floor edits another's objects (tests/test_layering.py)
-_mechanism.use_rank_test(_redundant_equations)  # Mechanism.redundant, where counting cannot tell
-Mechanism._repr_svg_ = views.mechanism_svg_display  # Jupyter's displays
-Sweep._repr_html_ = views.sweep_html_display
+    _aliases.install()  # `import kincas.modes` and other paths of the flat 0.1 layout
+    # the face wires the floors together: the model and the results never import the solver or
+    # their views, and no floor edits another's objects (tests/test_layering.py)
+    _mechanism.use_rank_test(_redundant_equations)  # Mechanism.redundant, where counting cannot tell
+    Mechanism._repr_svg_ = views.mechanism_svg_display  # Jupyter's displays
+    Sweep._repr_html_ = views.sweep_html_display
+except KeyboardInterrupt:
+    from ._launch import interrupted_while_loading
+    interrupted_while_loading()  # exits 130 where kincas runs as the command; otherwise:
+    raise
 
 
 def __getattr__(name):

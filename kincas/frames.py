@@ -50,6 +50,8 @@ def unit_of(name: str, length: str = "", angle: str = "rad", time: str = "s") ->
         q = name[2:name.index(")/d(")]
         uq = unit_of(q, length, angle, time)
         return f"{uq or '1'}/{length}" if length else uq
+    if name.startswith("shaking."):  # a force or moment: no force unit is known here
+        return ""
     attr = name.rsplit(".", 1)[-1] if "." in name else None
     order = derivative_order(attr) if attr else None
     if order is None:

@@ -36,8 +36,8 @@ def param_unit(units: dict, mech, name: str) -> str:
     force labels where it gives a link's mass or inertia, a load's force or torque, a spring's
     stiffness; else length."""
     angular = mech is not None and any(
-        isinstance(sl.angle, Param) and sl.angle.name == name and abs(sl.angle.scale) != 1
-        for sl in mech.slides)
+        isinstance(a, Param) and a.name == name and abs(a.scale) != 1
+        for a in (getattr(sl, "angle", None) for sl in mech.slides))  # (a 3D slide has none)
     if angular:
         return units.get("angle", "deg")
     L = units.get("length", "")

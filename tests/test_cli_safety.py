@@ -74,6 +74,33 @@ def assert_interrupted(proc, waited, err):
     assert "interrupted" in err and "Traceback" not in err, err
 
 
+@pytest.mark.parametrize("after", [0.15, 0.3, 0.5, 0.7, 0.9, 1.2])
+def test_ctrl_c_while_kincas_loads_is_one_line(after):
+    """Ctrl-C in the first second, while Python still imports numpy and CasADi (before the
+    command's own handler exists), once ended in a KeyboardInterrupt traceback: now the
+    command's one line and 130 (or, if the signal beat Python's own handler, death by SIGINT;
+    or a finished command), never a traceback."""
+    proc = kincas("solve", EXAMPLES / "fourbar_coupler.toml")
+    time.sleep(after)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=30)
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    assert proc.returncode in (130, -signal.SIGINT, 0), (proc.returncode, err)
+    if proc.returncode == 130:
+        assert err.strip() == "kincas: interrupted", err
+
+
+def test_interrupt_while_loading_exits_only_as_the_command(monkeypatch):
+    """In a user's script or a notebook the KeyboardInterrupt goes on (they may handle it)."""
+    from kincas import _launch
+    monkeypatch.setattr(sys, "argv", ["my_script.py"])
+    _launch.interrupted_while_loading()  # returns: the caller re-raises
+    monkeypatch.setattr(sys, "argv", ["/usr/bin/kincas", "solve"])
+    with pytest.raises(SystemExit) as e:
+        _launch.interrupted_while_loading()
+    assert e.value.code == 130
+
+
 def test_ctrl_c_stops_a_long_study_and_leaves_no_file(tmp_path):
     # 250,000 designs x 360 poses: about half a minute of work
     scene = write_scene(tmp_path, STUDY.replace("grid = [41, 41]", "grid = [500, 500]"))

@@ -39,3 +39,16 @@ def test_cli_header_of_a_spatial_scene_names_rates_per_time(tmp_path):
     assert code == 0
     header = buf.getvalue().splitlines()[2]
     assert "mid.omega_x [deg/s]" in header and "out.omega [deg/s]" in header
+
+
+@pytest.mark.parametrize("name,want", [("shaking.x", "N"), ("shaking.y", "N"), ("shaking.z", "N"),
+                                       ("shaking.mx", "N·m"), ("shaking.my", "N·m"), ("shaking.mz", "N·m"),
+                                       ("shaking.moment", "N·m")])
+def test_shaking_forces_and_moments_are_forces_not_lengths(name, want):
+    """shaking.z read as a point's z once got the length unit (and shaking.m* too)."""
+    from types import SimpleNamespace
+    from kincas.views.columns import quantity_unit
+    sc = SimpleNamespace(study=SimpleNamespace(units={"length": "m", "angle": "deg", "time": "s", "force": "N"}),
+                         mechanism=None)
+    assert quantity_unit(sc, name) == want
+    assert unit_of(name, "m", "deg") == ""  # pandas/xarray: no force unit is known there

@@ -30,6 +30,7 @@ from ..core.tolerances import EVENT_TIME, SIM_ATOL, SIM_CLASSIFY, SIM_MAX_STEPS,
 from ..errors import ModelError
 from ..model.mechanism import Link, Mechanism
 from ..result_base import Result
+from ..model.names import is_angle_name
 
 FLYWHEEL = "_flywheel_inertia"  # the hidden parameter carrying the flywheel link's inertia
 
@@ -37,13 +38,14 @@ FLYWHEEL = "_flywheel_inertia"  # the hidden parameter carrying the flywheel lin
 def rate_name(key: str) -> str:
     """The name of an input's rate: `L.omega` for an angle, `S.v` for a slide, `d(p)/dt`.
 
-    >>> rate_name("crank.angle"), rate_name("guide.s"), rate_name("a1")
-    ('crank.omega', 'guide.v', 'd(a1)/dt')
+    >>> rate_name("crank.angle"), rate_name("guide.s"), rate_name("a1"), rate_name("x.angle2")
+    ('crank.omega', 'guide.v', 'd(a1)/dt', 'x.omega2')
     """
-    if key.endswith(".angle"):
-        return key[:-6] + ".omega"
-    if key.endswith(".s"):
-        return key[:-2] + ".v"
+    obj, _, attr = key.rpartition(".")
+    if is_angle_name(key):  # J.angle1 -> J.omega1
+        return f"{obj}.omega{attr[5:]}"
+    if obj and attr in ("s", "s1", "s2"):
+        return f"{obj}.v{attr[1:]}"
     return f"d({key})/dt"
 
 
@@ -331,7 +333,7 @@ class _Setup:
             return self._singular_reason()
         Jq = J[:, 0].reshape(-1, nq, order="F")
         # columns O(1) at any size: an angle's column is a length (over L), a length's a ratio
-        col = [1 / L if k.endswith(".angle") else 1.0 for k in self.free]
+        col = [1 / L if is_angle_name(k) else 1.0 for k in self.free]
         A = np.hstack([Jq * self.model.column_scale(L), Ju[:, 0].reshape(Jq.shape[0], -1, order="F") * col])
         # near a limit g_q's smallest singular value goes like the square root of the distance
         # and (g_q | g_u)'s stays finite; near a change point both go like the distance

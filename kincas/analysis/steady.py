@@ -28,6 +28,7 @@ from ..errors import ModelError
 from ..core.motion import CycleODE
 from ..core.tolerances import CYCLE_MATCH
 from .simulate import _Setup
+from ..model.names import is_angle_name
 
 SAMPLES = 720  # samples of a cycle where the extremes of the speed are first looked for
 
@@ -75,7 +76,7 @@ class Shooting:
 
     def __init__(self, setup: _Setup):
         mo = setup.motion
-        if len(mo.free) != 1 or mo.held or not setup.free[0].endswith(".angle"):
+        if len(mo.free) != 1 or mo.held or not is_angle_name(setup.free[0]):
             raise ModelError("--steady: expected one free angle input and no other input")
         self.setup, self.key = setup, setup.free[0]
         self.cycle = cycle_of(setup, self.key)

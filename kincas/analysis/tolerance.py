@@ -41,6 +41,7 @@ from ..core.tolerances import ROUNDING_REL, TINY
 from ..model.mechanism import Mechanism
 from .._deprecated import attribute, keyword, renamed
 from ..result_base import Result
+from ..model.names import is_angle_name
 
 FEW_POSES = 16  # up to this many poses, each is solved from the nominal's (not swept to)
 CHUNK = 2048  # samples per task of the executor
@@ -326,7 +327,7 @@ class _Samples:
             d = Qv[i]
             d -= np.where(ok, sw[nm], 0.0)
             d[bad] = 0.0
-            wrap = np.abs(d) > np.pi if nm.endswith(".angle") else None  # across +-pi
+            wrap = np.abs(d) > np.pi if is_angle_name(nm) else None  # across +-pi
             if wrap is not None and wrap.any():
                 d[wrap] -= 2 * np.pi * np.round(d[wrap] / (2 * np.pi))
             with np.errstate(invalid="ignore", divide="ignore"):

@@ -14,6 +14,7 @@ from ..core.tolerances import SAME_ASSEMBLY
 from ..errors import OutputError, SceneError
 from .scene import load
 from .scene_guess import scene_with_guess
+from ..model.names import is_angle_name
 
 
 def cli_arguments(parser) -> None:
@@ -47,7 +48,7 @@ def cli_run(args) -> int:
     if not sc.mechanism.guess and modes:
         modes = _solve_starts_on(sc, modes)
     deg = sc.study.deg
-    user_in = {k: (math.degrees(v) if deg and k.endswith(".angle") else v) for k, v in at.items()}
+    user_in = {k: (math.degrees(v) if deg and is_angle_name(k) else v) for k, v in at.items()}
     user_ang = [{lk: (math.degrees(a) if deg else a) for lk, a in md.angles.items()} for md in modes]
     if args.write:
         _write_scenes(args.scene, args.write, modes)
@@ -97,7 +98,7 @@ def _certificate(md) -> dict:
 
 def _print_modes(sc, modes, user_in, user_ang, args):
     units = sc.study.units
-    unit = {k: units.get("angle", "deg") if k.endswith(".angle") else
+    unit = {k: units.get("angle", "deg") if is_angle_name(k) else
             units.get("length", "") if k.endswith(".s") else "" for k in user_in}
     at = ", ".join(f"{k} = {v:.6g}" + (f" {unit[k]}" if unit[k] else "") for k, v in user_in.items())
     print(sc.study.title or "kincas")
@@ -126,8 +127,9 @@ def _print_modes(sc, modes, user_in, user_ang, args):
                + (f" ({box['flag']})" if box["flag"] else "") + (f"; {box['note']}" if "note" in box else "")
                if box else "")
         print(f"\nmode {k} of {n}: residual {md.residual:.1e}, orientation {md.orientation:+d}{box}{mark}")
-        print("  angles: " + ", ".join(f"{lk} {a:.6g}" for lk, a in ang.items())
-              + f" {units.get('angle', 'deg')}")
+        if ang:  # (a mechanism of bars and points alone has no angle to show)
+            print("  angles: " + ", ".join(f"{lk} {a:.6g}" for lk, a in ang.items())
+                  + f" {units.get('angle', 'deg')}")
         print(md.guess_block(), end="")
     if getattr(modes, "positive_dimension", False):
         print("infinitely many assemblies at this pose: a link is free to turn (no finite list)")

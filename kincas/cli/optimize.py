@@ -13,6 +13,7 @@ from ..synthesis.optimize import Optimization
 from .common import _list, _param_unit, _unit
 from .scene import load
 from .scene_optimize import run_scene
+from ..model.names import is_angle_name
 
 
 def cli_arguments(parser) -> None:
@@ -50,7 +51,7 @@ def report(sc, r: Optimization) -> dict:
     if "curve" in r.info:  # the fitted input at each target and the distance left there
         c = r.info["curve"]
         fitted = user(key, r.inputs[key])
-        if key.endswith(".angle"):  # within one turn from the sweep's start, not 677 deg
+        if is_angle_name(key):  # within one turn from the sweep's start, not 677 deg
             turn, lo = (360.0 if deg else 2 * math.pi), float(np.min(sc.study.written[key]))
             fitted = lo + np.mod(fitted - lo, turn)
         curve = {"curve": {"point": c["point"], "targets": c["targets"].tolist(),

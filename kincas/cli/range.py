@@ -31,8 +31,9 @@ def cli_run(args) -> int:
     for i, key in enumerate(keys):
         if args.input and key != args.input:
             continue
-        conv = math.degrees if (m.inputs[i].kind == "angle" and sc.study.deg) else float
-        unit = sc.study.units.get("angle") if m.inputs[i].kind == "angle" else sc.study.units.get("length", "")
+        angle = m.inputs[i].is_angle  # (a joint's angle too: J.angle, J.angle1)
+        conv = math.degrees if (angle and sc.study.deg) else float
+        unit = sc.study.units.get("angle", "deg") if angle else sc.study.units.get("length", "")
         try:
             r = input_range(m, start, key)
         except ModelError:

@@ -37,6 +37,7 @@ from ..model.mechanism import GROUND, Link, Mechanism, Param, Slide
 from ..results import Sweep
 from .scene_params import LARGEST, ParameterReader
 from .scene_study import StudyReader
+from ..model.names import is_angle_name
 
 SECTIONS = {"title", "space", "units", "parameters", "ground", "links", "slides", "inputs", "guess",
             "output", "optimize", "tolerance", "gravity", "loads", "study", "gears", "racks",
@@ -95,7 +96,7 @@ class Scene:
         `Sweep.info["display"]`): each name's unit label, and the names in degrees."""
         from ..model.names import is_angular
         from ..views.columns import quantity_unit
-        deg = [k for k in sw.inputs if k.endswith(".angle")] + [k for k in sw.values if is_angular(k, self.mechanism)]
+        deg = [k for k in sw.inputs if is_angle_name(k)] + [k for k in sw.values if is_angular(k, self.mechanism)]
         return {"units": dict(self.study.units), "degrees": deg if self.study.deg else [],
                 "labels": {k: quantity_unit(self, k) for k in [*sw.inputs, *sw.values]}}
 
@@ -119,7 +120,7 @@ class Scene:
         """Input values in the scene's units: the numbers as written, not through radians."""
         out = {}
         for k, v in s.inputs.items():
-            user, w = self._to_user(k, v, angle=k.endswith(".angle")), self.study.written.get(k)
+            user, w = self._to_user(k, v, angle=is_angle_name(k)), self.study.written.get(k)
             same = w is not None and w.shape == user.shape and np.allclose(user, w, rtol=1e-12, atol=0)
             out[k] = w if same else user
         return out

@@ -17,6 +17,7 @@ import numpy as np
 from .common import EXIT_OK, EXIT_UNSOLVED, _list, _unit
 from .scene import load
 from .scene_simulate import arguments_of
+from ..model.names import is_angle_name
 
 
 def cli_arguments(parser) -> None:
@@ -48,7 +49,7 @@ def user_series(sc, r) -> tuple[dict, dict]:
     ins = {"t": r.time}
     rates = {}
     for key in sc.study.simulation["free"]:
-        ang = key.endswith(".angle")
+        ang = is_angle_name(key)
         ins[key] = r.inputs[key] * (k if ang else 1.0)
         rates[rate_name(key)] = r.rates[key] * (k if ang else 1.0)
     values = {n: v * (k if is_angular(n, sc.mechanism) else 1.0) for n, v in r.values.items()}

@@ -14,6 +14,7 @@ import numpy as np
 from .common import EXIT_OK, EXIT_UNSOLVED, _list, _unit, progress_for
 from .scene import load
 from ..analysis.resume import label_text
+from ..model.names import is_angle_name
 
 
 def cli_arguments(parser) -> None:
@@ -76,7 +77,7 @@ def rate_line(sc, sw) -> str:
     for k in sw.inputs:
         u = _unit(sc, k)
         r, a = (np.asarray(d.get(k, 0.0), float) for d in (sw.rates, sw.accelerations))
-        if k.endswith(".angle") and sc.study.deg:
+        if is_angle_name(k) and sc.study.deg:
             r, a = np.degrees(r), np.degrees(a)
         show = lambda v: f"{v.flat[0]:.6g}" if v.size and np.ptp(v) == 0 else "varies"
         parts.append(f"{k} rate {show(r)} {u}/{T}, acceleration {show(a)} {u}/{T}^2")
@@ -89,7 +90,7 @@ def _user_rates(sc, rates: dict) -> dict:
     out = {}
     for k, v in rates.items():
         v = np.atleast_1d(np.asarray(v, float))
-        if k.endswith(".angle") and sc.study.deg:
+        if is_angle_name(k) and sc.study.deg:
             v = np.degrees(v)
         v = np.array([float(f"{x:.15g}") for x in v])  # through radians: 60.00000000000001 is 60
         out[k] = float(v[0]) if v.size and np.ptp(v) == 0 else _list(v)
@@ -99,7 +100,7 @@ def _user_rates(sc, rates: dict) -> dict:
 def _user_event(sc, e: dict) -> dict:
     """A singular position or a resumption, with its input values in the scene's units."""
     deg = sc.study.deg
-    ins = {k: (math.degrees(v) if deg and k.endswith(".angle") else v) for k, v in e["inputs"].items()}
+    ins = {k: (math.degrees(v) if deg and is_angle_name(k) else v) for k, v in e["inputs"].items()}
     return {**e, "inputs": ins}
 
 

@@ -30,7 +30,7 @@ from ..model.joints import Circle
 
 def _build_pose_function(model):
     sym, m = model.sym, model.sym.mech
-    out = [c for g in m.ground_points for c in sym.points[g]]
+    out = [c for g in m.ground_points for c in sym.ground_at(g)]
     out += [c for p in m.moving_points for c in sym.points[p]]
     if sym.dim == 3:  # a spatial slide: its `through` point and direction (or normal), world axes
         from .quaternions import apply, rotation

@@ -158,7 +158,7 @@ class Model(FirstPose):
         m = sym.mech
         locs = [c for lk in m.links for xy in sym.local_points(lk) for c in xy]
         self.f_local = ca.Function("local", [sym.u, sym.p], [ca.vertcat(*locs)])
-        gxy = [c for g, _ in m.ground for c in sym.points[g]]
+        gxy = [c for g, _ in m.ground for c in sym.ground_at(g)]
         self.f_ground = ca.Function("ground", [sym.u, sym.p], [ca.vertcat(*gxy) if gxy else ca.SX(0, 1)])
         # both at once through buffers: every Newton asks for them (its groups' lengths)
         self._geometry = _Call(ca.Function("geometry", [sym.u, sym.p],

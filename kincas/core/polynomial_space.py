@@ -227,9 +227,9 @@ def closure_space(m, u, driven_joints=True, snap=False) -> PolySystem:
     const = lambda v: [Poly.const(c) for c in v]
     one, zero = Poly.const(1), Poly.const(0)
     frames = {GROUND: (const([0, 0, 0]), [[one, zero, zero], [zero, one, zero], [zero, zero, one]], [0, 0, 0])}
-    points = {g: const(rel(xyz)) for g, xyz in m.ground}
+    exempt = m.exempt()  # (a slide joint's point listed in [ground] too is its second body's)
+    points = {g: const(rel(xyz)) for g, xyz in m.ground if (g, GROUND) not in exempt}
     layout = []  # per kincas unknown block: ("body", r indices, R indices) or ("point", indices)
-    exempt = m.exempt()
     for b in m.bodies:
         if b.two_point:
             continue

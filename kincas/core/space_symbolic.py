@@ -92,9 +92,13 @@ class SpatialSymbolic(Symbolic):
         # coordinates relative to the first ground point: far from the global origin, the
         # residuals (differences of nearby points) and the steps keep their relative accuracy
         self.origin = self._xyz(m.ground[0][1]) if m.ground else [ca.SX(0)] * 3
-        self.points = {g: self._rel(xyz) for g, xyz in m.ground}
-        self.frames = {GROUND: ([ca.SX(0)] * 3, [ca.SX(c) for c in IDENTITY], [ca.SX(0)] * 3)}
         exempt = m.exempt()
+        # a ground point that is the point of a cylindrical, prismatic or planar joint with the
+        # ground first marks where the line or plane is drawn; the point itself is the second
+        # body's (it slides), so the ground's copy does not hold it
+        self._ground = {g: self._rel(xyz) for g, xyz in m.ground}
+        self.points = {g: v for g, v in self._ground.items() if (g, GROUND) not in exempt}
+        self.frames = {GROUND: ([ca.SX(0)] * 3, [ca.SX(c) for c in IDENTITY], [ca.SX(0)] * 3)}
         for b in m.bodies:
             if b.two_point:
                 continue
@@ -143,7 +147,12 @@ class SpatialSymbolic(Symbolic):
                 eqs.append(self._input_equation(i.target, u))
         self.angles = {}
         self.points = {k: [v[i] + self.origin[i] for i in range(3)] for k, v in self.points.items()}
+        self._ground = {k: [v[i] + self.origin[i] for i in range(3)] for k, v in self._ground.items()}
         self._finish(qs, eqs)
+
+    def ground_at(self, g: str) -> list:
+        """Where ground point `g` is drawn, also where it is the anchor of a slide joint."""
+        return self._ground[g]
 
     # --- numbers, frames ---
     def _xyz(self, xyz):
@@ -286,6 +295,10 @@ class SpatialSymbolic(Symbolic):
             elif n.replace(" ", "").startswith("reaction("):  # optional in 3D (contract), not built
                 out.append(f"{where}: {n!r}: joint reactions are not built for spatial scenes in this "
                            f"version (efforts, effort(KEY), and shaking.x .. shaking.mz are)")
+            elif b in BODY_Q and any(lk.two_point and lk.name == a for lk in self.mech.bodies):
+                out.append(f"{where}: {n!r}: {a} is a two-point bar: its spin about its own axis is "
+                           f"not defined, so it has no rotation, quaternion or angular rate (report "
+                           f"its ends' positions and velocities, or make it a body with points)")
             elif self.position_expr(a, b)[0] is None and self.extra(n)[0] is None:
                 out.append(f"{where}: unknown quantity {n!r} (expected P.x .. P.z, P.vx, P.ax, P.jx .., "
                            f"L.qw .. L.qz, L.R11 .. L.R33, L.omega_x .., L.alpha_x .., J.angle, "

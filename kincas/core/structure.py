@@ -138,7 +138,7 @@ class Structure:
         for lk in m.links:
             pts = sym.local_points(lk)
             ext.append(fmax([dist(a, b) for i, a in enumerate(pts) for b in pts[i + 1:]]))
-        gxy = [sym.points[g] for g, _ in m.ground]
+        gxy = [sym.ground_at(g) for g, _ in m.ground]
         out = []
         for near, gidx in self._extent_links:
             span = [dist(gxy[a], gxy[b]) for i, a in enumerate(gidx) for b in gidx[i + 1:]]

@@ -146,6 +146,10 @@ class Symbolic:
         self.f_tangent = ca.Function("tangent", args, [self.g, self.Jq, self.Ju])
         self.f_points = ca.Function("points", args, [self._point_matrix()])
 
+    def ground_at(self, g: str) -> list:
+        """Where ground point `g` is drawn (fixed): its coordinates as expressions."""
+        return self.points[g]
+
     def _point_matrix(self):
         pts = [self.points[p] for p in self.mech.moving_points]
         return ca.horzcat(*[ca.vertcat(*xy) for xy in pts]) if pts else ca.SX(self.dim, 0)

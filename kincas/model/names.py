@@ -69,6 +69,22 @@ def is_rotation_entry(attr: str) -> bool:
     return _ROTATION.match(attr) is not None
 
 
+ANGLE_ATTRS = ("angle", "angle1", "angle2")  # a link's or joint's angle; a universal joint's two
+
+
+def is_angle_name(name: str) -> bool:
+    """Whether an input key or quantity name is an angle itself (not a rate): `crank.angle`,
+    `A/B.angle`, a joint's `J.angle`, a universal joint's `J.angle1` and `J.angle2`. The one
+    test for converting to degrees, wrapping to a turn and labelling an input's unit (a
+    parameter input's key has no dot: a length).
+
+    >>> is_angle_name("crank.angle"), is_angle_name("x.angle1"), is_angle_name("x.omega1"), is_angle_name("l1")
+    (True, True, False, False)
+    """
+    obj, dot, attr = name.rpartition(".")
+    return bool(dot) and attr in ANGLE_ATTRS and not name.startswith("d(")
+
+
 def is_angular(name: str, mech=None) -> bool:
     """Whether a quantity is an angle or an angle's rate (converted to degrees at the edge).
     `S.jerk` of a slide is a length's: give the mechanism to tell it from a link's `L.jerk`.

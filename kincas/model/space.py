@@ -186,7 +186,7 @@ class SpatialMechanism(SpatialChecks, SpatialLookups):
         ng = len(rigid) + sum(b.two_point for b in self.bodies)
         exempt = self.exempt()
         for p in on_body:
-            carriers = ([GROUND] if p in dict(self.ground) else []) + [
+            carriers = ([GROUND] if p in dict(self.ground) and (p, GROUND) not in exempt else []) + [
                 b.name for b in rigid if p in b.point_names and (p, b.name) not in exempt]
             ng += 3 * max(len(carriers) - 1, 0)
         extra = {"spherical": 0, "revolute": 2, "universal": 1, "cylindrical": 4,

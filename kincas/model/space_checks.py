@@ -98,7 +98,7 @@ class SpatialChecks:
         ground = dict(self.ground)
         drawn = {p for b in self.bodies if not b.two_point for p in b.point_names} | set(ground)
         for p, xyz in given:
-            if p in ground:
+            if p in ground and p not in self.moving_points:  # (a slide joint's point moves)
                 out.append(f"[guess] {p}: is a ground point (fixed)")
             elif p not in carried:
                 out.append(f"[guess] {p}: is not a point of any body")

@@ -13,6 +13,7 @@ from dataclasses import replace
 from ..errors import ModelError
 from .checks import _number_check
 from .lookups import Lookups
+from .mobility import GROUND
 from typing import TYPE_CHECKING
 
 from .space_parts import Joint, _triple
@@ -38,6 +39,25 @@ class SpatialLookups(Lookups):
         ['arm']
         """
         return self.bodies
+
+    @property
+    def moving_points(self) -> tuple[str, ...]:
+        """Points carried by bodies and not fixed to the ground, in declaration order. A ground
+        point that is the point of a cylindrical, prismatic or planar joint with the ground
+        first is moving: it belongs to the joint's second body, and the ground's copy only
+        marks where the line or plane is drawn (docs/scene-format.md).
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"G": (0, 0, 0)}, bodies=[Body("pad", {"G": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("prismatic", "G", axis=(0, 0, 1))], inputs=[Input.joint("G")])
+        >>> m.moving_points
+        ('G', 'P')
+        """
+        anchors = {p for p, b in self.exempt() if b == GROUND}
+        seen = dict.fromkeys(p for lk in self.links for p in lk.point_names)
+        return tuple(p for p in seen if p not in dict(self.ground) or p in anchors)
 
     @property
     def redundant(self) -> int:

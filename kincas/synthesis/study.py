@@ -37,6 +37,7 @@ from ..model.mechanism import Mechanism
 from .._deprecated import keyword, renamed
 from ..result_base import Result
 from .expressions import AGGREGATE, CONST, SAMPLE, TOTAL, parse, quantity_name
+from ..model.names import is_angle_name
 
 FIELDS = {"vary", "grid", "samples", "seed", "report"}
 
@@ -350,7 +351,7 @@ def study(m: Mechanism, vary: dict, inputs, report, *, grid=None, designs=None, 
 
 
 def _user(v, key, degrees):
-    return math.degrees(v) if degrees and key.endswith(".angle") else float(v)
+    return math.degrees(v) if degrees and is_angle_name(key) else float(v)
 
 
 # the name of 0.1 (results are named by what they hold, as Sweep and Pose are)

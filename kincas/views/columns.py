@@ -14,6 +14,10 @@ import numpy as np
 
 from ..results import Sweep
 from ..units import unit_label
+from ..model.names import is_angle_name
+
+SHAKING_FORCES = ("shaking.x", "shaking.y", "shaking.z")  # 2D: x, y; 3D: x, y, z
+SHAKING_MOMENTS = ("shaking.moment", "shaking.mx", "shaking.my", "shaking.mz")  # 2D; 3D
 
 
 def quantity_unit(sc, name: str) -> str:
@@ -29,11 +33,11 @@ def _force_unit(name: str, L: str, force: str = "force") -> str | None:
     from ..core.dynamics import _EFFORT
     m = _EFFORT.match(name)
     if m:
-        angular = m["key"].endswith(".angle")
+        angular = is_angle_name(m["key"])
         return f"{force}·{L}" if angular and L else force
-    if name.startswith(("reaction(", "contact(")) or name in ("shaking.x", "shaking.y"):
+    if name.startswith(("reaction(", "contact(")) or name in SHAKING_FORCES:
         return force
-    if name == "shaking.moment":
+    if name in SHAKING_MOMENTS:
         return f"{force}·{L}" if L else force
     if name.endswith(".curvature"):
         return f"1/{L}" if L else ""

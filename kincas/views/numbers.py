@@ -19,6 +19,8 @@ import math
 
 import numpy as np
 
+from ..model.names import is_angle_name
+
 EPS = 1e-11  # relative to a quantity's scale: below it, a value is zero to the solve's accuracy
 
 
@@ -40,6 +42,8 @@ def scale_of(name: str, scene, sweep) -> float:
     try:
         kind, obj, attr = parse_quantity(name)
     except Exception:  # a quantity kind this module does not know
+        return 0.0
+    if name.startswith("shaking."):  # a force or moment (not a position named x, y, z)
         return 0.0
     L = _size(scene)
     if kind == "sens":
@@ -70,7 +74,7 @@ def _input_rates(scene, sweep, L: float) -> tuple[float, float]:
     that is a length counts as rate / L. At least 1: the scale must not vanish."""
     w = a = 0.0
     for k in sweep.inputs:
-        per = 1.0 if k.endswith(".angle") else (1.0 / L if L > 0 else 0.0)
+        per = 1.0 if is_angle_name(k) else (1.0 / L if L > 0 else 0.0)
         r = np.asarray(sweep.rates.get(k, 0.0), float)
         acc = np.asarray(sweep.accelerations.get(k, 0.0), float)
         w = max(w, float(np.nanmax(np.abs(r))) * per if r.size else 0.0)

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from .picture import INK
+from ..model.names import is_angle_name
 
 LABEL_FRAMES = 180  # the names' places are worked out at most this often over a sweep
 
@@ -31,7 +32,7 @@ def _arr(a, digits=9):
 
 def _wrap(name: str, unit: str):
     """Half a turn for a wrapped angle (its plot breaks where it jumps by a turn), else None."""
-    if not name.endswith(".angle") or name.startswith("d("):
+    if not is_angle_name(name):
         return None
     return 180.0 if unit == "deg" else math.pi
 

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..results import Sweep
 from .columns import _abscissa, heading, user_columns
+from ..model.names import is_angle_name
 
 FLAG_STYLE = {"limit": ("#d62728", "limit of motion"), "change point": ("#9467bd", "change point"),
               "singular": ("#ff7f0e", "singular position")}
@@ -66,7 +67,7 @@ def _break_wraps(name: str, x, v, half):
     >>> _break_wraps("L.angle", np.arange(3.0), np.array([3.0, -3.1, -3.0]), np.pi)[1].tolist()
     [3.0, nan, -3.1, -3.0]
     """
-    if not name.endswith(".angle") or name.startswith("d(") or len(v) < 2:
+    if not is_angle_name(name) or len(v) < 2:
         return x, v
     jumps = np.flatnonzero(np.abs(np.diff(v)) > half) + 1
     return np.insert(x.astype(float), jumps, np.nan), np.insert(np.asarray(v, float), jumps, np.nan)
