@@ -18,18 +18,12 @@ wrapped to (-pi, pi].
 """
 from __future__ import annotations
 
-import threading
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .result_base import Result, listed as _names
-
-
-def wrap_angle(a: np.ndarray) -> np.ndarray:
-    """Wrap radians to (-pi, pi]."""
-    w = np.mod(np.asarray(a, dtype=float) + np.pi, 2 * np.pi) - np.pi
-    return np.where(w == -np.pi, np.pi, w)
+from .result_later import _Later, install, trues, wrap_angle, wrap_angles  # noqa: F401 (wrap_angle: its old home)
 
 
 @dataclass(repr=False)
@@ -135,79 +129,6 @@ class Pose(Result):
         return in_angle(pose_to_xarray(self, length), angle)
 
 
-class _Later:
-    """A result's array made when first read (`Sweep._built`): `make(*args)`, once, whichever
-    thread asks first (the others get the same object)."""
-
-    __slots__ = ("make", "args", "value")
-
-    def __init__(self, make, *args):
-        self.make, self.args, self.value = make, args, None
-
-    def get(self):
-        value = self.value
-        if value is None:
-            with _LATER:
-                if self.value is None:
-                    self.value = self.make(*self.args)
-                value = self.value
-        return value
-
-
-_LATER = threading.Lock()
-
-
-def _all_ok(n: int) -> np.ndarray:
-    status = np.empty(n, dtype=object)  # (np.full of an object is ten times slower)
-    status.fill("ok")
-    return status
-
-
-def _no_flags(n: int) -> list:
-    return [None] * n
-
-
-def _as_int(a: np.ndarray) -> np.ndarray:
-    return a.astype(int)
-
-
-_ANGLES: dict = {}  # reported names (a tuple) -> those that are angles, wrapped into (-pi, pi]
-
-
-def _angle_names(names: tuple) -> tuple:
-    """The names among `names` whose values are angles taken into (-pi, pi] (`.angle` and
-    `.phi`, not derivatives `d(...)`), looked up once per list of names."""
-    out = _ANGLES.get(names)
-    if out is None:
-        out = tuple(k for k in names if type(k) is str and k.endswith((".angle", ".phi")) and not k.startswith("d("))
-        if len(_ANGLES) >= 256:  # (bounded: a loop over many lists)
-            _ANGLES.clear()
-        _ANGLES[names] = out
-    return out
-
-
-def _lazy_field(name: str, doc: str, convert=None):
-    """A Sweep field kept as `_name`: read through `_Later` where it is made when first read;
-    set (by __init__ too) through `convert`."""
-    key = "_" + name
-
-    def get(self):
-        v = self.__dict__[key]
-        return v.get() if type(v) is _Later else v
-
-    def set(self, value):
-        self.__dict__[key] = value if convert is None else convert(value)
-    get.__doc__ = doc
-    return property(get, set, doc=doc)
-
-
-def _object_status(st):
-    # object dtype: a longer status assigned later is kept whole, not truncated
-    if isinstance(st, np.ndarray) and st.dtype == object:  # (kept if it is one)
-        return st
-    return st.astype(object) if isinstance(st, np.ndarray) else np.array(list(st), dtype=object)
-
-
 @dataclass(repr=False)
 class Sweep(Result):
     """Poses over a sweep of the inputs: `sweep["C.x"]` is an array with one entry per pose.
@@ -265,28 +186,7 @@ class Sweep(Result):
 
     def __post_init__(self):
         # (the status is made an object array by its setter, `_set_status`)
-        for k in _angle_names(tuple(self.values)):
-            self.values[k] = wrap_angle(self.values[k])
-
-    @classmethod
-    def _built(cls, n: int, status, flags, iterations, **fields) -> "Sweep":
-        """A sweep's result as `kincas.sweep` builds it, without the checks of `__init__`:
-        `status` an object array, or None where every pose is "ok"; `flags` a list, or None
-        where no pose is flagged; `iterations` an int array, or a float array of whole numbers
-        (the fast kernel's counts). Where None or float, the array users read is made when
-        first read (`_Later`): a warm sweep whose status, flags and iteration counts nobody
-        reads does not pay for them (an object array of 360 "ok" alone costs as much as a
-        third of the four-bar's compiled solve). Angles reported are wrapped here."""
-        out = cls.__new__(cls)
-        d = out.__dict__
-        d.update(fields)
-        d["_status"] = _Later(_all_ok, n) if status is None else status
-        d["_flags"] = _Later(_no_flags, n) if flags is None else flags
-        d["_iterations"] = iterations if iterations.dtype.kind == "i" else _Later(_as_int, iterations)
-        values = fields["values"]
-        for k in _angle_names(tuple(values)):
-            values[k] = wrap_angle(values[k])
-        return out
+        wrap_angles(self.values)
 
     def __len__(self) -> int:
         return len(self.status)
@@ -440,16 +340,11 @@ class Sweep(Result):
         ([True, True], [True, True])
         """
         st = self.__dict__["_status"]
-        if type(st) is _Later and st.value is None:  # never read (or changed): every pose "ok"
-            out = np.empty(st.args[0], dtype=bool)  # (np.ones: three times the cost)
-            out.fill(True)
-            return out
-        st = self.status
-        n = len(st)  # every pose solved (the usual sweep): list.count compares by identity first
+        if type(st) is _Later and st.value is None:  # never read (nor set): every pose "ok"
+            return trues(st.args[0])
+        st, n = self.status, len(self.status)  # every pose solved (the usual sweep): list.count
         if type(st) is np.ndarray and st.dtype == object and st.ndim == 1 and st.tolist().count("ok") == n:
-            out = np.empty(n, dtype=bool)  # (numpy's == calls __eq__: 3x)
-            out.fill(True)
-            return out
+            return trues(n)  # compares by identity first (numpy's == calls __eq__: 3x)
         return np.asarray(st == "ok", dtype=bool).reshape(n)
 
     @property
@@ -494,23 +389,4 @@ class Sweep(Result):
                     residual=float(self.residual[i]))
 
 
-# status, flags and iterations: made when first read where `Sweep._built` leaves them for later
-_SWEEP_EXAMPLE = """
-    Examples
-    --------
-    >>> import kincas
-    >>> m = kincas.Mechanism(ground={"O": (0, 0)}, links=[kincas.Link.bar("crank", "O", "A", 2)],
-    ...                      inputs=[kincas.Input.angle("crank")])
-    >>> sw = kincas.sweep(m, {"crank.angle": [0.0, 1.5707963267948966]}, report=["A.x"])
-    >>> %s
-    %s
-    """
-Sweep.status = _lazy_field("status", """Per pose, "ok" or why it was not solved: a numpy array of
-    strings (object dtype: a longer status assigned later is kept whole).
-""" + _SWEEP_EXAMPLE % ("sw.status.tolist(), sw.status.dtype", "(['ok', 'ok'], dtype('O'))"), _object_status)
-Sweep.flags = _lazy_field("flags", """Per pose, "limit", "change point" or "singular" at or next to a
-    singular position, else None (a list).
-""" + _SWEEP_EXAMPLE % ("sw.flags", "[None, None]"))
-Sweep.iterations = _lazy_field("iterations", """Per pose, the Newton steps taken (integers; 0
-    where none was attempted).
-""" + _SWEEP_EXAMPLE % ("sw.iterations.dtype.kind, bool((sw.iterations >= 0).all())", "('i', True)"))
+install(Sweep)  # status, flags and iterations: made when first read (kincas/result_later.py)
