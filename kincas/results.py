@@ -23,12 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .result_base import Result, listed as _names
-
-
-def wrap_angle(a: np.ndarray) -> np.ndarray:
-    """Wrap radians to (-pi, pi]."""
-    w = np.mod(np.asarray(a, dtype=float) + np.pi, 2 * np.pi) - np.pi
-    return np.where(w == -np.pi, np.pi, w)
+from .result_later import _Later, install, trues, wrap_angle, wrap_angles  # noqa: F401 (wrap_angle: its old home)
 
 
 @dataclass(repr=False)
@@ -190,13 +185,8 @@ class Sweep(Result):
     info: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        # object dtype: a longer status assigned later is kept whole, not truncated
-        if not (isinstance(st := self.status, np.ndarray) and st.dtype == object):  # (kept if it is one)
-            self.status = st.astype(object) if isinstance(st, np.ndarray) else np.array(list(st), dtype=object)
-        angles = ".angle" in (names := "\n".join(map(str, self.values))) or ".phi" in names  # (one search)
-        for k in list(self.values) if angles else ():
-            if k.endswith((".angle", ".phi")) and not k.startswith("d("):  # cam.phi too
-                self.values[k] = wrap_angle(self.values[k])
+        # (the status is made an object array by its setter, `_set_status`)
+        wrap_angles(self.values)
 
     def __len__(self) -> int:
         return len(self.status)
@@ -349,9 +339,12 @@ class Sweep(Result):
         >>> sw.ok.tolist(), (sw.status == "ok").tolist()
         ([True, True], [True, True])
         """
+        st = self.__dict__["_status"]
+        if type(st) is _Later and st.value is None:  # never read (nor set): every pose "ok"
+            return trues(st.args[0])
         st, n = self.status, len(self.status)  # every pose solved (the usual sweep): list.count
         if type(st) is np.ndarray and st.dtype == object and st.ndim == 1 and st.tolist().count("ok") == n:
-            return np.ones(n, dtype=bool)  # compares by identity first (numpy's == calls __eq__: 3x)
+            return trues(n)  # compares by identity first (numpy's == calls __eq__: 3x)
         return np.asarray(st == "ok", dtype=bool).reshape(n)
 
     @property
@@ -394,3 +387,6 @@ class Sweep(Result):
                     status=str(self.status[i]), flag=self.flags[i],
                     values={k: float(v[i]) for k, v in self.values.items()},
                     residual=float(self.residual[i]))
+
+
+install(Sweep)  # status, flags and iterations: made when first read (kincas/result_later.py)

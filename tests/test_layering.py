@@ -18,7 +18,7 @@ PKG = ROOT / "kincas"
 LAYERS = ["kincas.model", "kincas.core", "kincas.analysis", "kincas.synthesis", "kincas.views",
           "kincas.cli"]
 # neutral modules, used by every floor: they import nothing but the model and one another
-NEUTRAL = {"kincas.errors", "kincas.results", "kincas.units", "kincas.frames", "kincas.result_base",
+NEUTRAL = {"kincas.errors", "kincas.results", "kincas.result_later", "kincas.units", "kincas.frames", "kincas.result_base",
            "kincas._deprecated", "kincas._launch"}
 # the package's face: re-exports the library and registers the notebook displays (so it sits
 # above every floor but the command line, which takes the version from it); `python -m kincas`

@@ -203,3 +203,58 @@ def test_the_first_pose_solved_once_per_inputs_and_guess_is_never_served_elsewhe
         low = kincas.sweep(mech, {"crank.angle": th}, report=["C.y"], guess={"C": (2.5, -1.0)})
         C_low = closed_forms.fourbar((0, 0), (4, 0), 1.0, b, 3.0, th, -1)[1].T
         assert low.ok.all() and np.abs(low["C.y"] - C_low[1]).max() < 1e-12
+
+
+# --- what a warm sweep leaves for later, and the one-pass test of "nothing met" ---
+
+
+def test_status_flags_and_iterations_made_when_read_are_the_sweeps_own():
+    """A sweep with every pose solved makes its status, flags and iteration counts when first
+    read: each read gives the same array (a change made to it stays), two sweeps never share
+    one, `ok` before and after any read follows the status, and a copy or a pickle keeps them."""
+    import copy
+    import pickle
+    m, th = fourbar(), np.linspace(0.1, 6.0, 40)
+    a = kincas.sweep(m, {"crank.angle": th}, report=REPORT)
+    b = kincas.sweep(m, {"crank.angle": th}, report=REPORT)
+    assert a.ok.dtype == bool and a.ok.all() and len(a.ok) == 40  # before any read of status
+    assert a.status is a.status and a.status.dtype == object and a.status.tolist() == ["ok"] * 40
+    assert a.flags == [None] * 40 and a.flags is a.flags
+    assert a.iterations.dtype.kind == "i" and (a.iterations >= 0).all() and a.iterations is a.iterations
+    a.status[3], a.flags[5] = "no assembly", "limit"
+    assert not a.ok[3] and a.ok.sum() == 39 and a.flags[5] == "limit"
+    assert b.ok.all() and b.status.tolist() == ["ok"] * 40 and b.flags == [None] * 40  # not shared
+    c = pickle.loads(pickle.dumps(b))
+    d = copy.deepcopy(a)
+    assert c.ok.all() and c.status.tolist() == ["ok"] * 40 and c.flags == [None] * 40
+    assert d.status[3] == "no assembly" and d.flags[5] == "limit" and d.ok.sum() == 39
+    b.status = ["ok"] * 39 + ["gone"]  # set whole: an object array again
+    assert b.status.dtype == object and b.ok.tolist() == [True] * 39 + [False]
+    check(c, th, 3.5, 1.0)
+
+
+def test_nothing_met_from_the_kernels_measures_agrees_with_the_general_test():
+    """`nothing_met_measures` (modes summed, one comparison) answers as `nothing_met` on
+    tables of modes and sigmas built to sit on every edge: a mode changing once, a mode 0
+    or NaN, a sigma at, just above and just below the bound, NaN, one pose, two groups."""
+    from kincas.analysis.events import _SIGMA_BOUND, nothing_met, nothing_met_measures
+    rng = np.random.default_rng(7)
+    edges = [_SIGMA_BOUND, np.nextafter(_SIGMA_BOUND, 1), np.nextafter(_SIGMA_BOUND, 0), np.nan, 0.3, 1.0]
+    tried = {True: 0, False: 0}
+    for trial in range(400):
+        n, g = int(rng.choice([1, 2, 7, 40])), int(rng.choice([1, 2, 3]))
+        signs = np.tile(rng.choice([-1.0, 1.0], g), (n, 1))
+        sigma = rng.uniform(0.01, 1.0, n)
+        kind = trial % 5
+        if kind == 1:
+            signs[rng.integers(n), rng.integers(g)] *= -1
+        elif kind == 2:
+            signs[rng.integers(n), rng.integers(g)] = rng.choice([0.0, np.nan])
+        elif kind == 3:
+            sigma[rng.integers(n)] = rng.choice(edges)
+        M = np.empty((n, g + 1))
+        M[:, :g], M[:, g] = signs, sigma
+        want = nothing_met(np.ones(n, dtype=bool), signs, sigma, True)
+        assert nothing_met_measures(M, M.ravel()) == want, (signs, sigma)
+        tried[want] += 1
+    assert min(tried.values()) > 50  # both answers were met often

@@ -179,11 +179,45 @@ def nothing_met(ok, signs, sigma, every: bool | None = None) -> bool:
     if the caller knows it already), every group well conditioned at every pose (none near
     NEAR_SINGULAR or FLAG_SIGMA) and in one mode throughout. The usual sweep: then none of
     the searches of `sweep_events` has anything to look at."""
-    if not (ok.all() if every is None else every) or not sigma.min(initial=np.inf) > max(NEAR_SINGULAR, 1e3 * FLAG_SIGMA):  # (NaN: not)
+    if not (ok.all() if every is None else every) or not sigma.min(initial=np.inf) > _SIGMA_BOUND:  # (NaN: not)
         return False
     signs = np.asarray(signs)
     return not np.count_nonzero(signs != signs[:1])  # (NaN != NaN: a NaN sign is a change;
     # count_nonzero costs a third of a ufunc's reduction .all())
+
+
+def nothing_met_measures(M, flat) -> bool:
+    """`nothing_met` for a sweep with every pose solved, from the fast kernel's measures as it
+    writes them, pose by pose: M (N, groups + 1) each group's mode then sigma, `flat` the same
+    numbers in one row. The same answer as `nothing_met` in three numpy calls instead of
+    seven, none of them a ufunc's reduction: each mode is -1, 0 or +1 (NaN where not
+    measured), so a group's modes summed over the N poses (whole numbers, exact) are N times
+    the first pose's mode, +-1, exactly where every pose has that mode; and flat > c (c: -2
+    at each mode, the bound at each sigma) holds everywhere exactly where no measure is NaN
+    and every sigma exceeds the bound. A first pose with a mode 0 or NaN is left to
+    `nothing_met`."""
+    n = len(M)
+    ones, c = _rows_of(n, M.shape[1])
+    sums = np.dot(ones, M).tolist()  # (BLAS: a matrix-vector product)
+    if not all(abs(v) == n for v in sums[:-1]) or n == 0:  # (NaN: not)
+        return n > 0 and nothing_met(np.ones(n, dtype=bool), M[:, :-1], M[:, -1], True)
+    return np.count_nonzero(flat > c) == flat.size
+
+
+_SIGMA_BOUND = max(NEAR_SINGULAR, 1e3 * FLAG_SIGMA)  # sigma above it everywhere: nothing near singular
+_ROWS: dict = {}  # (N, groups + 1) -> (ones (N,), c (N * (groups + 1),)), read only
+
+
+def _rows_of(n: int, width: int):
+    """(ones (n,), c): what `nothing_met_measures` multiplies and compares with, per size."""
+    got = _ROWS.get((n, width))
+    if got is None:
+        ones, c = np.ones(n), np.tile([-2.0] * (width - 1) + [_SIGMA_BOUND], n)
+        ones.flags.writeable = c.flags.writeable = False
+        if len(_ROWS) >= 64:  # (bounded: sweeps of many lengths)
+            _ROWS.clear()
+        got = _ROWS[(n, width)] = (ones, c)
+    return got
 
 
 def _distinct(events):

@@ -115,7 +115,7 @@ class Prepared:
             return None
         key = (np.asarray(u, float).tobytes(),
                None if guess is self.guess else tuple(sorted(guess.items())))  # (the usual case)
-        out = self._places.get(key, self)  # (self: not kept; a placement may be None)
+        out = self._places.peek(key, self)  # (self: not kept; a placement may be None)
         return self._places.get_or_build(key, lambda: self._place(model, u, guess)) if out is self else out
 
     def _place(self, model, u, guess):
@@ -177,6 +177,10 @@ def model_and_prepared(m: Mechanism, model_of):
     structure key is every link and joint) nor repeats the deferred mobility check, which
     `model_of` runs (a mechanism is immutable: what was decided for it stays decided; a
     mechanism refused raises every time, since nothing is kept for it)."""
+    seen = _SEEN.peek(id(m))  # (the usual case: no lock, no closure)
+    if seen is not None and seen[0] is m:
+        return seen[1], seen[2]
+
     def build():
         model = model_of(m)
         return m, model, prepared(model, m)

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.mechanism import Mechanism
+from ..core.fast_run import FastRun
 from ..core.numeric import Model, compile
 from ..results import Pose, Sweep
 from ..core.symbolic import needs_jerk
@@ -29,7 +30,7 @@ from ..model.names import default_report
 from .choice import choose_assembly
 from .continuation import careful_pose
 from .resume import unlabelled_resumes
-from .events import nothing_met, null_derivatives, sweep_events
+from .events import nothing_met, nothing_met_measures, null_derivatives, sweep_events
 from ..core.joints import check_first_pose
 from .inputs import derivative_table, input_table as _input_table
 from .prepared import model_and_prepared
@@ -144,23 +145,22 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     # (a tall system, with redundant joints, has no compiled pass: its g_q is not square)
     # Which pass solves which pose is the method's choice (kincas/analysis/methods.py).
     run = solver.sweep(SweepProblem(model, pm, names, report, U, Ud, Udd, p, L, careful, first, progress))
-    ok, Q, res, its = run.solved, run.Q, run.residual.copy(), run.iterations
+    ok, Q = run.solved, run.Q
     every = np.count_nonzero(ok) == n  # (a ufunc's reduction costs twice as much)
     if m.gears and ok.any():  # gear centre distances at the first solved pose
         check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
-    if every:
-        status = np.empty(n, dtype=object)  # (np.full of an object is ten times slower)
-        status.fill("ok")
-    else:
-        status = np.array(["ok" if s else NO_ASSEMBLY for s in ok], dtype=object)
-    flags = [None] * n
+    # status None: every pose "ok" (the Sweep makes the array when first read)
+    status = None if every else np.array(["ok" if s else NO_ASSEMBLY for s in ok], dtype=object)
+    flags = None  # None: no pose flagged (the Sweep makes the list when first read)
     if not every:  # after gaps the fast pass crossed (none where every pose is solved)
         events += unlabelled_resumes(model, U, p, L, Q, ok, events)
-    crossed, signs, sigma = getattr(run, "crossed", ()), run.signs, run.sigma
-    if every and not len(crossed) and nothing_met(ok, signs, sigma, every):
+    crossed = getattr(run, "crossed", ())
+    if every and not len(crossed) and (nothing_met_measures(*run.measures_by_pose()) if type(run) is FastRun
+                                       else nothing_met(ok, run.signs, run.sigma, every)):
         at = None  # the usual sweep: no singular position met, no gap (nothing to search)
     else:
-        found, at = _singular_events(model, m, U, Q, ok, p, L, flags, signs, sigma, crossed)
+        flags = [None] * n
+        found, at = _singular_events(model, m, U, Q, ok, p, L, flags, run.signs, run.sigma, crossed)
         events += found
     values = run.values
     if Uddd is not None:  # the inputs' jerks enter only the third derivatives
@@ -176,15 +176,19 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         events.sort(key=lambda e: e["pose"])
         for e in events:
             e.setdefault("inputs", {kk: float(U[e["pose"], j]) for j, kk in enumerate(keys)})
-    out = Sweep(inputs=({keys[0]: U.ravel().copy()} if U.shape[1] == 1 else  # (one input: no view)
-                        {k: U[:, j].copy() for j, k in enumerate(keys)}),
-                rates={k: Ud[:, j] for j, k in enumerate(keys)},  # (tables of this call's own)
-                accelerations={k: Udd[:, j] for j, k in enumerate(keys)},
-                status=status, flags=flags,
-                values=dict(zip(report, values)),  # (each row a view, as indexing gives it)
-                q=Q, residual=res, iterations=its,
-                unknowns=model.unknown_names, size=L, events=events,
-                info={"fast pass": getattr(run, "backend", None)})
+    if len(keys) == 1:  # (one input: no view of the caller's array, no comprehension)
+        k0 = keys[0]
+        ins, rts, accs = {k0: U.ravel().copy()}, {k0: Ud[:, 0]}, {k0: Udd[:, 0]}
+    else:
+        ins = {k: U[:, j].copy() for j, k in enumerate(keys)}
+        rts = {k: Ud[:, j] for j, k in enumerate(keys)}  # (tables of this call's own)
+        accs = {k: Udd[:, j] for j, k in enumerate(keys)}
+    its = run.info[4] if getattr(run, "attempted", False) else run.iterations  # (whole numbers:
+    # the Sweep makes them integers when first read)
+    out = Sweep._built(n, status, flags, its, inputs=ins, rates=rts, accelerations=accs,
+                       values=dict(zip(report, values)),  # (each row a view, as indexing gives it)
+                       q=Q, residual=run.residual, unknowns=model.unknown_names, size=L,
+                       events=events, info={"fast pass": getattr(run, "backend", None)})
     if g or every:
         return out  # the guess picks the assembly, whatever poses its branch loses
     # no guess: where the default assembly loses poses, one of the first pose's others that

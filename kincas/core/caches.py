@@ -70,6 +70,13 @@ class Memo:
         with self._lock:
             return self._d.get(key, default)
 
+    def peek(self, key, default=None):
+        """`get` without taking the lock, for a look-up on a warm path: one dict look-up is
+        one step under the GIL, and entries are only added or removed whole (under the
+        lock), so a reader sees an entry or its absence, never half of one. Not for a weak
+        memo (its look-up runs Python code)."""
+        return self._d.get(key, default)
+
     def __contains__(self, key) -> bool:
         with self._lock:
             return key in self._d

@@ -104,7 +104,7 @@ class FastSweeper(VirtualMachineSweep):
         self._group_of = np.full(self.nq, len(self.blocks), dtype=np.intp)  # each unknown's group
         for i, b in enumerate(self.blocks):
             self._group_of[np.asarray(b.cols, dtype=np.intp)] = i
-        self._one_group = len(self.blocks) == 1 and not self._group_of.any()
+        self._groups = self._group_of.tolist()
         self.nj = diagonal_size(self.blocks)  # g_q's diagonal blocks, all the state keeps of it
         self.state_size = 2 * self.nq + self.nj + 2 * (self.nq * self.nu + self.nu)
         self._functions, self._size, self._poses, self._calls = None, None, 0, 0  # swept so far
@@ -277,8 +277,10 @@ class FastSweeper(VirtualMachineSweep):
             s = self.state(q0, r.U[k], r.p)
             s.flags.writeable = False
             before = _diagonal_signs(s[self.nq:self.nq + self.nj], self.blocks)
-            placed.kernel = s, before.tolist(), bool((before != 0).all()), 1.0 / qs
-        s, before, regular, inv_qs = placed.kernel
+            # q0 and 1 / qs as Python numbers: the correction of a few unknowns summed in
+            # Python costs a third of numpy's calls for it
+            placed.kernel = s, before.tolist(), bool((before != 0).all()), q0.tolist(), (1.0 / qs).tolist()
+        s, before, regular, q0s, inv_qs = placed.kernel
         if not regular:  # a group singular at q0: its mode is not the guess's to choose
             r._s = None
             return k
@@ -286,11 +288,11 @@ class FastSweeper(VirtualMachineSweep):
         r._s = r._state
         bad = r.advance(k, None, None, stop)
         if bad > k and r.measures[:len(self.blocks), k].tolist() == before:
-            # each group's sum of |q - q0| / qs over its own unknowns
-            dq = np.abs(r.Q[k] - q0)
-            moved = (float(np.dot(dq, inv_qs)) if self._one_group else
-                     np.bincount(self._group_of, dq * inv_qs, len(self.blocks) + 1)[:-1].max(initial=0.0))
-            if moved <= CORRECTION:
+            # each group's sum of |q - q0| / qs over its own unknowns (in the order of q)
+            moved = [0.0] * (len(self.blocks) + 1)
+            for g, a, b, w in zip(self._groups, r.Q[k].tolist(), q0s, inv_qs):
+                moved[g] += abs(a - b) * w
+            if max(moved[:-1], default=0.0) <= CORRECTION:
                 return bad
         r._s = None  # nothing of this attempt is kept: the careful path starts afresh
         r.Q[k:bad + 1] = r.values[:, k:bad + 1] = r.measures[:, k:bad + 1] = np.nan

@@ -13,7 +13,6 @@ and `_take` read rates and accelerations given as a table or as one row for ever
 from __future__ import annotations
 
 import ctypes
-from itertools import accumulate
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -26,6 +25,7 @@ if TYPE_CHECKING:
 
 INFO = ("residual", "step", "jac_change", "correction", "steps")
 _HEAD = np.array([np.nan, RESIDUAL, STEP, JAC_CHANGE, CORRECTION, KERNEL_NEAR])  # L, then thresholds
+_F8 = np.dtype(np.float64)
 
 
 class FastRun:
@@ -44,33 +44,43 @@ class FastRun:
 
     def __init__(self, sweeper: "FastSweeper", U, p, L, Ud=None, Udd=None):
         self.sweeper, nq, nu = sweeper, sweeper.nq, sweeper.nu
-        U = table(U, nu)
+        if not (type(U) is np.ndarray and U.ndim == 2 and U.shape[1] == nu and U.dtype == _F8):
+            U = table(U, nu)
         self.n = n = U.shape[0]
         Ud, sud = _rows(np.ones(nu) if Ud is None else Ud, n, nu)
         Udd, sudd = _rows(np.zeros(nu) if Udd is None else Udd, n, nu)
-        if not (type(p) is np.ndarray and p.dtype == np.float64 and p.ndim == 1):  # (a mechanism's
+        if not (type(p) is np.ndarray and p.dtype == _F8 and p.ndim == 1):  # (a mechanism's
             p = np.asarray(p, dtype=float).ravel()  # prepared values are: no call for them)
         # everything the kernel reads or writes of this run in one block of memory: L and
         # the thresholds, the state, Q, info, values, measures, then copies of the inputs
         # (U, rates, accelerations: a table, or one row for every pose) and the parameters
         # (one address per run: numpy's array interface costs ~1.5 us an array)
         no, nm = len(sweeper.report), len(sweeper.blocks) + 1
-        o = self._off = list(accumulate([0, 6, sweeper.state_size, n * nq, 5 * n, no * n, nm * n, n * nu,
-                                         (n if sud else 1) * nu, (n if sudd else 1) * nu, p.size]))
+        o1 = 6
+        o2 = o1 + sweeper.state_size
+        o3 = o2 + n * nq
+        o4 = o3 + 5 * n
+        o5 = o4 + no * n
+        o6 = o5 + nm * n
+        o7 = o6 + n * nu
+        o8 = o7 + (n if sud else 1) * nu
+        o9 = o8 + (n if sudd else 1) * nu
+        o = self._off = (0, o1, o2, o3, o4, o5, o6, o7, o8, o9, o9 + p.size)
         block = self._block = np.empty(o[-1])
         block[:6] = _HEAD  # the thresholds, then L in its place
         block[0] = L
-        self._state, self.Q = block[o[1]:o[2]], block[o[2]:o[3]].reshape(n, nq)
-        per_pose = block[o[3]:o[5]].reshape(5 + no, n)  # info, values: one table
+        self._state, self.Q = block[o1:o2], block[o2:o3].reshape(n, nq)
+        per_pose = block[o3:o5].reshape(5 + no, n)  # info, values: one table
         self.info, self.values = per_pose[:5], per_pose[5:]
         # the measures pose by pose (the kernel writes one pose's together: a row per measure
         # of 100,000 poses would be 41 streams of writes on 40 chained four-bars, 1.7 us a
         # pose), seen as (groups + 1, N)
-        self.measures = block[o[5]:o[6]].reshape(n, nm).T
+        self.measures = block[o5:o6].reshape(n, nm).T
         # the inputs and parameters copied in by one call (views of them made when asked)
-        np.concatenate((U.ravel(), Ud.ravel(), Udd.ravel(), p), out=block[o[6]:])
+        np.concatenate((U.ravel(), Ud.ravel(), Udd.ravel(), p), out=block[o6:])
         self._sud, self._sudd, self._U, self._Ud, self._Udd, self._p = sud, sudd, None, None, None, None
-        self.accepted, self.solved = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+        self._ok = np.zeros((2, n), dtype=bool)  # accepted, solved: one table, set by one call
+        self.accepted, self.solved = self._ok
         self.first_bad, self._s, self._addr, self.recorded = 0, None, None, 0
         self.attempted = False  # True once every pose was attempted (`FastSweeper.sweep`)
         self.backend = None  # "compiled" or "virtual machine": what `advance` ran last
@@ -114,6 +124,11 @@ class FastRun:
     signs = property(lambda self: self.measures[:-1].T, doc="(N, groups) signs of det per group")
     sigma = property(lambda self: self.measures[-1], doc="smallest relative singular value bound")
 
+    def measures_by_pose(self) -> tuple:
+        """The measures as the kernel writes them: (N, groups + 1), and the same in one row."""
+        flat = self._block[self._off[5]:self._off[6]]
+        return self.measures.T, flat
+
     def advance(self, start: int, q_last, u_last, stop: int | None = None) -> int:
         """Solve poses start, start + 1, ... (before `stop`, default N) from the solved pose
         (q_last, u_last) until one is rejected, and return its index (`stop` if none was).
@@ -138,7 +153,7 @@ class FastRun:
                 a + 8 * (o[8] + start * sudd), sudd, a + 8 * (o[4] + start), a + 8 * (o[5] + start * (len(sw.blocks) + 1)))
         else:
             k = sw._vm_advance(self, start, stop, s)
-        self.accepted[start:k] = self.solved[start:k] = True
+        self._ok[:, start:k] = True  # accepted and solved
         if k < stop:
             self.Q[k] = self.values[:, k] = self.measures[:, k] = np.nan
         self.first_bad = k

@@ -344,8 +344,12 @@ class Model(FirstPose):
 
     @property
     def unknown_names(self) -> list[str]:
-        """The names of the unknowns, in the order of q (`crank.angle`, `L.x`, ...)."""
-        return [nm for nm, _ in self.sym.unknowns]
+        """The names of the unknowns, in the order of q (`crank.angle`, `L.x`, ...): a new
+        list each time (the names found once)."""
+        names = self.__dict__.get("_unknown_names")
+        if names is None:
+            names = self._unknown_names = tuple(nm for nm, _ in self.sym.unknowns)
+        return list(names)
 
     @property
     def unknown_kinds(self) -> list[str]:
