@@ -63,7 +63,11 @@ def test_grouped_and_flat_kernels_agree(source):
             x, y = np.asarray(x), np.asarray(y)
             assert x.shape == y.shape
             scale = 1 + np.abs(x)
-            assert np.all((np.abs(x - y) <= 1e-12 * scale) | (np.isnan(x) & np.isnan(y))), a.name()
+            # kN solves each group's Newton system at these random arguments, far from any
+            # assembly: its condition number (the Delta robot's, with its arms hung on revolutes)
+            # multiplies the rounding of the two writings' different orders of operations
+            rel = 1e-10 if a.name().startswith("kN") else 1e-12
+            assert np.all((np.abs(x - y) <= rel * scale) | (np.isnan(x) & np.isnan(y))), a.name()
 
 
 @pytest.mark.parametrize("compile", [False, True])
