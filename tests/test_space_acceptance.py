@@ -16,7 +16,8 @@ import pytest
 
 from kincas.analysis import certify_msolve
 
-from conftest import run_cli, write_scene
+import kincas
+from conftest import EXAMPLES, run_cli, write_scene
 
 SLIDER = """
 title = "spatial slider-crank, slot point listed in [ground]"
@@ -255,3 +256,11 @@ def test_a_universal_joints_angle_as_input_is_in_degrees_everywhere(tmp_path, ca
     assert abs(r["from"] + 30) < 1e-7 and abs(r["to"] - 30) < 1e-7, r
     code, text, err = run_cli(capsys, "range", scene)
     assert "deg" in text and "mm" not in text, text
+
+
+def test_groups_are_named_by_the_bodies_they_place():
+    """A hung body's unknown is its joint's coordinate (`D.angle`): the group it forms is
+    still named by the body (events and resumes say "group rocker"), not by the joint."""
+    for name, want in [("space_rssr", [("rocker",)]), ("space_suspension", [("upper", "upright")])]:
+        model = kincas.model_of(kincas.scene.load(EXAMPLES / f"{name}.toml").mechanism)
+        assert [b.links for b in model.blocks] == want, name

@@ -53,7 +53,7 @@ def blocks(model) -> list[tuple[np.ndarray, np.ndarray]]:
 
 def group_links(model) -> list[list[str]]:
     """The links whose unknowns each group solves (how events and resumes name a group)."""
-    names = [nm.split(".")[0] for nm, _ in model.sym.unknowns]
+    names = model.sym.unknown_links()
     return [sorted({names[j] for j in cols}) for _, cols in blocks(model)]
 
 

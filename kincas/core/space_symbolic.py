@@ -96,9 +96,12 @@ class SpatialSymbolic(Symbolic):
         m = self.mech
         qs, self.unknowns, eqs = [], [], []
 
+        body = [None]  # the body being placed: it owns the unknowns made now (a joint's J.angle too)
+
         def new(name, kind):
             qs.append(ca.SX.sym(name))
             self.unknowns.append((name, kind))
+            self._owner.append(body[0] or name.split(".")[0])
             return qs[-1]
 
         self.Ls = self._size()
@@ -115,8 +118,9 @@ class SpatialSymbolic(Symbolic):
         self.points = {g: v for g, v in self._ground.items() if (g, GROUND) not in exempt}
         self.frames = {GROUND: ([ca.SX(0)] * 3, [ca.SX(c) for c in IDENTITY], [ca.SX(0)] * 3)}
         self.hung = {}  # "J.angle", "J.s" of the joints bodies hang on: an unknown, or the input
+        self._owner = []
         for name, hang in placement(m):
-            b = m.link(name)
+            b, body[0] = m.link(name), name
             loc = {p: self._rel(xyz) for p, xyz in b.points}
             if hang is None:  # floating: its reference point and unit quaternion
                 c = [sum(v[i] for v in loc.values()) / len(loc) for i in range(3)]
@@ -138,6 +142,7 @@ class SpatialSymbolic(Symbolic):
                     eqs += [w[i] - self.points[p][i] for i in range(3)]
                 else:
                     self.points[p] = w
+        body[0] = None
         for p in m.moving_points:
             if p not in self.points:  # carried by bars only
                 self.points[p] = [new(f"{p}.{a}", "length") for a in "xyz"]
@@ -171,6 +176,11 @@ class SpatialSymbolic(Symbolic):
         self.points = {k: [v[i] + self.origin[i] for i in range(3)] for k, v in self.points.items()}
         self._ground = {k: [v[i] + self.origin[i] for i in range(3)] for k, v in self._ground.items()}
         self._finish(qs, eqs)
+
+    def unknown_links(self) -> list[str]:
+        """Per unknown, the body it places (a hung body's joint coordinate `D.angle` is the
+        body's, not the joint's), or the point only bars carry: how groups are named."""
+        return list(self._owner)
 
     def _hang(self, hang, loc, new):
         """(r, e, c) of a body hung on a placed body's joint (kincas/model/space_tree.py), its

@@ -71,7 +71,7 @@ class Structure:
     def __init__(self, sym):
         self.sym = sym
         nq, ng = sym.nq, sym.ng
-        owner = [name.split(".")[0] for name, _ in sym.unknowns]  # unknown -> its link
+        owner = sym.unknown_links()  # unknown -> its link
         blocks = []
         if nq and ng == nq:
             sp = sym.Jq.sparsity()

@@ -165,6 +165,10 @@ class Symbolic:
         self.f_tangent = ca.Function("tangent", args, [self.g, self.Jq, self.Ju])
         self.f_points = ca.Function("points", args, [self._point_matrix()])
 
+    def unknown_links(self) -> list[str]:
+        """Per unknown, the link (or point) it places: how groups are named."""
+        return [name.split(".")[0] for name, _ in self.unknowns]
+
     def ground_at(self, g: str) -> list:
         """Where ground point `g` is drawn (fixed): its coordinates as expressions."""
         return self.points[g]
