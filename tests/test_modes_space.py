@@ -79,3 +79,21 @@ def test_double_cardan_multistart_survives_a_start_with_a_singular_normal_matrix
         g = model.residual(np.asarray(md.q, float), np.array([angle]), model.sym.p0 if hasattr(model.sym, "p0") else
                            np.asarray([m.param_values[k] for k in model.sym.mech.param_values], float))
         assert np.abs(g).max() < 1e-9 * 200
+
+
+def test_multistart_finds_both_assemblies_of_the_spatial_slider_crank():
+    """The slider's second assembly lies 2 d.(C - B) = 279.6 mm from the drawn one along its
+    line, beyond the size (150 mm) that once bounded the starts of a slide: 16 starts missed
+    it in most runs. The two roots of |C0 + s d - B|^2 = 150^2, written here, at every seed."""
+    import kincas
+    sc = kincas.scene.load(EXAMPLES / "space_slider_crank.toml")
+    m = sc.mechanism
+    C0 = np.array([154.4018940888198, 68.88037881776397, 68.32056822664595])
+    d = np.array([0.9407208683835973, 0.18814417367671946, 0.28221626051507914])
+    B = np.array([40.0, 0.0, 0.0])  # the crank at 0 deg, as drawn
+    b, c = d @ (C0 - B), (C0 - B) @ (C0 - B) - 150.0 ** 2
+    roots = sorted(-b + k * np.sqrt(b * b - c) for k in (-1, 1))
+    for seed in range(8):
+        modes = kincas.find_modes(m, {"A.angle": 0.0}, starts=16, seed=seed)
+        got = sorted((np.array(md.points["C"]) - C0) @ d for md in modes)
+        assert np.allclose(got, roots, atol=1e-9), (seed, got, roots)
