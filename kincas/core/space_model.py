@@ -311,9 +311,7 @@ class SpatialFirstPose:
             if f"{j.name}.angle" in index:
                 q[index[f"{j.name}.angle"]] = angle_about(Rp.T @ R if hang.parent_first else R.T @ Rp, j.axis)
             if f"{j.name}.s" in index:
-                owner = m.joint_bodies(j)[1]
-                xyz = dict(m.ground)[j.point] if owner == GROUND else m.link(owner).local(j.point)
-                P0 = rel(xyz)
+                P0 = rel(m.slide_point(j))
                 sign = 1.0 if hang.parent_first else -1.0
                 q[index[f"{j.name}.s"]] = sign * (world(name, P0) - world(hang.parent, P0)) @ (Rp @ np.asarray(j.axis))
         for pt, v in points.items():
@@ -343,9 +341,7 @@ class SpatialFirstPose:
                 Q[:, j] = rng.uniform(-np.pi, np.pi, n)
             elif nm.endswith(".s"):  # a hung body's slide along its joint's line
                 jt = m.joint(nm[:-2])
-                owner = m.joint_bodies(jt)[1]  # the point is drawn on the second body
-                P0 = np.array([m.value(c) for c in (dict(m.ground)[jt.point] if owner == GROUND
-                                                     else m.link(owner).local(jt.point))]) - o
+                P0 = np.array([m.value(c) for c in m.slide_point(jt)]) - o
                 near = (ground[rng.integers(len(ground), size=n)] - P0) @ np.asarray(jt.axis, float)
                 Q[:, j] = near + rng.uniform(-reach, reach, n)
             elif nm.endswith(".qw"):

@@ -202,8 +202,7 @@ class SpatialSymbolic(Symbolic):
         if j.type == "revolute":
             return self._carried(hang), e, loc[hang.point]
         s = self.hung[f"{j.name}.s"] = coord("s", hang.driven_s, "length")
-        owner = m.joint_bodies(j)[1]  # the point is drawn on the second body
-        P0 = self._rel(dict(m.ground)[j.point] if owner == GROUND else m.link(owner).local(j.point))
+        P0 = self._rel(m.slide_point(j))  # the point is drawn on the second body
         Xp = self.world(hang.parent, P0)
         Ra = apply(rotation(ep), list(j.axis)) if hang.parent != GROUND else list(j.axis)
         sign = 1 if hang.parent_first else -1

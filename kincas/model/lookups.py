@@ -126,7 +126,12 @@ class Lookups:
         ('A',)
         """
         seen = dict.fromkeys(p for lk in self.links for p in lk.point_names)
-        return tuple(p for p in seen if p not in dict(self.ground))
+        fixed = self._fixed_points()
+        return tuple(p for p in seen if p not in fixed)
+
+    def _fixed_points(self) -> set:
+        """The points that do not move: the ground's."""
+        return set(dict(self.ground))
 
     @property
     def mobility(self) -> int:

@@ -40,12 +40,10 @@ class SpatialLookups(Lookups):
         """
         return self.bodies
 
-    @property
-    def moving_points(self) -> tuple[str, ...]:
-        """Points carried by bodies and not fixed to the ground, in declaration order. A ground
-        point that is the point of a cylindrical, prismatic or planar joint with the ground
-        first is moving: it belongs to the joint's second body, and the ground's copy only
-        marks where the line or plane is drawn (docs/scene-format.md).
+    def _fixed_points(self) -> set:
+        """The ground's points but a slide joint's: a ground point that is the point of a
+        cylindrical, prismatic or planar joint with the ground first moves (it belongs to the
+        joint's second body; the ground's copy only marks where the line or plane is drawn).
 
         Examples
         --------
@@ -55,9 +53,22 @@ class SpatialLookups(Lookups):
         >>> m.moving_points
         ('G', 'P')
         """
-        anchors = {p for p, b in self.exempt() if b == GROUND}
-        seen = dict.fromkeys(p for lk in self.links for p in lk.point_names)
-        return tuple(p for p in seen if p not in dict(self.ground) or p in anchors)
+        return set(dict(self.ground)) - {p for p, b in self.exempt() if b == GROUND}
+
+    def slide_point(self, j) -> tuple:
+        """Where a cylindrical, prismatic or planar joint's point is drawn: on its second
+        body (the ground's where the ground is second), as written (numbers or parameters).
+
+        Examples
+        --------
+        >>> from kincas import SpatialMechanism, Body, Joint, Input
+        >>> m = SpatialMechanism(ground={"G": (0, 0, 0)}, bodies=[Body("pad", {"G": (0, 0, 0), "P": (1, 0, 0)})],
+        ...     joints=[Joint("prismatic", "P", axis=(0, 0, 1))], inputs=[Input.joint("P")])
+        >>> m.slide_point(m.joint("P"))
+        (1, 0, 0)
+        """
+        owner = self.joint_bodies(j)[1]
+        return dict(self.ground)[j.point] if owner == GROUND else self.link(owner).local(j.point)
 
     @property
     def redundant(self) -> int:
