@@ -3,8 +3,8 @@ import sys
 
 try:
     from .cli import main
-except KeyboardInterrupt:  # Ctrl-C while Python imports kincas
-    print("\nkincas: interrupted", file=sys.stderr)
-    sys.exit(130)
+except KeyboardInterrupt:  # Ctrl-C while Python imports the command line (here: always the command)
+    from ._launch import exit_interrupted
+    exit_interrupted()
 
 sys.exit(main())

@@ -16,7 +16,7 @@ from __future__ import annotations
 import os
 import sys
 
-EXIT_INTERRUPTED = 130  # kincas.cli.common's; not imported, as the CLI may be what was loading
+EXIT_INTERRUPTED = 130  # the shell's usual status after Ctrl-C (kincas.cli.common takes it from here)
 COMMAND_NAMES = ("kincas", "kincas.exe", "kincas-script.py")
 
 
@@ -32,9 +32,14 @@ def running_as_command(argv0: str | None = None) -> bool:
     return a0 == "-m" or os.path.basename(a0) in COMMAND_NAMES
 
 
+def exit_interrupted() -> None:
+    """The command's one line on Ctrl-C, and exit status 130."""
+    print("\nkincas: interrupted", file=sys.stderr)
+    raise SystemExit(EXIT_INTERRUPTED)
+
+
 def interrupted_while_loading() -> None:
     """Exit with the command's one line and status 130 when kincas runs as the command;
     return (the caller re-raises) otherwise."""
     if running_as_command():
-        print("\nkincas: interrupted", file=sys.stderr)
-        raise SystemExit(EXIT_INTERRUPTED)
+        exit_interrupted()

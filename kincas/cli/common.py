@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import sys
 
+from .._launch import EXIT_INTERRUPTED  # noqa: F401  (130: one definition, usable while kincas loads)
 from ..units import json_list as _list, param_unit, unit_label  # noqa: F401  (_list: JSON, NaN -> null)
 from ..views.columns import _force_unit, quantity_unit as _unit  # noqa: F401  (units of the printed tables)
 
-EXIT_OK, EXIT_SCENE, EXIT_UNSOLVED, EXIT_INTERRUPTED = 0, 2, 3, 130
+EXIT_OK, EXIT_SCENE, EXIT_UNSOLVED = 0, 2, 3
 
 
 def progress_for(args):

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import Union
 
 from .loads import Inertia
+from .names import is_angle_name
 from .values import _pair, _table, as_number, is_number  # noqa: F401  (their old home)
 
 # --- numbers that may name a parameter ---
@@ -339,6 +340,4 @@ class Input:
         >>> Input.angle("crank").is_angle, Input.slide("guide").is_angle
         (True, False)
         """
-        if self.kind == "joint":
-            return self.target.rpartition(".")[2].startswith("angle")
-        return self.kind == "angle"
+        return is_angle_name(self.key)  # (the one reading of a key: names.is_angle_name)
