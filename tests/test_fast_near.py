@@ -76,12 +76,12 @@ def test_exact_predictions_take_no_newton_step(monkeypatch, grouped):
 
 
 def test_predictions_near_step_switch_between_both_ways_alike(monkeypatch):
-    # steps of 1e-3 rad: the third-order prediction (kincas/core/kernel.py, kP) misses the
-    # four-bar by about STEP (tests/test_fast_predict.py computes it: above at 542 poses,
-    # below at 457), so poses go either way (kF first, accepted; or not, and Newton from the
-    # prediction)
+    # steps of 7.5e-3 rad over half a turn: the predictions (kincas/core/prediction.py: the
+    # quintic where the cubic misses by up to QUINTIC_TRY, else the cubic) miss the four-bar
+    # by about STEP, so poses go either way (kF first, accepted; or not, and Newton from kF's
+    # step), and the prediction switches between the quintic and the cubic
     m = fourbar(b=3.45)
-    th = np.linspace(0.3, 1.3, 1001)
+    th = np.linspace(0.3, 3.3, 401)
     model, p, L, out = runs(m, ["C.x", "C.y", "C.vx", "C.vy"], th[:, None], [10.0], monkeypatch)
     same_decisions(out)
     run = out["compiled"]

@@ -1,9 +1,11 @@
-"""The fast kernel's third-order prediction (kincas/core/kernel.py, kP): the cubic through the
-last two solved poses with their tangents (Hermite's). On a dense sweep of a mechanism whose
-q(u) is not linear it lands within STEP of the pose where the second-order prediction misses
-by far more, so the kernel accepts the pose with kF alone, no Newton step; the compiled loop
-and both forms of the virtual machine take the same decisions, and the answers are the closed
-forms' (written here, not kincas's)."""
+"""The fast kernel's predictions (kincas/core/prediction.py): kP the cubic through the last two
+solved poses with their tangents (Hermite's), kQ the quintic through the last three. On a
+dense sweep of a mechanism whose q(u) is not linear the cubic lands within STEP of the pose
+where the second-order prediction misses by far more, and at ten times the step the quintic
+does where the cubic misses: the kernel accepts the pose with kF alone, no Newton step. The
+quintic runs only while it pays (dense sweeps keep the cubic); the compiled loop and both
+forms of the virtual machine take the same decisions, and the answers are the closed forms'
+(written here, not kincas's)."""
 import numpy as np
 import pytest
 
@@ -80,3 +82,71 @@ def test_uneven_and_reversing_steps_keep_the_closed_form(monkeypatch, turn):
         scale = L * (w if ".v" in name else 1.0)
         assert np.abs(run.values[i, 1:] - cf[name][1:]).max() <= 1e-12 * scale, name
     check_residuals(model, run, p, L, tol=1e-13)
+
+
+# --- the fifth-order prediction (kincas/core/prediction.py: kQ) ---
+
+
+def hermite(nodes, values, slopes, t):
+    """The polynomial through (node, value, slope) triples, at t: the confluent Vandermonde
+    system solved by numpy (written here from the definition, not from kincas's formula)."""
+    k = 2 * len(nodes)
+    rows = [[x ** j for j in range(k)] for x in nodes] + [[j * x ** (j - 1) if j else 0.0 for j in range(k)] for x in nodes]
+    rhs = np.stack([np.asarray(v, float) for v in (*values, *slopes)])
+    coef = np.linalg.solve(np.array(rows), rhs.reshape(k, -1))
+    return sum(c * t ** j for j, c in enumerate(coef)).reshape(rhs.shape[1:])
+
+
+def test_kq_is_the_quintic_through_three_poses_and_the_cubic_where_steps_are_uneven():
+    import casadi as ca
+    from kincas.core.fast import FastSweeper
+    from kincas.core.tolerances import QUINTIC_RATIO
+    from test_fast import first_pose
+    m = fourbar(b=3.45)
+    model, p, L, q0 = first_pose(m, np.array([[0.3]]))
+    kP, kQ = (FastSweeper(model, [], compile=False).functions[i] for i in (0, 4))
+    rng = np.random.default_rng(3)
+    nq = model.sym.nq
+    for trial in range(20):
+        h0, ratio = rng.uniform(1e-3, 5e-2), rng.uniform(0.3, 2.5)
+        u0, lam = 0.7, rng.uniform(0.2, 1.8)
+        u1, u2, u = u0 - h0, u0 - h0 - ratio * h0, u0 + lam * h0
+        # smooth made-up unknowns of u with their derivatives (exact), far above rounding
+        f = lambda x: np.array([np.sin(2 * x) + x ** 5, np.exp(x) - 3 * x ** 4])[:nq]
+        df = lambda x: np.array([2 * np.cos(2 * x) + 5 * x ** 4, np.exp(x) - 12 * x ** 3])[:nq]
+        args = [f(u0), df(u0), [u0], [u], df(u1), [u1], f(u1), df(u2), [u2], f(u2), np.full(len(model.blocks), 4.0)]
+        got, miss = (np.asarray(v).ravel() for v in kQ(*args))
+        cub = np.asarray(kP(*args[:7])).ravel()
+        want3 = hermite([u0, u1], [f(u0), f(u1)], [df(u0), df(u1)], u)
+        np.testing.assert_allclose(cub, want3, rtol=0, atol=1e-11)  # kP: the cubic
+        if QUINTIC_RATIO[0] <= ratio <= QUINTIC_RATIO[1]:
+            want5 = hermite([u0, u1, u2], [f(u0), f(u1), f(u2)], [df(u0), df(u1), df(u2)], u)
+            np.testing.assert_allclose(got, want5, rtol=0, atol=1e-11)
+            assert np.abs(want5 - want3).max() > 1e-9  # a change, applied, and reported:
+            np.testing.assert_allclose(miss[0], np.abs(want5 - want3).max(), rtol=1e-6)
+        else:  # too uneven: the cubic, and nothing applied
+            np.testing.assert_array_equal(got, cub)
+            assert miss[0] == 0
+
+
+def test_the_quintic_takes_moderate_steps_without_newton_and_the_cubic_dense_ones(monkeypatch):
+    a, b, c, d, w = 1.0, 3.45, 3.0, 4.0, 10.0
+    names = ["C.x", "C.y", "C.vx", "C.vy"]
+    for h, quintic_on in ((3e-3, True), (3e-4, False)):
+        th = 0.3 + h * np.arange(401)
+        q, T = fourbar_angles(th, a, b, c, d)
+        cubic = predictions(q, T, h)[1]
+        quint = hermite([0.0, -1.0, -2.0], [q[2:-1], q[1:-2], q[:-3]], [T[2:-1] * h, T[1:-2] * h, T[:-3] * h], 1.0)
+        miss3, miss5 = np.abs(cubic[1:] - q[3:]).max(1), np.abs(quint - q[3:]).max(1)
+        if quintic_on:
+            assert miss3.min() > 5 * STEP and miss5.max() < 0.1 * STEP  # what the test is about
+        model, p, L, out = runs(fourbar(b=b), names, th[:, None], [w], monkeypatch)
+        same_decisions(out)
+        run = out["compiled"]
+        assert (run.iterations[5:] == 0).all()  # no Newton step: kF at the prediction, accepted
+        assert bool(run._state[-1]) == quintic_on  # the quintic ran (and goes on) only where it paid
+        cf = fourbar_closed(th, a, b, c, d, w=w)
+        for i, name in enumerate(names):
+            scale = L * (w if ".v" in name else 1.0)
+            assert np.abs(run.values[i, 1:] - cf[name][1:]).max() <= 1e-12 * scale, name
+        check_residuals(model, run, p, L, tol=1e-13)

@@ -145,7 +145,7 @@ class _Job:
             T = -_solve(J, Ju)
             cm = lambda a: a.transpose(0, 2, 1).reshape(len(idx), -1)  # column-major rows
             Jd = self.kernel.sweeper.diagonal(J)  # g_q's diagonal blocks, as the kernel keeps them
-            self.S[idx] = np.concatenate([self.Q[idx, 0], Jd, cm(T), u, cm(T), u, self.Q[idx, 0]], axis=1)
+            self.S[idx] = self.kernel.sweeper.state_rows(self.Q[idx, 0], Jd, cm(T), u)
 
     def _continue_in_parameters(self, idx, q0, p0, sign0) -> np.ndarray:
         """Whether each design of `idx` was continued from the nominal's first pose (q0 at

@@ -166,8 +166,10 @@ int kincas_designs_full(casadi_int nd, casadi_int n, const casadi_real* U, const
     if (kT(arg, res, iw, w, 0)) continue;
     for (i = 0; i < NQ; ++i) s[i] = q[i];
     for (i = 0; i < NU; ++i) s[NQ + NJ + NQ*NU + i] = U[i];
-    for (i = 0; i < NQ*NU + NU; ++i) s[NQ + NJ + NQ*NU + NU + i] = s[NQ + NJ + i];
-    for (i = 0; i < NQ; ++i) s[NQ + NJ + 2*(NQ*NU + NU) + i] = q[i];
+    for (i = 0; i < NQ*NU + NU; ++i)  /* the poses before: this one (predictions start linear) */
+      s[NQ + NJ + NQ*NU + NU + i] = s[NQ + NJ + 2*(NQ*NU + NU) + NQ + i] = s[NQ + NJ + i];
+    for (i = 0; i < NQ; ++i) s[NQ + NJ + 2*(NQ*NU + NU) + i] = s[NQ + NJ + 3*(NQ*NU + NU) + NQ + i] = q[i];
+    s[KS_NEAR] = s[KS_FIVE] = 0;
     k = kincas_sweep(n, U, p, Ls + d, thr, max_evals, s, q, info, n, Ud, sud, Udd, sudd, vals + d*NO*n, 0);
     while (k > 0 && k < n && kincas_substeps(k, U, p, Ls + d, thr, max_evals, s, Ud + k*sud,
                                              Udd + k*sudd, q + k*NQ, vals + d*NO*n + k, n)) {

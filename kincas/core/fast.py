@@ -48,7 +48,8 @@ from .compiled import CHUNK, Backend, Library, QuantityEvaluator  # noqa: F401 (
 from .fast_run import INFO, FastRun, _rows, _take  # noqa: F401 (INFO, _rows: their old home)
 from .fast_vm import VM_CHUNKS, VM_FLAT, VM_SKIP, VirtualMachineSweep, _Buffered  # noqa: F401
 from .group_kernel import kernel_sizes
-from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, KERNEL_NEAR, RESIDUAL, STEP, SWEEP_C,  # noqa: F401
+from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, KERNEL_NEAR, NEAR_TRY, QUINTIC_ON, QUINTIC_TRY, RESIDUAL,  # noqa: F401
+                     STEP, SWEEP_C,
                      kernel_functions, state_function)
 
 # Kernel size, in casadi instructions, beyond which compiling costs more than it saves: gcc
@@ -106,7 +107,7 @@ class FastSweeper(VirtualMachineSweep):
             self._group_of[np.asarray(b.cols, dtype=np.intp)] = i
         self._groups = self._group_of.tolist()
         self.nj = diagonal_size(self.blocks)  # g_q's diagonal blocks, all the state keeps of it
-        self.state_size = 2 * self.nq + self.nj + 2 * (self.nq * self.nu + self.nu)
+        self.state_size = 3 * self.nq + self.nj + 3 * (self.nq * self.nu + self.nu) + 2  # (+ near, five)
         self._functions, self._size, self._poses, self._calls = None, None, 0, 0  # swept so far
         self._lock = threading.RLock()
         self._local = threading.local()  # the virtual machine's buffers, one set per thread
@@ -137,7 +138,7 @@ class FastSweeper(VirtualMachineSweep):
 
     @property
     def functions(self) -> list[ca.Function]:
-        """kP, kN, kF, kL (kincas/core/kernel.py), built when first needed, once per model
+        """kP, kN, kF, kL, kQ (kincas/core/kernel.py), built when first needed, once per model
         and report: the sweepers of one kernel with different `compile` settings share them,
         so they generate the same C code (the same library)."""
         if self._functions is None:
@@ -153,21 +154,33 @@ class FastSweeper(VirtualMachineSweep):
     def sweep_macros(self) -> dict:
         """The sizes SWEEP_C is compiled with (kincas/core/kernel.py)."""
         return {"NQ": self.nq, "NU": self.nu, "NO": len(self.report), "NM": len(self.blocks) + 1,
-                "NJ": self.nj}
+                "NJ": self.nj, "NEAR_TRY": repr(float(NEAR_TRY)), "QUINTIC_ON": repr(float(QUINTIC_ON)),
+                "QUINTIC_TRY": repr(float(QUINTIC_TRY))}
 
     def state(self, q, u, p, out=None) -> np.ndarray:
-        """(q, J, T = dq/du, u, T, u, q) at a solved pose, matrices column-major as in casadi
-        (the second T, u, q stand for the pose before: the first prediction is linear), in
-        `out` if given. At a singular start T is not finite, and the next pose fails the
-        branch test."""
+        """(q, J, T = dq/du, u, T, u, q, T, u, q, near, five) at a solved pose, matrices
+        column-major as in casadi (the second and third T, u, q stand for the poses before:
+        the first prediction is linear; near = 0: Newton from the first prediction; five =
+        0: by the cubic), in `out` if given. At a singular start T is not finite, and the
+        next pose fails the branch test."""
         nq, nu, nj = self.nq, self.nu, self.nj
         s = np.empty(self.state_size) if out is None else out
         s[:nq], s[nq + nj + nq * nu:][:nu] = np.ravel(q), np.ravel(u)
         f = self._state_call()
         f(s[:nq], s[nq + nj + nq * nu:][:nu], np.ravel(p), s[nq:nq + nj], s[nq + nj:][:nq * nu])
-        s[nq + nj + nq * nu + nu:][:nq * nu + nu] = s[nq + nj:nq + nj + nq * nu + nu]
-        s[nq + nj + 2 * (nq * nu + nu):] = s[:nq]
+        back = nq + nj + nq * nu + nu  # where the pose before starts: (T, u, q), then again
+        for at in (back, back + nq * nu + nu + nq):
+            s[at:at + nq * nu + nu] = s[nq + nj:back]
+            s[at + nq * nu + nu:][:nq] = s[:nq]
+        s[-2:] = 0.0
         return s
+
+    def state_rows(self, q, Jd, T, u) -> np.ndarray:
+        """(N, state_size): the states (as `state` makes one) of N solved poses, given their
+        unknowns q (N, nq), g_q's diagonal blocks Jd (N, nj, as `diagonal` gives them),
+        tangents T (N, nq * nu, each column-major) and inputs u (N, nu)."""
+        before = np.concatenate([T, u, q], axis=1)  # the poses before: this one
+        return np.concatenate([q, Jd, T, u, before, before, np.zeros((len(q), 2))], axis=1)
 
     def diagonal(self, J: np.ndarray) -> np.ndarray:
         """(N, nj): the diagonal blocks of N matrices g_q (N, nq, nq), as the state keeps them."""

@@ -35,7 +35,7 @@ VM_CHUNKS = (1, 8, 32, 128, CHUNK)  # poses per call of the virtual machine's sw
 # 240), one flat SX pose, and chunks of VM_FLAT poses, the last one padded: CHUNK for a
 # stretch of at least 4 * CHUNK poses (fewer calls); a short sweep builds only 64 (3 ms).
 VM_SKIP = 2_000
-_ACC = 8  # the accumulated inputs and outputs of `vm_step`: the state's seven parts and `near`
+_ACC = 12  # the accumulated inputs and outputs of `vm_step`: the state's ten parts, `near`, `five`
 VM_FLAT = 64
 
 
@@ -72,8 +72,8 @@ class VirtualMachineSweep:
             nq, nu, no, nm = self.nq, self.nu, len(self.report), len(self.blocks) + 1
             F = self._vm_function(size)
             buf, call = F.buffer()
-            scratch = [np.zeros((size, m)) for m in (nq, self.nj, nq * nu, nu, nq * nu, nu, nq, 1, 6, no, nm,
-                                                     nu, nu, nu)]
+            scratch = [np.zeros((size, m)) for m in (nq, self.nj, nq * nu, nu, nq * nu, nu, nq, nq * nu, nu, nq,
+                                                     1, 1, 6, no, nm, nu, nu, nu)]
             for i, a in enumerate(scratch[:_ACC + 3]):
                 buf.set_res(i, memoryview(a))
             vms[size] = (F, buf, call, scratch)  # buf holds raw pointers: keep it
@@ -81,9 +81,9 @@ class VirtualMachineSweep:
 
     def _vm_advance(self, r: FastRun, start: int, stop: int, s: np.ndarray) -> int:
         nq, nu = self.nq, self.nu
-        # the state, and `near` (the compiled loop's flag: the last pose was predicted to
-        # within STEP), which starts off at every call as it does there
-        parts = [*np.split(s.copy(), np.cumsum([nq, self.nj, nq * nu, nu, nq * nu, nu])), np.zeros(1)]
+        # the state, its last entries `near` and `five` (the compiled loop's flags: try kF at
+        # the prediction first; predict by the quintic)
+        parts = np.split(s.copy(), np.cumsum([nq, self.nj, nq * nu, nu, nq * nu, nu, nq, nq * nu, nu, nq, 1]))
         k, sized = start, self.work > VM_SKIP
         flat = CHUNK if stop - start >= 4 * CHUNK else VM_FLAT
         while k < stop:  # a large kernel: the smallest chunk that holds what is left (padded
@@ -92,7 +92,8 @@ class VirtualMachineSweep:
             left = stop - k if k > start else min(stop - k, VM_CHUNKS[1])
             size = (next((c for c in VM_CHUNKS if c >= left), VM_CHUNKS[-1]) if sized
                     else flat)
-            _, buf, call, (Qc, Jc, Tc, Uo, T1c, U1c, Q1c, Nc, Ic, Yc, Mc, Uc, Udc, Uddc) = self._vm_buffers(size)
+            _, buf, call, (*state, Ic, Yc, Mc, Uc, Udc, Uddc) = self._vm_buffers(size)
+            Qc = state[0]
             m = min(size, stop - k)
             for c, (a, st) in ((Uc, (r.U, 1)), (Udc, r.Ud), (Uddc, r.Udd)):
                 c[:m], c[m:] = (a[k:k + m] if st else a), (a[k + m - 1] if st else a)  # pad
@@ -106,9 +107,9 @@ class VirtualMachineSweep:
             r.measures[:, k:k + e] = Mc[:e].T
             if j < m:
                 return k + j
-            parts = [a[m - 1].copy() for a in (Qc, Jc, Tc, Uo, T1c, U1c, Q1c, Nc)]
+            parts = [a[m - 1].copy() for a in state]
             k += m
-        s[:] = np.concatenate(parts[:-1])  # where the compiled loop leaves it too
+        s[:] = np.concatenate(parts)  # where the compiled loop leaves it too
         return stop
 
 

@@ -193,9 +193,9 @@ class JaxDesigns:
         jnp, lax = jax.numpy, jax.lax
         # a kernel written group by group (kincas/core/group_kernel.py) calls SX functions
         # from MX ones: inlined into one SX function each for the translation
-        kP, kN, kF, kL = (to_jax(f.expand() if f.is_a("MXFunction") else f) for f in self.sweeper.functions)
+        kP, kN, kF, kL = (to_jax(f.expand() if f.is_a("MXFunction") else f) for f in self.sweeper.functions[:4])
         nq, nu, nj, max_evals = self.nq, self.nu, self.nj, self.sweeper.max_evals
-        cuts = np.cumsum([nq, nj, nq * nu, nu, nq * nu, nu]).tolist()
+        cuts = np.cumsum([nq, nj, nq * nu, nu, nq * nu, nu, nq, nq * nu, nu, nq]).tolist()
 
         def design(s0, p, L, signs0, U, Ud, Udd, thr):
             (Lb,) = kL(U[0], p)  # each group's length, at the first pose as the C loop has it
@@ -208,7 +208,9 @@ class JaxDesigns:
                     q, it, _ = c
                     dq, rs = kN(q, u, p, Lb)
                     return q - dq, it + 1, rs[1] <= thr[4]
-                q0, J0, T0, u0, T1, u1, q1 = jnp.split(s, cuts)
+                # (the poses before the last two, and the C loop's flags: unused, the cubic
+                # predicts every pose here)
+                q0, J0, T0, u0, T1, u1, q1, T2, u2, q2, flags = jnp.split(s, cuts)
                 (qp,) = kP(q0, T0, u0, u, T1, u1, q1)
                 q, it, _ = lax.while_loop(lambda c: ~c[2] & (c[1] < max_evals), newton,
                                           (qp, jnp.int64(0), jnp.bool_(False)))
@@ -217,7 +219,7 @@ class JaxDesigns:
                 q = jnp.where(conv, q - dq, q)
                 ok = (alive & conv & (mc[0] <= thr[2]) & (mc[1] <= thr[3])
                       & jnp.all(meas[:-1] == signs0))
-                s1 = jnp.concatenate([q, J, T, u, T0, u0, q0])
+                s1 = jnp.concatenate([q, J, T, u, T0, u0, q0, T1, u1, q1, flags])
                 keep = lambda a: jnp.where(ok, a, jnp.nan)
                 info = jnp.concatenate([rf, mc, it[None].astype(jnp.float64)])
                 return (jnp.where(ok, s1, s), ok), (keep(q), keep(y), keep(info), ok)

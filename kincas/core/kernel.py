@@ -4,6 +4,7 @@ Three functions, every linear solve done Assur group by Assur group (kincas/core
 so their size grows with the number of groups, not with nq^3:
 
 - kP: the prediction from the last two solved poses (tangent, second- and third-order terms);
+  kQ: from the last three, of fifth order, run while it pays (kincas/core/prediction.py);
 - kN: at q, the Newton step g_q^-1 g (Gauss-Newton's (g_q'g_q)^-1 g_q' g for a tall group:
   redundant joints, kincas/core/blocks.py) and the measures that stop Newton (max |g| / L and the
   step's size in radians or lengths / L, each equation and unknown against its own Assur
@@ -29,11 +30,12 @@ from __future__ import annotations
 
 import casadi as ca
 
+from .prediction import cubic, quintic
 from .group_kernel import GroupFunctions, _max_abs, group_correction, group_scales
 from .structure import Structure
 from ..model.names import parse_quantity
 from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size, reciprocal, is_tall
-from .tolerances import ACCEPT, CORRECTION, JAC_CHANGE, KERNEL_NEAR, MAX_EVALS, TOL  # noqa: F401
+from .tolerances import ACCEPT, CORRECTION, JAC_CHANGE, KERNEL_NEAR, MAX_EVALS, NEAR_TRY, QUINTIC_ON, QUINTIC_TRY, TOL  # noqa: F401
 
 RESIDUAL = ACCEPT  # max |g| / L at an accepted pose, as on the careful path
 # The next Newton step's largest entry (radians, or lengths / L), applied before stopping: the
@@ -56,36 +58,23 @@ GROUP_RUN = 4  # consecutive groups per function written group by group (measure
 
 
 def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> list[ca.Function]:
-    """[kP, kN, kF, kL] (see the module text), outputs dense so that C can index them.
+    """[kP, kN, kF, kL, kQ] (see the module text), outputs dense so that C can index them.
     `structure` (the `Structure` whose blocks these are, built from `sym` if not given)
     gives the groups' lengths.
 
-    The prediction is of third order: with the unknowns q0, q1 and tangents T0, T1 at the
-    last pose (input u0) and the one before (u1), and a step u - u0 = l (u0 - u1) along the
-    line through them, q(u0 + t (u0 - u1)) is extrapolated by the cubic through both poses
-    with both tangents (Hermite's), written as the second-order prediction
-    q0 + T0 (u - u0) + l/2 (T0 - T1)(u - u0) (dT = T0 - T1 ~ H[u0 - u1, .] for the second
-    derivative H of q(u)) plus l^2 (l + 3/2) E, where E = (T0 + T1)(u0 - u1) - 2 (q0 - q1)
-    is the trapezoid rule's defect over the last step, the cubic's t^3 coefficient, O(h^3).
-    Its error is O(h^4) on a straight sweep and still O(h^2) where the sweep turns. On a
-    dense sweep of a mechanism whose q(u) is not linear the prediction is then converged to
-    STEP where the second-order one needed a Newton step: on chained four-bars that are not
-    parallelograms (benchmarks/cases.py `chain`), from 3,600 poses a turn on, kF alone (no kN)."""
+    kP predicts the next pose by Hermite's cubic through the last two solved poses (q, T =
+    dq/du, u each, newest first), kQ by the quintic through the last three where the steps
+    are even enough (kincas/core/prediction.py). Error O(h^4), O(h^6), on a straight sweep:
+    on a dense sweep the prediction is converged to STEP and the pose costs kF alone (no
+    kN); 40 chained four-bars that are not parallelograms (benchmarks/cases.py `chain`) need
+    no Newton step at most poses from 360 poses a sixth of a turn on with kQ, where kP needs
+    one at every pose."""
     nq, nu = sym.nq, sym.nu
     solve = lambda A, b: block_solve(A, b, blocks)
     q, qp, J0 = ca.SX.sym("q", nq), ca.SX.sym("qp", nq), ca.SX.sym("J0", diagonal_size(blocks))
     T0, u0, u = ca.SX.sym("T0", nq, nu), ca.SX.sym("u0", nu), ca.SX.sym("u", nu)
     T1, u1, q1 = ca.SX.sym("T1", nq, nu), ca.SX.sym("u1", nu), ca.SX.sym("q1", nq)
-    du, dup = u - u0, u0 - u1
-    # lam = du.dup / dup.dup, 0 where dup = 0 (a first step), written without if_else: casadi
-    # would carry an if_else into every unknown's expression that lam multiplies
-    dd = ca.dot(dup, dup)
-    lam = ca.dot(du, dup) / (dd + (dd == 0))
-    # q0 + T0 du + lam/2 (T0 - T1) du + c3 E with E = (T0 + T1) dup - 2 (q0 - q1), gathered
-    # per tangent: the scalars once, then 7 operations an unknown (with nu = 1)
-    c3 = lam * lam * (lam + 1.5)
-    v0, v1 = du * (1 + 0.5 * lam) + c3 * dup, c3 * dup - (0.5 * lam) * du
-    pred = q + ca.mtimes(T0, v0) + ca.mtimes(T1, v1) - (2 * c3) * (q - q1)
+    T2, u2, q2 = ca.SX.sym("T2", nq, nu), ca.SX.sym("u2", nu), ca.SX.sym("q2", nq)
     p, L, ud, udd = ca.SX.sym("p", sym.np), ca.SX.sym("L"), ca.SX.sym("ud", nu), ca.SX.sym("udd", nu)
     # the reported quantities take q' = (dq/du) u' from the tangent kF computes anyway: one
     # linear solve through the chain fewer per pose. Not with a sensitivity d(Q)/d(p): it
@@ -96,16 +85,18 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
     given = (lambda a, qd: qf(*a, qd)) if tangent else (lambda a, qd: qf(*a))
     d, o = ca.densify, {"cse": True}  # cse: one sin and cos per angle, shared by everything
     kL = (structure or Structure(sym)).length_function()
-    kP = ca.Function("kP", [q, T0, u0, u, T1, u1, q1], [d(pred)], o)
-    if not is_tall(blocks) and (grouped or (grouped is None and len(blocks) >= GROUPS_APART)):
-        # one small function per kind of group, the quantities apart
-        qd = ca.SX.sym("qd", nq)
-        kY = ca.Function("kY", [q, u, p, ud, udd, qd], [ca.densify(given((q, u, p, ud, udd), qd))], o) if report else None
-        return [kP, *GroupFunctions(sym, blocks, GROUP_RUN).kernel(kY), kL]
     Lb = ca.SX.sym("Lb", len(blocks))  # each group's length
     is_length = ca.DM(sym.is_length.astype(float))
     Lq, Lg = group_scales(Lb, blocks, sym.nq, sym.ng)
     D = ca.if_else(is_length, Lq, 1)  # the scale of each unknown: its group's length or 1
+    kP = ca.Function("kP", [q, T0, u0, u, T1, u1, q1], [d(cubic(q, T0, u0, u, T1, u1, q1))], o)
+    kQ = ca.Function("kQ", [q, T0, u0, u, T1, u1, q1, T2, u2, q2, Lb],
+                     [d(v) for v in quintic(q, T0, u0, u, T1, u1, q1, T2, u2, q2, D)], o)
+    if not is_tall(blocks) and (grouped or (grouped is None and len(blocks) >= GROUPS_APART)):
+        # one small function per kind of group, the quantities apart
+        qd = ca.SX.sym("qd", nq)
+        kY = ca.Function("kY", [q, u, p, ud, udd, qd], [ca.densify(given((q, u, p, ud, udd), qd))], o) if report else None
+        return [kP, *GroupFunctions(sym, blocks, GROUP_RUN).kernel(kY), kL, kQ]
     cs = ca.if_else(is_length, 1, reciprocal(L))  # g_q's columns to O(1): 1 (lengths), 1/L (angles)
     g, Jq, Ju = ca.Function("G", [sym.q, sym.u, sym.p], [sym.g, sym.Jq, sym.Ju])(q, u, p)
     step = solve(Jq, g)
@@ -120,7 +111,7 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
                       ca.vertcat(signs, sigma), y, d(step), *((Jq, D) if tall else ())], o)
     if tall:
         kF = _exact_where_needed(kF, blocks)
-    return [kP, ca.Function("kN", [q, u, p, Lb], [d(step), rs], o), kF, kL]
+    return [kP, ca.Function("kN", [q, u, p, Lb], [d(step), rs], o), kF, kL, kQ]
 
 
 def _exact_where_needed(kF, blocks) -> ca.Function:
@@ -151,7 +142,7 @@ def state_function(sym, blocks) -> ca.Function:
                        {"cse": True})
 
 
-def vm_step(kP, kN, kF, kL, nq, nu, max_evals, skip: bool = True) -> ca.Function:
+def vm_step(kP, kN, kF, kL, kQ, nq, nu, max_evals, skip: bool = True) -> ca.Function:
     """One pose for the virtual machine, the compiled loop's arithmetic: where the last pose
     was predicted to within STEP (`near`), kF at the prediction first, its step the last if
     negligible; else kN evaluated until its step is below KERNEL_NEAR (at most max_evals
@@ -166,15 +157,17 @@ def vm_step(kP, kN, kF, kL, nq, nu, max_evals, skip: bool = True) -> ca.Function
     groups' lengths Lb are an input, computed once per sweep as the compiled loop does.
     Functions written group by group are inlined (`expand`) for the virtual machine; those
     of a tall kernel (numeric linear solves, which have no SX form) stay MX, with `skip`."""
-    kP, kN, kF = (_expanded(f) for f in (kP, kN, kF))
+    kP, kN, kF, kQ = (_expanded(f) for f in (kP, kN, kF, kQ))
     skip = skip or kN.is_a("MXFunction") or kF.is_a("MXFunction")
     X = ca.MX if skip else ca.SX
     q0, J0, T0, u0 = X.sym("q0", nq), X.sym("J0", kF.size1_in(6)), X.sym("T0", nq, nu), X.sym("u0", nu)
     u, p, L, thr = X.sym("u", nu), X.sym("p", kN.size1_in(2)), X.sym("L"), X.sym("t", 5)
-    Lb, near = X.sym("Lb", kL.size1_out(0)), X.sym("near")
+    Lb, near, five = X.sym("Lb", kL.size1_out(0)), X.sym("near"), X.sym("five")
     ud, udd, T1, u1 = X.sym("ud", nu), X.sym("udd", nu), X.sym("T1", nq, nu), X.sym("u1", nu)
-    q1 = X.sym("q1", nq)
-    qp = kP(q0, T0, u0, u, T1, u1, q1)
+    q1, T2, u2, q2 = X.sym("q1", nq), X.sym("T2", nq, nu), X.sym("u2", nu), X.sym("q2", nq)
+    # the C loop's choice of prediction (both evaluated here: the same numbers, chosen)
+    qQ, missQ = kQ(q0, T0, u0, u, T1, u1, q1, T2, u2, q2, Lb)
+    qp = ca.if_else(five, qQ, kP(q0, T0, u0, u, T1, u1, q1))
     converged = lambda rs: ca.logic_and(rs[0] <= thr[0], rs[1] <= thr[1])
     if skip:
         Y = ca.MX if kN.is_a("MXFunction") else ca.SX
@@ -222,9 +215,11 @@ def vm_step(kP, kN, kF, kL, nq, nu, max_evals, skip: bool = True) -> ca.Function
     conv = converged(rs)
     q = ca.if_else(conv, q - dq, q)
     info = ca.vertcat(rs, mc, evals, conv)
-    near_next = ca.logic_or(evals == 0, mc[1] <= thr[1])
-    return ca.Function("kS", [q0, J0, T0, u0, T1, u1, q1, near, u, p, L, thr, ud, udd, Lb],
-                       [q, J, T, u, T0, u0, q0, near_next, info, y, meas])
+    near_next = ca.logic_or(evals == 0, mc[1] <= NEAR_TRY * thr[1])
+    miss = ca.if_else(five, missQ, mc[1])  # the cubic's error at this pose
+    five_next = ca.logic_and(miss > QUINTIC_ON, miss <= QUINTIC_TRY)
+    return ca.Function("kS", [q0, J0, T0, u0, T1, u1, q1, T2, u2, q2, near, five, u, p, L, thr, ud, udd, Lb],
+                       [q, J, T, u, T0, u0, q0, T1, u1, q1, near_next, five_next, info, y, meas])
 
 
 def _expanded(f: ca.Function) -> ca.Function:
@@ -239,19 +234,24 @@ def _expanded(f: ca.Function) -> ca.Function:
 
 
 # --- the C loop around them (NQ, NU, NO, NM, NJ: sizes, NM - 1 groups; state s = q, g_q's
-# diagonal blocks, T = dq/du, u at the last pose, then T, u and q at the one before; matrices
-# column-major; L the whole mechanism's length, for the singular measures' column scale) ---
+# diagonal blocks, T = dq/du, u at the last pose, then T, u and q at the one before, then at
+# the one before that, then `near` (1: try kF at the prediction first) and `five` (1: predict
+# by kQ, else kP); matrices column-major; L the whole mechanism's length, for the singular
+# measures' column scale; NEAR_TRY, QUINTIC_ON, QUINTIC_TRY: kincas/core/tolerances.py) ---
 
 SWEEP_C = """
+#define KS_NEAR (NQ + NJ + 3*(NQ*NU + NU) + 2*NQ)
+#define KS_FIVE (KS_NEAR + 1)
 int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const casadi_real* L,
                  const casadi_real* thr, casadi_int max_evals, casadi_real* s, casadi_real* Q,
                  casadi_real* info, casadi_int ld, const casadi_real* Ud, casadi_int sud,
                  const casadi_real* Udd, casadi_int sudd, casadi_real* vals, casadi_real* meas) {
   const casadi_real* arg[SZ_ARG]; casadi_real* res[SZ_RES]; casadi_int iw[SZ_IW]; casadi_real w[SZ_W];
-  casadi_real qp[NQ], q[NQ], dq[NQ], J[NJ > 0 ? NJ : 1], T[NQ*NU], rs[2], rf[2], mc[2], ms[NM], y[NO > 0 ? NO : 1];
+  casadi_real qp[NQ], q[NQ], dq[NQ], miss = 0, J[NJ > 0 ? NJ : 1], T[NQ*NU], rs[2], rf[2], mc[2], ms[NM], y[NO > 0 ? NO : 1];
   casadi_real Lb[NM > 1 ? NM - 1 : 1];  /* each group's length, from the parameters */
   casadi_int k, i, it;
-  int near = 0;  /* the last pose was predicted to within STEP: try kF at the prediction first */
+  int near = s[KS_NEAR] != 0;  /* the last pose was predicted well: try kF at the prediction first */
+  int five = s[KS_FIVE] != 0;  /* predict by the quintic (kQ), else the cubic (kP) */
   if (n > 0) {
     arg[0] = U; arg[1] = p; res[0] = Lb;
     if (kL(arg, res, iw, w, 0)) return 0;
@@ -261,8 +261,9 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     int conv = 0;
     arg[0] = s; arg[1] = s + NQ + NJ; arg[2] = s + NQ + NJ + NQ*NU; arg[3] = u;
     arg[4] = s + NQ + NJ + NQ*NU + NU; arg[5] = s + NQ + NJ + 2*NQ*NU + NU;
-    arg[6] = s + NQ + NJ + 2*(NQ*NU + NU); res[0] = qp;
-    if (kP(arg, res, iw, w, 0)) break;
+    arg[6] = s + NQ + NJ + 2*(NQ*NU + NU); arg[7] = arg[6] + NQ; arg[8] = arg[7] + NQ*NU;
+    arg[9] = arg[8] + NU; arg[10] = Lb; res[0] = qp; res[1] = &miss;
+    if (five ? kQ(arg, res, iw, w, 0) : kP(arg, res, iw, w, 0)) break;
     for (i = 0; i < NQ; ++i) q[i] = qp[i];
     if (near) {  /* kF at the prediction first: where its (next) step is negligible, no kN */
       arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = L; arg[4] = Ud + k*sud; arg[5] = Udd + k*sudd;
@@ -270,12 +271,17 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
       res[0] = J; res[1] = T; res[2] = rf; res[3] = mc; res[4] = ms; res[5] = y; res[6] = dq;
       if (kF(arg, res, iw, w, 0)) break;
       if (rf[0] <= thr[0] && rf[1] <= thr[1]) { it = 0; goto evaluated; }
-    }  /* (else Newton from the prediction, as without: kN's first step is the same as kF's) */
-    for (it = 1; ; ++it) {  /* Newton until the step just applied makes the next negligible */
-      arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = Lb; res[0] = dq; res[1] = rs;
-      if (kN(arg, res, iw, w, 0)) break;
+      /* else kF's step is Newton's first (kN's there is the same): applied, and counted */
       for (i = 0; i < NQ; ++i) q[i] -= dq[i];
-      if (rs[1] <= thr[4] || it >= max_evals) break;
+      it = 1;
+    } else it = 0;
+    if (it == 0 || !(rf[1] <= thr[4] || it >= max_evals)) {
+      for (++it; ; ++it) {  /* Newton until the step just applied makes the next negligible */
+        arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = Lb; res[0] = dq; res[1] = rs;
+        if (kN(arg, res, iw, w, 0)) break;
+        for (i = 0; i < NQ; ++i) q[i] -= dq[i];
+        if (rs[1] <= thr[4] || it >= max_evals) break;
+      }
     }
     arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = L; arg[4] = Ud + k*sud; arg[5] = Udd + k*sudd;
     arg[6] = s + NQ; arg[7] = qp; arg[8] = Lb;
@@ -290,7 +296,12 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     info[k] = rf[0]; info[ld + k] = rf[1]; info[2*ld + k] = mc[0]; info[3*ld + k] = mc[1];
     info[4*ld + k] = (casadi_real) it;
     if (!(conv && mc[0] <= thr[2] && mc[1] <= thr[3])) break;
-    near = it == 0 || mc[1] <= thr[1];
+    near = it == 0 || mc[1] <= NEAR_TRY * thr[1];
+    if (!five) miss = mc[1];  /* the cubic's error at this pose (kincas/core/prediction.py) */
+    five = miss > QUINTIC_ON && miss <= QUINTIC_TRY;
+    s[KS_NEAR] = near; s[KS_FIVE] = five;  /* kept with the state: a sweep in several calls is one */
+    for (i = 0; i < NQ*NU + NU; ++i) s[NQ + NJ + 2*(NQ*NU + NU) + NQ + i] = s[NQ + NJ + NQ*NU + NU + i];
+    for (i = 0; i < NQ; ++i) s[NQ + NJ + 3*(NQ*NU + NU) + NQ + i] = s[NQ + NJ + 2*(NQ*NU + NU) + i];
     for (i = 0; i < NQ*NU + NU; ++i) s[NQ + NJ + NQ*NU + NU + i] = s[NQ + NJ + i];
     for (i = 0; i < NQ; ++i) s[NQ + NJ + 2*(NQ*NU + NU) + i] = s[i];
     for (i = 0; i < NQ; ++i) s[i] = q[i];

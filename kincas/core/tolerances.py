@@ -70,6 +70,19 @@ JAC_CHANGE = 0.9  # per group, sum |entries of D^-1 (A_prev^-1 A - I) D| (below 
 CORRECTION = 0.25  # max per group of ||D^-1 (q - q_pred)||_1: Newton may not wander far from the prediction
 MAX_EVALS = 5  # kN evaluations per pose at most
 KERNEL_NEAR = 1e-8  # kN's step below which the next is negligible where convergence is quadratic
+# The quintic prediction (three poses and their tangents) is used where the step before the
+# last was between these times the last one (else the cubic of the last two): beyond, the
+# extrapolation's weights grow with the unevenness and amplify rounding
+QUINTIC_RATIO = (0.5, 2.0)
+QUINTIC_REACH = 2.0  # ... and the step predicted is at most this times the last one
+QUINTIC_FROM = 3e-14  # ... and only for an unknown whose cubic prediction is off by more than this relatively
+# the quintic runs at a pose where the cubic's error at the last one (scaled) lay between these
+# (below, the cubic converges: a dense sweep; above, the quintic misses by more than STEP too)
+QUINTIC_ON, QUINTIC_TRY = 5e-14, 3e-10
+# The next pose tries kF at the prediction first (no kN) where the last pose's correction was
+# below this times STEP: the prediction of a smooth sweep is about as good from one pose to the
+# next (a pose that missed by a little is followed by one that may not)
+NEAR_TRY = 10.0
 PARAM_STEP = 0.05  # designs loop: largest parameter change per continuation step, relative to the size
 
 # --- assembly modes and starts ---
