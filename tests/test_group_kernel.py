@@ -42,11 +42,30 @@ def test_equal_groups_share_one_function():
 EXAMPLES = sorted((Path(__file__).resolve().parent.parent / "examples").glob("*.toml"))
 
 
-@pytest.mark.parametrize("source", ["chain"] + [p.stem for p in EXAMPLES])
+def test_each_angle_has_one_sine_per_evaluation():
+    """A run hanging on an earlier run's angle takes its sine and cosine from that run: kF's
+    calls compute one sine and one cosine per angle of the chain (2 per four-bar, and the
+    crank's), no more."""
+    import casadi as ca
+    n = 13  # four runs of GROUP_RUN = 4 groups, the last one short
+    model = kincas.model_of(chain(n))
+    kF = kernel_functions(model.sym, list(model.blocks), (), model.structure, grouped=True)[2]
+
+    def count(f, op):
+        if not f.is_a("MXFunction"):
+            return sum(f.instruction_id(i) == op for i in range(f.n_instructions()))
+        return sum(count(f.instruction_MX(i).which_function(), op) for i in range(f.n_instructions())
+                   if f.instruction_id(i) == ca.OP_CALL)
+    assert count(kF, ca.OP_SIN) == 2 * n + 1 and count(kF, ca.OP_COS) == 2 * n + 1
+
+
+@pytest.mark.parametrize("source", ["chain", "chain9"] + [p.stem for p in EXAMPLES])
 def test_grouped_and_flat_kernels_agree(source):
-    """kP, kN, kF, kL of both writings at the same random arguments: same numbers."""
-    if source == "chain":
-        m, report = chain(4), [f"T4.{c}" for c in ("x", "y", "vx", "vy", "ax")]
+    """kP, kN, kF, kL of both writings at the same random arguments: same numbers (chain9:
+    three runs of groups, each passing its last rocker's sine and cosine to the next)."""
+    if source.startswith("chain"):
+        k = int(source[5:] or 4)
+        m, report = chain(k), [f"T{k}.{c}" for c in ("x", "y", "vx", "vy", "ax")]
     else:
         sc = scene.load(EXAMPLES[[p.stem for p in EXAMPLES].index(source)])
         m, report = sc.mechanism, sc.study.report

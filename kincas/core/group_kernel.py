@@ -81,13 +81,29 @@ class _Group:
         new = [ca.vertcat(*qv) if qv else ca.SX(0, 1), u, ca.vertcat(*pv) if pv else ca.SX(0, 1)]
         keep = [k for k, v in enumerate(old) if v.numel()]
         g = ca.substitute([gB], [old[k] for k in keep], [new[k] for k in keep])[0]
-        shape, self.values = _lift_constants(ca.Function("g", [x, z, u, p], [g]))
+        trig, self.trig = _lift_trig(ca.Function("g", [x, z, u, p], [g]), 1)
+        shape, self.values = _lift_constants(trig)
         self.is_length = sym.is_length[self.cols]
         layout = tuple((len(b.rows), len(b.cols)) for b in blks)
         self.key = (shape.serialize(), tuple(self.is_length), layout)
-        self.x, self.z, self.u, self.p, self.c = shape.sx_in()
+        self.x, self.z, self.u, self.p, self.t, self.c = shape.sx_in()
         self.g = shape.call(shape.sx_in())[0]
         self.nj = diagonal_size(self.local)
+        self.passes = []  # own unknowns (local) whose sine and cosine later runs take
+
+    def hang_jacobian(self):
+        """dg/dz with z's sines and cosines t (inputs) depending on z: d sin z = cos z dz."""
+        C = ca.jacobian(self.g, self.z)
+        if self.trig:
+            dt = ca.SX(2 * len(self.trig), self.z.numel())
+            for n, k in enumerate(self.trig):
+                dt[2 * n, k], dt[2 * n + 1, k] = self.t[2 * n + 1], -self.t[2 * n]
+            C = C + ca.mtimes(ca.jacobian(self.g, self.t), dt)
+        return C
+
+    def passed(self):
+        """[sin x_k, cos x_k for k in passes]: computed with g's own (one sincos call)."""
+        return ca.vertcat(*[f(self.x[k]) for k in self.passes for f in (ca.sin, ca.cos)]) if self.passes else ca.SX(0, 1)
 
 
 class GroupFunctions:
@@ -102,6 +118,15 @@ class GroupFunctions:
     def __init__(self, sym, blocks, per: int = 1):
         self.sym, self.blocks = sym, blocks
         self.groups = [_Group(sym, blocks[i:i + per]) for i in range(0, len(blocks), per)]
+        owner = {j: (i, k) for i, grp in enumerate(self.groups) for k, j in enumerate(grp.cols)}
+        passes = {}  # per kind of run, the own unknowns whose sine and cosine a later run takes
+        for grp in self.groups:
+            for k in grp.trig:
+                i, kk = owner[grp.hang[k]]
+                passes.setdefault(self.groups[i].key, set()).add(kk)
+        for grp in self.groups:  # the same for every run of a kind: one function
+            grp.passes = sorted(passes.get(grp.key, ()))
+            grp.key = (*grp.key, tuple(grp.passes))
         self.newton_kinds, self.final_kinds, self.kind, seen = [], [], [], {}
         for grp in self.groups:
             if grp.key not in seen:
@@ -119,23 +144,24 @@ class GroupFunctions:
 
     @staticmethod
     def _newton(grp, name):
-        """(x, z, dz, u, p, Lb, c) -> (dx, [max |g| / Lb, max |dx / D|])."""
+        """(x, z, dz, u, p, Lb, c, t) -> (dx, [max |g| / Lb, max |dx / D|], passed)."""
         dz, Lb = ca.SX.sym("dz", grp.z.numel()), ca.SX.sym("Lb", len(grp.local))
-        A, C = ca.jacobian(grp.g, grp.x), ca.jacobian(grp.g, grp.z)
+        A, C = ca.jacobian(grp.g, grp.x), grp.hang_jacobian()
         D, Lg = GroupFunctions._scales(grp, Lb)
         rhs = grp.g - ca.mtimes(C, dz) if grp.z.numel() else grp.g
         dx = block_solve(A, rhs, grp.local)
         rs = ca.vertcat(_max_abs(grp.g * reciprocal(Lg)), _max_abs(dx * reciprocal(D)))
-        return ca.Function(name, [grp.x, grp.z, dz, grp.u, grp.p, Lb, grp.c], [ca.densify(dx), rs], OPTS)
+        return ca.Function(name, [grp.x, grp.z, dz, grp.u, grp.p, Lb, grp.c, grp.t],
+                           [ca.densify(dx), rs, grp.passed()], OPTS)
 
     @staticmethod
     def _final(grp, name):
-        """(x, z, dz, Tz, u, p, Lb, L, A0, xp, c) -> (A, T, rs, [change, correction],
-        [sign per group, sigma], dx): kF's measures for this run."""
+        """(x, z, dz, Tz, u, p, Lb, L, A0, xp, c, t) -> (A, T, rs, [change, correction],
+        [sign per group, sigma], dx, passed): kF's measures for this run."""
         n, m, nu = grp.x.numel(), grp.z.numel(), grp.u.numel()
         dz, Tz, Lb, L = ca.SX.sym("dz", m), ca.SX.sym("Tz", m, nu), ca.SX.sym("Lb", len(grp.local)), ca.SX.sym("L")
         A0, xp = ca.SX.sym("A0", grp.nj), ca.SX.sym("xp", n)
-        A, C = ca.jacobian(grp.g, grp.x), ca.jacobian(grp.g, grp.z)
+        A, C = ca.jacobian(grp.g, grp.x), grp.hang_jacobian()
         Gu = ca.jacobian(grp.g, grp.u)
         D, Lg = GroupFunctions._scales(grp, Lb)
         cs = ca.if_else(ca.DM(grp.is_length.astype(float)), 1, reciprocal(L))  # columns to O(1): 1 (lengths), 1/L (angles)
@@ -145,9 +171,9 @@ class GroupFunctions:
         change = block_change(A0, A, D, grp.local)
         corr = group_correction((grp.x - xp) / D, grp.local)
         signs, sigma = block_measures(A, cs, grp.local)
-        return ca.Function(name, [grp.x, grp.z, dz, Tz, grp.u, grp.p, Lb, L, A0, xp, grp.c],
+        return ca.Function(name, [grp.x, grp.z, dz, Tz, grp.u, grp.p, Lb, L, A0, xp, grp.c, grp.t],
                            [diagonal_blocks(A, grp.local), ca.densify(T), rs, ca.vertcat(change, corr),
-                            ca.vertcat(signs, sigma), ca.densify(dx)], OPTS)
+                            ca.vertcat(signs, sigma), ca.densify(dx), grp.passed()], OPTS)
 
     # --- kN and kF: MX functions routing vectors between the groups' calls ---
     def kernel(self, report_function):
@@ -159,12 +185,16 @@ class GroupFunctions:
         J0, qp = ca.MX.sym("J0", nj), ca.MX.sym("qp", nq)
         pick = lambda v, idx: v[idx] if idx else ca.MX(0, 1)
         rows = lambda parts, idx: ca.vertcat(*[parts[j] for j in idx]) if idx else ca.MX(0, 1)
+        # sin and cos of unknown j as the run that solved j computed them, for the later ones
+        trig = lambda grp, passed: dict(zip(grp.passes, ca.vertsplit(passed, 2))) if grp.passes else {}
+        given = lambda grp, tr: ca.vertcat(*[tr[grp.hang[k]] for k in grp.trig]) if grp.trig else ca.MX(0, 1)
         # kN
-        dxs, r, b0 = [None] * nq, [], 0
+        dxs, r, b0, tr = [None] * nq, [], 0, {}
         for grp, kd in zip(self.groups, self.kind):
             f, c, nb = self.newton_kinds[kd], ca.DM(grp.values), len(grp.local)
-            dx, rs = f(pick(q, grp.cols), pick(q, grp.hang), rows(dxs, grp.hang), u, pick(p, grp.params),
-                       Lb[b0:b0 + nb], c)
+            dx, rs, ps = f(pick(q, grp.cols), pick(q, grp.hang), rows(dxs, grp.hang), u, pick(p, grp.params),
+                           Lb[b0:b0 + nb], c, given(grp, tr))
+            tr.update({grp.cols[k]: v for k, v in trig(grp, ps).items()})
             b0 += nb
             for k, j in enumerate(grp.cols):
                 dxs[j] = dx[k]
@@ -174,12 +204,14 @@ class GroupFunctions:
         kN = ca.Function("kN", [q, u, p, Lb], [step, rs])
         # kF
         dxs, Ts, r, A, ch, co, sg, sig, at, b0 = [None] * nq, [None] * nq, [], [], [], [], [], [], 0, 0
+        tr = {}
         for grp, kd in zip(self.groups, self.kind):
             f, c, nb = self.final_kinds[kd], ca.DM(grp.values), len(grp.local)
             Tz = ca.vertcat(*[Ts[j] for j in grp.hang]) if grp.hang else ca.MX(0, nu)
-            a, T, rs, mc, ms, dx = f(pick(q, grp.cols), pick(q, grp.hang), rows(dxs, grp.hang), Tz, u,
-                                     pick(p, grp.params), Lb[b0:b0 + nb], L, J0[at:at + grp.nj],
-                                     pick(qp, grp.cols), c)
+            a, T, rs, mc, ms, dx, ps = f(pick(q, grp.cols), pick(q, grp.hang), rows(dxs, grp.hang), Tz, u,
+                                         pick(p, grp.params), Lb[b0:b0 + nb], L, J0[at:at + grp.nj],
+                                         pick(qp, grp.cols), c, given(grp, tr))
+            tr.update({grp.cols[k]: v for k, v in trig(grp, ps).items()})
             at, b0 = at + grp.nj, b0 + nb
             for k, j in enumerate(grp.cols):
                 dxs[j], Ts[j] = dx[k], T[k, :]
@@ -267,16 +299,57 @@ def _lift_constants(f: ca.Function):
     """(g, c): g(*f's inputs, c) == f(*f's inputs), every constant of f's instructions an
     entry of the new last input c; the same operations in the same order, so g computes
     f's numbers exactly."""
-    ins = f.sx_in()
-    consts, values, work, outs = [], [], {}, [[None] * f.nnz_out(k) for k in range(f.n_out())]
+    g, keys = _lift(f, lambda i, op, src: i if op == ca.OP_CONST else None)
+    return g, np.array([f.instruction_constant(i) for i in keys], dtype=float)
+
+
+def _lift_trig(f: ca.Function, which: int):
+    """(g, ks): the sines and cosines of entries of f's input `which` (a run's hanging
+    unknowns z) lifted into a new last input t = [sin z_k, cos z_k for k in ks]: the run that
+    solved z_k has computed them already and passes them on (40 chained four-bars: 10 of 90
+    sines and cosines a pose fewer). Both of each pair, as d sin z / dz = cos z."""
+    srcs = _sources(f)
+    ks = sorted({src[1] for i, src in enumerate(srcs)
+                 if f.instruction_id(i) in (ca.OP_SIN, ca.OP_COS) and src and src[0] == which})
+    at = {(k, op): 2 * n + (op == ca.OP_COS) for n, k in enumerate(ks) for op in (ca.OP_SIN, ca.OP_COS)}
+    g, _ = _lift(f, lambda i, op, src: at[src[1], op] if op in (ca.OP_SIN, ca.OP_COS) and src
+                 and src[0] == which else None, slots=2 * len(ks))
+    return g, ks
+
+
+def _sources(f):
+    """Per instruction of f: (input, entry) where it is unary and its argument an input's
+    entry, else None."""
+    srcs, slot = [], {}
+    for j in range(f.n_instructions()):
+        op, o, ii = f.instruction_id(j), f.instruction_output(j), f.instruction_input(j)
+        srcs.append(slot.get(ii[0]) if len(ii) == 1 and op not in (ca.OP_INPUT, ca.OP_OUTPUT) else None)
+        if op == ca.OP_INPUT:
+            slot[o[0]] = (ii[0], ii[1])
+        elif op != ca.OP_OUTPUT:
+            slot.pop(o[0], None)
+    return srcs
+
+
+def _lift(f: ca.Function, key, slots=None):
+    """(g, keys): g(*f's inputs, t) == f(*f's inputs) where every instruction i for which
+    key(i, op, source) is not None gives (instead of its own result) the entry t[key] of a
+    new last input t (`slots` entries, or one per such instruction in their order, `keys`
+    holding their keys); every other instruction the same operation in the same order."""
+    ins, srcs = f.sx_in(), _sources(f)
+    lifted, keys, work, outs = {}, [], {}, [[None] * f.nnz_out(k) for k in range(f.n_out())]
+    t = ca.SX.sym("t", slots) if slots is not None else None
     nz = [ca.vertsplit(ca.vec(a), 1) if a.numel() else [] for a in ins]
     for i in range(f.n_instructions()):
         op, o, ii = f.instruction_id(i), f.instruction_output(i), f.instruction_input(i)
-        if op == ca.OP_CONST:
-            c = ca.SX.sym(f"c{len(consts)}")
-            consts.append(c)
-            values.append(f.instruction_constant(i))
-            work[o[0]] = c
+        k = key(i, op, srcs[i]) if op not in (ca.OP_INPUT, ca.OP_OUTPUT) else None
+        if k is not None:
+            if slots is None:
+                lifted[k] = ca.SX.sym(f"c{len(keys)}")
+                keys.append(k)
+            work[o[0]] = t[k] if slots is not None else lifted[k]
+        elif op == ca.OP_CONST:
+            work[o[0]] = ca.SX(f.instruction_constant(i))
         elif op == ca.OP_INPUT:
             work[o[0]] = nz[ii[0]][ii[1]]
         elif op == ca.OP_OUTPUT:
@@ -289,5 +362,6 @@ def _lift_constants(f: ca.Function):
     for k, col in enumerate(outs):
         sp = f.sparsity_out(k)
         res.append(ca.SX(sp, ca.vertcat(*[ca.SX(0) if v is None else v for v in col]) if col else ca.SX(0, 1)))
-    c = ca.vertcat(*consts) if consts else ca.SX(0, 1)
-    return ca.Function("g", [*ins, c], res), np.array(values, dtype=float)
+    if slots is None:
+        t = ca.vertcat(*[lifted[k] for k in keys]) if keys else ca.SX(0, 1)
+    return ca.Function("g", [*ins, t], res), keys
