@@ -148,27 +148,43 @@ def block_solve(J, b, blocks: list[Block]):
 
 def block_measures(J, cs, blocks: list[Block]):
     """(sign of det of each diagonal block, smallest lower bound of a block's smallest
-    singular value relative to max(1, its largest)), J's columns scaled by cs > 0."""
-    signs, sig = [], []
+    singular value relative to max(1, its largest)), J's columns scaled by cs > 0.
+
+    Each block's bound is taken squared, the smallest of them, then one square root: for a
+    2 x 2 block A C (C = diag(c), F = ||A C||_F^2, d = det(A C) = det(A) c_1 c_2),
+    sigma_min^2 = 2 d^2 / (F + sqrt(F^2 - 4 d^2)) (F^2 - 4 d^2 = (s_1^2 - s_2^2)^2: no
+    cancellation), relative to max(1, F): one square root and one division a group where
+    the same number as 2|d| / (sqrt(F + 2|d|) + sqrt(F - 2|d|)) / max(1, sqrt F) took three
+    and one (40 chained four-bars: 120 square roots a pose). The sign is det(A)'s, which the
+    step's solve computes anyway (the positive scales c do not change it)."""
+    signs, sig2 = [], []
     for blk in blocks:
-        A = _scaled(J, cs, blk)
-        n, F = A.size1(), ca.sumsqr(A)
-        if n > A.size2():  # tall (redundant joints): no determinant, so no mode (+1)
+        r, c = blk.rows.tolist(), blk.cols.tolist()
+        n = len(r)
+        if n > len(c):  # tall (redundant joints): no determinant, so no mode (+1)
+            F = ca.sumsqr(_scaled(J, cs, blk))
             signs.append(ca.SX(1))
-            sig.append(_tall_sigma(J[blk.rows.tolist(), blk.cols.tolist()], _col_scales(cs, blk)) / ca.fmax(1, ca.sqrt(F)))
-            continue
-        d = ca.det(A) if n > 1 else A[0, 0]
-        ad = ca.fabs(d)
-        if n <= 2:  # (one division for both ratios)
-            lb = ad if n == 1 else 2 * ad
-            den = 1 if n == 1 else ca.sqrt(F + 2 * ad) + ca.sqrt(ca.fmax(F - 2 * ad, 0))
-            sig.append(lb / (den * ca.fmax(1, ca.sqrt(F))))
+            sig2.append((_tall_sigma(J[r, c], _col_scales(cs, blk)) / ca.fmax(1, ca.sqrt(F))) ** 2)
+        elif n == 1:
+            v = J[r[0], c[0]] * _col_scales(cs, blk)[0]
+            signs.append(ca.sign(v))
+            sig2.append(v * v / ca.fmax(1, v * v))
+        elif n == 2:
+            A, cb = J[r, c], _col_scales(cs, blk)
+            d = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]  # as `_small_solve` writes it: computed once
+            ds = d * (cb[0] * cb[1])
+            F = (cb[0] * cb[0]) * (A[0, 0] ** 2 + A[1, 0] ** 2) + (cb[1] * cb[1]) * (A[0, 1] ** 2 + A[1, 1] ** 2)
+            d2 = ds * ds
+            signs.append(ca.sign(d))
+            sig2.append(2 * d2 / ((F + ca.sqrt(ca.fmax(F * F - 4 * d2, 0))) * ca.fmax(1, F)))
         else:
-            sig.append(ad / F ** ((n - 1) / 2) / ca.fmax(1, ca.sqrt(F)))
-        signs.append(ca.sign(d))
+            A = _scaled(J, cs, blk)
+            F, d = ca.sumsqr(A), ca.det(A)
+            signs.append(ca.sign(d))
+            sig2.append((ca.fabs(d) / F ** ((n - 1) / 2) / ca.fmax(1, ca.sqrt(F))) ** 2)
     if not blocks:
         return ca.SX(0, 1), ca.SX(1)
-    return ca.vertcat(*signs), ca.mmin(ca.vertcat(*sig))
+    return ca.vertcat(*signs), ca.sqrt(ca.mmin(ca.vertcat(*sig2)))
 
 
 def _col_scales(cs, blk):
