@@ -236,13 +236,14 @@ def test_status_flags_and_iterations_made_when_read_are_the_sweeps_own():
 def test_nothing_met_from_the_kernels_measures_agrees_with_the_general_test():
     """`nothing_met_measures` (modes summed, one comparison) answers as `nothing_met` on
     tables of modes and sigmas built to sit on every edge: a mode changing once, a mode 0
-    or NaN, a sigma at, just above and just below the bound, NaN, one pose, two groups."""
+    or NaN, a sigma at, just above and just below the bound, NaN, one pose, two groups, and
+    more groups than are checked in Python."""
     from kincas.analysis.events import _SIGMA_BOUND, nothing_met, nothing_met_measures
     rng = np.random.default_rng(7)
     edges = [_SIGMA_BOUND, np.nextafter(_SIGMA_BOUND, 1), np.nextafter(_SIGMA_BOUND, 0), np.nan, 0.3, 1.0]
     tried = {True: 0, False: 0}
     for trial in range(400):
-        n, g = int(rng.choice([1, 2, 7, 40])), int(rng.choice([1, 2, 3]))
+        n, g = int(rng.choice([1, 2, 7, 40])), int(rng.choice([1, 2, 3, 12, 41]))  # (beyond 8: numpy's sums)
         signs = np.tile(rng.choice([-1.0, 1.0], g), (n, 1))
         sigma = rng.uniform(0.01, 1.0, n)
         kind = trial % 5

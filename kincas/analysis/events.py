@@ -201,7 +201,8 @@ def nothing_met_measures(M, flat=None) -> bool:
     if n == 0:
         return False
     sums = np.dot(_ones(n), M)  # (BLAS: a matrix-vector product)
-    if np.dot(sums[:g], M[0, :g]) != n * g:  # (NaN: not)
+    if not (all(abs(v) == n for v in sums.tolist()[:g]) if g <= 8 else  # (a few: in Python)
+            np.dot(sums[:g], M[0, :g]) == n * g):  # (NaN: not)
         return nothing_met(np.ones(n, dtype=bool), M[:, :-1], M[:, -1], True)
     return bool(M[:, g].min() > _SIGMA_BOUND)
 
