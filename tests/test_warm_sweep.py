@@ -236,13 +236,14 @@ def test_status_flags_and_iterations_made_when_read_are_the_sweeps_own():
 def test_nothing_met_from_the_kernels_measures_agrees_with_the_general_test():
     """`nothing_met_measures` (modes summed, one comparison) answers as `nothing_met` on
     tables of modes and sigmas built to sit on every edge: a mode changing once, a mode 0
-    or NaN, a sigma at, just above and just below the bound, NaN, one pose, two groups."""
+    or NaN, a sigma at, just above and just below the bound, NaN, one pose, two groups, and
+    more groups than are checked in Python."""
     from kincas.analysis.events import _SIGMA_BOUND, nothing_met, nothing_met_measures
     rng = np.random.default_rng(7)
     edges = [_SIGMA_BOUND, np.nextafter(_SIGMA_BOUND, 1), np.nextafter(_SIGMA_BOUND, 0), np.nan, 0.3, 1.0]
     tried = {True: 0, False: 0}
     for trial in range(400):
-        n, g = int(rng.choice([1, 2, 7, 40])), int(rng.choice([1, 2, 3]))
+        n, g = int(rng.choice([1, 2, 7, 40])), int(rng.choice([1, 2, 3, 12, 41]))  # (beyond 8: numpy's sums)
         signs = np.tile(rng.choice([-1.0, 1.0], g), (n, 1))
         sigma = rng.uniform(0.01, 1.0, n)
         kind = trial % 5
@@ -258,3 +259,31 @@ def test_nothing_met_from_the_kernels_measures_agrees_with_the_general_test():
         assert nothing_met_measures(M, M.ravel()) == want, (signs, sigma)
         tried[want] += 1
     assert min(tried.values()) > 50  # both answers were met often
+
+
+def test_a_first_poses_correction_summed_by_numpy_is_pythons_sum():
+    """`_moved_within` (the first pose's correction per group, FastSweeper._from_guess) sums
+    |q - q0| w per group with np.bincount beyond a few unknowns: the same numbers as Python's
+    sums in the order of q, so the same answer at and around CORRECTION, with NaN too (where
+    Python's max decides), with unknowns of no group, and with one group."""
+    from kincas.core.fast import CORRECTION, _moved_within
+    rng = np.random.default_rng(11)
+    for trial in range(300):
+        nq, ng = int(rng.integers(1, 40)), int(rng.integers(1, 6))
+        of = rng.integers(0, ng + 1, nq)  # (ng: an unknown of no group)
+        q0, w = rng.normal(size=nq), rng.uniform(0.1, 10.0, nq)
+        q = q0 + rng.normal(size=nq) * CORRECTION * rng.choice([0.01, 0.3, 1.0, 3.0])
+        if trial % 7 == 0:  # exactly at the bound in one group
+            i = int(rng.integers(nq))
+            q = q0.copy()
+            q[i] = q0[i] + CORRECTION / w[i]
+        if trial % 11 == 0:
+            q[int(rng.integers(nq))] = np.nan
+        # the sums written out, term by term in the order of q
+        moved = [0.0] * (ng + 1)
+        for g, a, b, x in zip(of.tolist(), q.tolist(), q0.tolist(), w.tolist()):
+            moved[g] += abs(a - b) * x
+        want = max(moved[:-1]) <= CORRECTION
+        got_list = _moved_within(q, q0.tolist(), w.tolist(), of.tolist(), of, ng)
+        got_numpy = _moved_within(q, q0, w, of.tolist(), of, ng)
+        assert got_list == got_numpy == want, (trial, moved)

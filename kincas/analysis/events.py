@@ -186,37 +186,40 @@ def nothing_met(ok, signs, sigma, every: bool | None = None) -> bool:
     # count_nonzero costs a third of a ufunc's reduction .all())
 
 
-def nothing_met_measures(M, flat) -> bool:
+def nothing_met_measures(M, flat=None) -> bool:
     """`nothing_met` for a sweep with every pose solved, from the fast kernel's measures as it
-    writes them, pose by pose: M (N, groups + 1) each group's mode then sigma, `flat` the same
-    numbers in one row. The same answer as `nothing_met` in three numpy calls instead of
-    seven, none of them a ufunc's reduction: each mode is -1, 0 or +1 (NaN where not
-    measured), so a group's modes summed over the N poses (whole numbers, exact) are N times
-    the first pose's mode, +-1, exactly where every pose has that mode; and flat > c (c: -2
-    at each mode, the bound at each sigma) holds everywhere exactly where no measure is NaN
-    and every sigma exceeds the bound. A first pose with a mode 0 or NaN is left to
-    `nothing_met`."""
-    n = len(M)
-    ones, c = _rows_of(n, M.shape[1])
-    sums = np.dot(ones, M).tolist()  # (BLAS: a matrix-vector product)
-    if not all(abs(v) == n for v in sums[:-1]) or n == 0:  # (NaN: not)
-        return n > 0 and nothing_met(np.ones(n, dtype=bool), M[:, :-1], M[:, -1], True)
-    return np.count_nonzero(flat > c) == flat.size
+    writes them, pose by pose: M (N, groups + 1) each group's mode then sigma (`flat`, the
+    same numbers in one row, is not needed). The same answer as `nothing_met` in a few numpy
+    calls, none of them over the whole table but one matrix-vector product: each mode is -1,
+    0 or +1 (NaN where not measured), so a group's modes summed over the N poses are whole
+    numbers (exact), at most N in size, and each times the first pose's mode is N exactly
+    where every pose has that mode, +-1; their total over the groups is then N times the
+    number of groups exactly where that holds for every group (a NaN mode makes it NaN).
+    Then no mode is NaN, and nothing was met exactly where every sigma exceeds the bound
+    (the smallest, NaN if any is). Anything else is left to `nothing_met`."""
+    n, g = M.shape[0], M.shape[1] - 1
+    if n == 0:
+        return False
+    sums = np.dot(_ones(n), M)  # (BLAS: a matrix-vector product)
+    if not (all(abs(v) == n for v in sums.tolist()[:g]) if g <= 8 else  # (a few: in Python)
+            np.dot(sums[:g], M[0, :g]) == n * g):  # (NaN: not)
+        return nothing_met(np.ones(n, dtype=bool), M[:, :-1], M[:, -1], True)
+    return bool(M[:, g].min() > _SIGMA_BOUND)
 
 
 _SIGMA_BOUND = max(NEAR_SINGULAR, 1e3 * FLAG_SIGMA)  # sigma above it everywhere: nothing near singular
-_ROWS: dict = {}  # (N, groups + 1) -> (ones (N,), c (N * (groups + 1),)), read only
+_ONES: dict = {}  # N -> N ones, read only
 
 
-def _rows_of(n: int, width: int):
-    """(ones (n,), c): what `nothing_met_measures` multiplies and compares with, per size."""
-    got = _ROWS.get((n, width))
+def _ones(n: int) -> np.ndarray:
+    """N ones, which `nothing_met_measures` multiplies with, one array per length."""
+    got = _ONES.get(n)
     if got is None:
-        ones, c = np.ones(n), np.tile([-2.0] * (width - 1) + [_SIGMA_BOUND], n)
-        ones.flags.writeable = c.flags.writeable = False
-        if len(_ROWS) >= 64:  # (bounded: sweeps of many lengths)
-            _ROWS.clear()
-        got = _ROWS[(n, width)] = (ones, c)
+        got = np.ones(n)
+        got.flags.writeable = False
+        if len(_ONES) >= 64:  # (bounded: sweeps of many lengths)
+            _ONES.clear()
+        _ONES[n] = got
     return got
 
 

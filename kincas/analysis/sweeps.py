@@ -155,7 +155,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     if not every:  # after gaps the fast pass crossed (none where every pose is solved)
         events += unlabelled_resumes(model, U, p, L, Q, ok, events)
     crossed = getattr(run, "crossed", ())
-    if every and not len(crossed) and (nothing_met_measures(*run.measures_by_pose()) if type(run) is FastRun
+    if every and not len(crossed) and (nothing_met_measures(run.measures_by_pose()[0]) if type(run) is FastRun
                                        else nothing_met(ok, run.signs, run.sigma, every)):
         at = None  # the usual sweep: no singular position met, no gap (nothing to search)
     else:

@@ -76,6 +76,7 @@ VM_MAX = 200_000
 BACKGROUND_CALLS = 2
 BACKGROUND_MIN_POSES = 500
 BACKGROUND_POSES = 20_000
+FEW_UNKNOWNS = 16  # up to this many unknowns, a first pose's correction is summed in Python
 BLOCK = 65536  # poses per call when a progress callback wants news
 _I, _V = ctypes.c_longlong, ctypes.c_void_p
 # kincas_sweep's C signature (SWEEP_C): every library that links the loop declares it so
@@ -291,8 +292,12 @@ class FastSweeper(VirtualMachineSweep):
             s.flags.writeable = False
             before = _diagonal_signs(s[self.nq:self.nq + self.nj], self.blocks)
             # q0 and 1 / qs as Python numbers: the correction of a few unknowns summed in
-            # Python costs a third of numpy's calls for it
-            placed.kernel = s, before.tolist(), bool((before != 0).all()), q0.tolist(), (1.0 / qs).tolist()
+            # Python costs a third of numpy's calls for it (many: as numpy arrays)
+            w = 1.0 / qs
+            w.flags.writeable = False
+            few = self.nq <= FEW_UNKNOWNS
+            placed.kernel = (s, before.tolist(), bool((before != 0).all()), q0.tolist() if few else q0,
+                             w.tolist() if few else w)
         s, before, regular, q0s, inv_qs = placed.kernel
         if not regular:  # a group singular at q0: its mode is not the guess's to choose
             r._s = None
@@ -300,13 +305,9 @@ class FastSweeper(VirtualMachineSweep):
         r._state[:] = s
         r._s = r._state
         bad = r.advance(k, None, None, stop)
-        if bad > k and r.measures[:len(self.blocks), k].tolist() == before:
-            # each group's sum of |q - q0| / qs over its own unknowns (in the order of q)
-            moved = [0.0] * (len(self.blocks) + 1)
-            for g, a, b, w in zip(self._groups, r.Q[k].tolist(), q0s, inv_qs):
-                moved[g] += abs(a - b) * w
-            if max(moved[:-1], default=0.0) <= CORRECTION:
-                return bad
+        if bad > k and r.modes_at(k) == before and _moved_within(r.Q[k], q0s, inv_qs, self._groups, self._group_of,
+                                                                   len(self.blocks)):
+            return bad
         r._s = None  # nothing of this attempt is kept: the careful path starts afresh
         r.Q[k:bad + 1] = r.values[:, k:bad + 1] = r.measures[:, k:bad + 1] = np.nan
         r.accepted[k:bad + 1] = r.solved[k:bad + 1] = False
@@ -322,6 +323,25 @@ class FastSweeper(VirtualMachineSweep):
         r.Q[k], r.info[:, k], r.measures[:, k] = kept
         r.solved[k] = True
         return False
+
+
+def _moved_within(q, q0, w, groups: list, group_of: np.ndarray, n_groups: int) -> bool:
+    """Whether each group's sum of |q - q0| w over its own unknowns (in the order of q) is
+    at most CORRECTION (`FastSweeper._from_guess`): q0 and w as lists (a few unknowns, summed
+    in Python) or as arrays (np.bincount adds each group's terms in the same order, so the
+    sums are the same numbers; where one is NaN, Python's max decides as it always did)."""
+    if type(q0) is list:
+        moved = [0.0] * (n_groups + 1)  # (the last: unknowns of no group)
+        for g, a, b, x in zip(groups, q.tolist(), q0, w):
+            moved[g] += abs(a - b) * x
+        return max(moved[:-1], default=0.0) <= CORRECTION
+    d = np.abs(q - q0)
+    d *= w
+    moved = np.bincount(group_of, d, n_groups + 1)
+    top = moved[:-1].max() if n_groups else 0.0
+    if top == top:  # (no NaN: the largest, as Python's max finds it)
+        return bool(top <= CORRECTION)
+    return _moved_within(q, q0.tolist(), w.tolist(), groups, group_of, n_groups)
 
 
 def _diagonal_signs(d: np.ndarray, blocks) -> np.ndarray:

@@ -42,6 +42,12 @@ class FastRun:
     Everything the kernel writes belongs to this run: runs in several threads share nothing.
     """
 
+    # (slots: a sweep makes one run, and each attribute stored in a __dict__ of twenty costs
+    # it more; `__dict__` stays for what callers add, such as `crossed`)
+    __slots__ = ("sweeper", "n", "_off", "_block", "Q", "info", "values", "_ok", "solved", "_accepted",
+                 "_measures", "_state_view", "_sud", "_sudd", "_U", "_Ud", "_Udd", "_p", "first_bad", "_s",
+                 "_addr", "recorded", "attempted", "backend", "__dict__")
+
     def __init__(self, sweeper: "FastSweeper", U, p, L, Ud=None, Udd=None):
         self.sweeper, nq, nu = sweeper, sweeper.nq, sweeper.nu
         if not (type(U) is np.ndarray and U.ndim == 2 and U.shape[1] == nu and U.dtype == _F8):
@@ -52,38 +58,62 @@ class FastRun:
         if not (type(p) is np.ndarray and p.dtype == _F8 and p.ndim == 1):  # (a mechanism's
             p = np.asarray(p, dtype=float).ravel()  # prepared values are: no call for them)
         # everything the kernel reads or writes of this run in one block of memory: L and
-        # the thresholds, the state, Q, info, values, measures, then copies of the inputs
-        # (U, rates, accelerations: a table, or one row for every pose) and the parameters
-        # (one address per run: numpy's array interface costs ~1.5 us an array)
+        # the thresholds, copies of the inputs (U, rates, accelerations: a table, or one row
+        # for every pose) and the parameters, then the state, Q, info, values, measures (one
+        # address per run: numpy's array interface costs ~1.5 us an array). The views a warm
+        # sweep does not read (the measures, the state, the inputs) are made when first asked.
         no, nm = len(sweeper.report), len(sweeper.blocks) + 1
-        o1 = 6
-        o2 = o1 + sweeper.state_size
-        o3 = o2 + n * nq
-        o4 = o3 + 5 * n
-        o5 = o4 + no * n
-        o6 = o5 + nm * n
-        o7 = o6 + n * nu
-        o8 = o7 + (n if sud else 1) * nu
-        o9 = o8 + (n if sudd else 1) * nu
-        o = self._off = (0, o1, o2, o3, o4, o5, o6, o7, o8, o9, o9 + p.size)
+        at_ud = 6 + n * nu  # where each part starts: U at 6, then the rates, ...
+        at_udd = at_ud + (n if sud else 1) * nu
+        at_p = at_udd + (n if sudd else 1) * nu
+        at_s = at_p + p.size
+        at_q = at_s + sweeper.state_size
+        at_info = at_q + n * nq
+        at_values = at_info + 5 * n
+        at_m = at_values + no * n
+        # (the order `advance` and the views read them in: state, Q, info, values, measures,
+        # U, rates, accelerations, parameters, then the ends of the parameters and measures)
+        o = self._off = (0, at_s, at_q, at_info, at_values, at_m, 6, at_ud, at_udd, at_p, at_s, at_m + nm * n)
         block = self._block = np.empty(o[-1])
-        block[:6] = _HEAD  # the thresholds, then L in its place
-        block[0] = L
-        self._state, self.Q = block[o1:o2], block[o2:o3].reshape(n, nq)
-        per_pose = block[o3:o5].reshape(5 + no, n)  # info, values: one table
-        self.info, self.values = per_pose[:5], per_pose[5:]
-        # the measures pose by pose (the kernel writes one pose's together: a row per measure
-        # of 100,000 poses would be 41 streams of writes on 40 chained four-bars, 1.7 us a
-        # pose), seen as (groups + 1, N)
-        self.measures = block[o5:o6].reshape(n, nm).T
-        # the inputs and parameters copied in by one call (views of them made when asked)
-        np.concatenate((U.ravel(), Ud.ravel(), Udd.ravel(), p), out=block[o6:])
+        np.concatenate((_HEAD, U.ravel(), Ud.ravel(), Udd.ravel(), p), out=block[:at_s])  # the
+        block[0] = L  # thresholds, then L in its place
+        self.Q = block[at_q:at_info].reshape(n, nq)
+        self.info = block[at_info:at_values].reshape(5, n)
+        self.values = block[at_values:at_m].reshape(no, n)
         self._sud, self._sudd, self._U, self._Ud, self._Udd, self._p = sud, sudd, None, None, None, None
-        self._ok = np.zeros((2, n), dtype=bool)  # accepted, solved: one table, set by one call
-        self.accepted, self.solved = self._ok
+        self._measures = self._state_view = self._accepted = None
+        self._ok = ok = np.zeros((2, n), dtype=bool)  # accepted, solved: one table, set by one call
+        self.solved = ok[1]
         self.first_bad, self._s, self._addr, self.recorded = 0, None, None, 0
         self.attempted = False  # True once every pose was attempted (`FastSweeper.sweep`)
         self.backend = None  # "compiled" or "virtual machine": what `advance` ran last
+
+    @property
+    def accepted(self) -> np.ndarray:
+        """(N,) bool: the poses the fast pass accepted."""
+        a = self._accepted
+        if a is None:
+            a = self._accepted = self._ok[0]
+        return a
+
+    @property
+    def measures(self) -> np.ndarray:
+        """(groups + 1, N): per pose, the sign of det of each Assur group's block of g_q,
+        then the smallest relative singular value bound (the kernel writes one pose's
+        together: a row per measure of 100,000 poses would be 41 streams of writes on 40
+        chained four-bars, 1.7 us a pose)."""
+        m = self._measures
+        if m is None:
+            m = self._measures = self.measures_by_pose()[0].T
+        return m
+
+    @property
+    def _state(self) -> np.ndarray:
+        """The kernel's state (`FastSweeper.state`) in the run's block."""
+        s = self._state_view
+        if s is None:
+            s = self._state_view = self._block[self._off[1]:self._off[2]]
+        return s
 
     @property
     def U(self) -> np.ndarray:
@@ -126,8 +156,14 @@ class FastRun:
 
     def measures_by_pose(self) -> tuple:
         """The measures as the kernel writes them: (N, groups + 1), and the same in one row."""
-        flat = self._block[self._off[5]:self._off[6]]
-        return self.measures.T, flat
+        flat = self._block[self._off[5]:self._off[11]]
+        return flat.reshape(self.n, len(self.sweeper.blocks) + 1), flat
+
+    def modes_at(self, k: int) -> list:
+        """Each group's mode at pose k (the sign of det of its block of g_q), as numbers."""
+        nm = len(self.sweeper.blocks) + 1
+        at = self._off[5] + k * nm
+        return self._block[at:at + nm - 1].tolist()
 
     def advance(self, start: int, q_last, u_last, stop: int | None = None) -> int:
         """Solve poses start, start + 1, ... (before `stop`, default N) from the solved pose
@@ -153,7 +189,10 @@ class FastRun:
                 a + 8 * (o[8] + start * sudd), sudd, a + 8 * (o[4] + start), a + 8 * (o[5] + start * (len(sw.blocks) + 1)))
         else:
             k = sw._vm_advance(self, start, stop, s)
-        self._ok[:, start:k] = True  # accepted and solved
+        if start == 0 and k == self.n:  # (the usual warm sweep: every pose at once)
+            self._ok.fill(True)  # accepted and solved
+        else:
+            self._ok[:, start:k] = True
         if k < stop:
             self.Q[k] = self.values[:, k] = self.measures[:, k] = np.nan
         self.first_bad = k
