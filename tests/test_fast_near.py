@@ -75,16 +75,23 @@ def test_exact_predictions_take_no_newton_step(monkeypatch, grouped):
     check_residuals(model, run, p, L)
 
 
-def test_predictions_near_step_switch_between_both_ways_alike(monkeypatch):
-    # steps of 7.5e-3 rad over half a turn: the predictions (kincas/core/prediction.py: the
-    # quintic where the cubic misses by up to QUINTIC_TRY, else the cubic) miss the four-bar
-    # by about STEP, so poses go either way (kF first, accepted; or not, and Newton from kF's
-    # step), and the prediction switches between the quintic and the cubic
+@pytest.mark.parametrize("quintic", [False, True])
+def test_predictions_near_step_switch_between_both_ways_alike(monkeypatch, quintic):
+    # the cubic (kincas/core/prediction.py) misses the four-bar by about STEP at steps of
+    # 1e-3 rad (tests/test_fast_predict.py computes it: above at 542 poses, below at 457);
+    # with the quintic (forced on a four-bar, which has too few unknowns for it), at 7.5e-3
+    # rad over half a turn, where it runs where the cubic misses by up to QUINTIC_TRY and
+    # the cubic elsewhere. Poses go either way (kF first, accepted; or not, and Newton from
+    # kF's step)
     m = fourbar(b=3.45)
-    th = np.linspace(0.3, 3.3, 401)
-    model, p, L, out = runs(m, ["C.x", "C.y", "C.vx", "C.vy"], th[:, None], [10.0], monkeypatch)
+    th = np.linspace(0.3, 3.3, 401) if quintic else np.linspace(0.3, 1.3, 1001)
+    extra = ["B.y"] if quintic else []  # (a report of its own: kernels are kept per report)
+    if quintic:
+        monkeypatch.setattr("kincas.core.kernel.QUINTIC_UNKNOWNS", 1)
+    model, p, L, out = runs(m, ["C.x", "C.y", "C.vx", "C.vy", *extra], th[:, None], [10.0], monkeypatch)
     same_decisions(out)
     run = out["compiled"]
+    assert (run.sweeper.functions[4] is not None) == quintic
     its = run.iterations[2:]
     assert (its == 0).sum() >= 10 and (its >= 1).sum() >= 10  # both ways
     cf = fourbar_closed(th, 1.0, 3.45, 3.0, 4.0, w=10.0)

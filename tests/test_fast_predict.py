@@ -1,5 +1,5 @@
 """The fast kernel's predictions (kincas/core/prediction.py): kP the cubic through the last two
-solved poses with their tangents (Hermite's), kQ the quintic through the last three. On a
+solved poses with their tangents (Hermite's), kP5 the quintic through the last three. On a
 dense sweep of a mechanism whose q(u) is not linear the cubic lands within STEP of the pose
 where the second-order prediction misses by far more, and at ten times the step the quintic
 does where the cubic misses: the kernel accepts the pose with kF alone, no Newton step. The
@@ -84,7 +84,7 @@ def test_uneven_and_reversing_steps_keep_the_closed_form(monkeypatch, turn):
     check_residuals(model, run, p, L, tol=1e-13)
 
 
-# --- the fifth-order prediction (kincas/core/prediction.py: kQ) ---
+# --- the fifth-order prediction (kincas/core/prediction.py: kP5) ---
 
 
 def hermite(nodes, values, slopes, t):
@@ -97,14 +97,16 @@ def hermite(nodes, values, slopes, t):
     return sum(c * t ** j for j, c in enumerate(coef)).reshape(rhs.shape[1:])
 
 
-def test_kq_is_the_quintic_through_three_poses_and_the_cubic_where_steps_are_uneven():
+def test_kp5_is_the_quintic_through_three_poses_and_the_cubic_where_steps_are_uneven(monkeypatch):
     import casadi as ca
     from kincas.core.fast import FastSweeper
     from kincas.core.tolerances import QUINTIC_RATIO
     from test_fast import first_pose
+    monkeypatch.setattr("kincas.core.kernel.QUINTIC_UNKNOWNS", 1)  # (a four-bar has 2)
     m = fourbar(b=3.45)
     model, p, L, q0 = first_pose(m, np.array([[0.3]]))
-    kP, kQ = (FastSweeper(model, [], compile=False).functions[i] for i in (0, 4))
+    # (a report of its own: the kernel functions are kept per model and report)
+    kP, kP5 = (FastSweeper(model, ["C.x", "B.y"], compile=False).functions[i] for i in (0, 4))
     rng = np.random.default_rng(3)
     nq = model.sym.nq
     for trial in range(20):
@@ -115,7 +117,7 @@ def test_kq_is_the_quintic_through_three_poses_and_the_cubic_where_steps_are_une
         f = lambda x: np.array([np.sin(2 * x) + x ** 5, np.exp(x) - 3 * x ** 4])[:nq]
         df = lambda x: np.array([2 * np.cos(2 * x) + 5 * x ** 4, np.exp(x) - 12 * x ** 3])[:nq]
         args = [f(u0), df(u0), [u0], [u], df(u1), [u1], f(u1), df(u2), [u2], f(u2), np.full(len(model.blocks), 4.0)]
-        got, miss = (np.asarray(v).ravel() for v in kQ(*args))
+        got, miss = (np.asarray(v).ravel() for v in kP5(*args))
         cub = np.asarray(kP(*args[:7])).ravel()
         want3 = hermite([u0, u1], [f(u0), f(u1)], [df(u0), df(u1)], u)
         np.testing.assert_allclose(cub, want3, rtol=0, atol=1e-11)  # kP: the cubic
@@ -130,6 +132,7 @@ def test_kq_is_the_quintic_through_three_poses_and_the_cubic_where_steps_are_une
 
 
 def test_the_quintic_takes_moderate_steps_without_newton_and_the_cubic_dense_ones(monkeypatch):
+    monkeypatch.setattr("kincas.core.kernel.QUINTIC_UNKNOWNS", 1)  # (a four-bar has 2)
     a, b, c, d, w = 1.0, 3.45, 3.0, 4.0, 10.0
     names = ["C.x", "C.y", "C.vx", "C.vy"]
     for h, quintic_on in ((3e-3, True), (3e-4, False)):
@@ -140,7 +143,8 @@ def test_the_quintic_takes_moderate_steps_without_newton_and_the_cubic_dense_one
         miss3, miss5 = np.abs(cubic[1:] - q[3:]).max(1), np.abs(quint - q[3:]).max(1)
         if quintic_on:
             assert miss3.min() > 5 * STEP and miss5.max() < 0.1 * STEP  # what the test is about
-        model, p, L, out = runs(fourbar(b=b), names, th[:, None], [w], monkeypatch)
+        # (a report of its own, "B.y" last: the kernel functions are kept per model and report)
+        model, p, L, out = runs(fourbar(b=b), names + ["B.y"], th[:, None], [w], monkeypatch)
         same_decisions(out)
         run = out["compiled"]
         assert (run.iterations[5:] == 0).all()  # no Newton step: kF at the prediction, accepted
@@ -150,3 +154,23 @@ def test_the_quintic_takes_moderate_steps_without_newton_and_the_cubic_dense_one
             scale = L * (w if ".v" in name else 1.0)
             assert np.abs(run.values[i, 1:] - cf[name][1:]).max() <= 1e-12 * scale, name
         check_residuals(model, run, p, L, tol=1e-13)
+
+
+def test_a_small_kernel_has_no_quintic_and_keeps_the_cubic(monkeypatch):
+    """Below QUINTIC_UNKNOWNS unknowns the kernel is built without kP5 (its compile would cost
+    more than it saves): the poses that the quintic would have taken without a Newton step take
+    one, with the same answers."""
+    from kincas.core.kernel import QUINTIC_UNKNOWNS
+    a, b, c, d, w = 1.0, 3.45, 3.0, 4.0, 10.0
+    th = 0.3 + 3e-3 * np.arange(201)
+    names = ["C.x", "C.y", "C.vx", "C.vy"]
+    model, p, L, out = runs(fourbar(b=b), names, th[:, None], [w], monkeypatch)
+    assert model.sym.nq < QUINTIC_UNKNOWNS
+    same_decisions(out)
+    run = out["compiled"]
+    assert run.sweeper.functions[4] is None and not run._state[-1]
+    assert (run.iterations[5:] >= 1).all()  # the cubic misses these by more than STEP
+    cf = fourbar_closed(th, a, b, c, d, w=w)
+    for i, name in enumerate(names):
+        scale = L * (w if ".v" in name else 1.0)
+        assert np.abs(run.values[i, 1:] - cf[name][1:]).max() <= 1e-12 * scale, name

@@ -129,6 +129,7 @@ static int kincas_substeps(casadi_int k, const casadi_real* U, const casadi_real
   for (i = 0; i < NS; ++i) s0[i] = s[i];
   for (h = 1; h <= HALVINGS; ++h) {
     m = (casadi_int) 1 << h;
+    s[KS_NEAR] = s[KS_FIVE] = 0;  /* shorter steps: the last prediction's quality says nothing */
     for (j = 0; j < m; ++j) for (i = 0; i < NU; ++i)  /* the last one is pose k's input exactly */
       Us[j*NU + i] = j == m - 1 ? U[k*NU + i]
                    : U[(k - 1)*NU + i] + (U[k*NU + i] - U[(k - 1)*NU + i]) * ((casadi_real) (j + 1) / m);
@@ -221,7 +222,7 @@ class DesignsLoop:
 
     def _library(self) -> Library:
         sw = self.sweeper
-        fns = [*sw.functions, *continuation_functions(self.model.sym, sw.blocks)]
+        fns = [*sw.compiled_functions, *continuation_functions(self.model.sym, sw.blocks)]
         return Library("kincas_designs", fns, SWEEP_C + _LOOP_C,
                        {**sw.sweep_macros(), "NP": self.np, "NG": self.ng, "NS": sw.state_size,
                         "HALVINGS": HALVINGS, "SUB": 2 ** HALVINGS},

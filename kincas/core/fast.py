@@ -119,7 +119,7 @@ class FastSweeper(VirtualMachineSweep):
         """The kernel's C code size in casadi instructions (what compiling costs: a
         function shared by several Assur groups counts once, kincas/core/group_kernel.py)."""
         if self._size is None:
-            code, self._work = kernel_sizes(self.functions)
+            code, self._work = kernel_sizes(self.compiled_functions)
             self._size = code  # set last: another thread reads _work once it sees _size
         return self._size
 
@@ -139,7 +139,7 @@ class FastSweeper(VirtualMachineSweep):
 
     @property
     def functions(self) -> list[ca.Function]:
-        """kP, kN, kF, kL, kQ (kincas/core/kernel.py), built when first needed, once per model
+        """kP, kN, kF, kL, kP5 (kincas/core/kernel.py), built when first needed, once per model
         and report: the sweepers of one kernel with different `compile` settings share them,
         so they generate the same C code (the same library)."""
         if self._functions is None:
@@ -148,15 +148,20 @@ class FastSweeper(VirtualMachineSweep):
                 lambda: kernel_functions(self.sym, self.blocks, self.report, self.model.structure))
         return self._functions
 
+    @property
+    def compiled_functions(self) -> list[ca.Function]:
+        """The kernel's functions that its C code holds (kP5 only where there is one)."""
+        return [f for f in self.functions if f is not None]
+
     def _library(self) -> Library:
-        return Library("kincas_sweep", self.functions, SWEEP_C, self.sweep_macros(),
+        return Library("kincas_sweep", self.compiled_functions, SWEEP_C, self.sweep_macros(),
                        {"kincas_sweep": SWEEP_SIG})
 
     def sweep_macros(self) -> dict:
         """The sizes SWEEP_C is compiled with (kincas/core/kernel.py)."""
         return {"NQ": self.nq, "NU": self.nu, "NO": len(self.report), "NM": len(self.blocks) + 1,
                 "NJ": self.nj, "NEAR_TRY": repr(float(NEAR_TRY)), "QUINTIC_ON": repr(float(QUINTIC_ON)),
-                "QUINTIC_TRY": repr(float(QUINTIC_TRY))}
+                "QUINTIC_TRY": repr(float(QUINTIC_TRY)), "HAVE_KP5": int(self.functions[4] is not None)}
 
     def state(self, q, u, p, out=None) -> np.ndarray:
         """(q, J, T = dq/du, u, T, u, q, T, u, q, near, five) at a solved pose, matrices

@@ -4,7 +4,7 @@ Three functions, every linear solve done Assur group by Assur group (kincas/core
 so their size grows with the number of groups, not with nq^3:
 
 - kP: the prediction from the last two solved poses (tangent, second- and third-order terms);
-  kQ: from the last three, of fifth order, run while it pays (kincas/core/prediction.py);
+  kP5: from the last three, of fifth order, run while it pays (kincas/core/prediction.py);
 - kN: at q, the Newton step g_q^-1 g (Gauss-Newton's (g_q'g_q)^-1 g_q' g for a tall group:
   redundant joints, kincas/core/blocks.py) and the measures that stop Newton (max |g| / L and the
   step's size in radians or lengths / L, each equation and unknown against its own Assur
@@ -52,22 +52,29 @@ STEP = TOL
 # 7.5 s (4 groups), 8.8 s (1) and 23 s (flat) of a loaded machine's wall clock.
 GROUPS_APART = 16
 GROUP_RUN = 4  # consecutive groups per function written group by group (measured above)
+# From this many unknowns on, the kernel has the quintic prediction kP5 (kincas/core/
+# prediction.py): where it lets a pose skip its Newton step, it saves a kN (40 chained
+# four-bars, 360 poses over 60 deg: 41k -> 26k instructions a pose). On a small kernel the
+# step costs little and compiling kP5 costs much: gcc took 0.27 -> 0.37 s of CPU for a
+# four-bar's kernel, which a user's first sweeps wait for in the virtual machine.
+QUINTIC_UNKNOWNS = 16
 
 
 # --- the casadi functions ---
 
 
 def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> list[ca.Function]:
-    """[kP, kN, kF, kL, kQ] (see the module text), outputs dense so that C can index them.
+    """[kP, kN, kF, kL, kP5] (see the module text), outputs dense so that C can index them;
+    kP5 None below QUINTIC_UNKNOWNS unknowns.
     `structure` (the `Structure` whose blocks these are, built from `sym` if not given)
     gives the groups' lengths.
 
     kP predicts the next pose by Hermite's cubic through the last two solved poses (q, T =
-    dq/du, u each, newest first), kQ by the quintic through the last three where the steps
+    dq/du, u each, newest first), kP5 by the quintic through the last three where the steps
     are even enough (kincas/core/prediction.py). Error O(h^4), O(h^6), on a straight sweep:
     on a dense sweep the prediction is converged to STEP and the pose costs kF alone (no
     kN); 40 chained four-bars that are not parallelograms (benchmarks/cases.py `chain`) need
-    no Newton step at most poses from 360 poses a sixth of a turn on with kQ, where kP needs
+    no Newton step at most poses from 360 poses a sixth of a turn on with kP5, where kP needs
     one at every pose."""
     nq, nu = sym.nq, sym.nu
     solve = lambda A, b: block_solve(A, b, blocks)
@@ -90,13 +97,14 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
     Lq, Lg = group_scales(Lb, blocks, sym.nq, sym.ng)
     D = ca.if_else(is_length, Lq, 1)  # the scale of each unknown: its group's length or 1
     kP = ca.Function("kP", [q, T0, u0, u, T1, u1, q1], [d(cubic(q, T0, u0, u, T1, u1, q1))], o)
-    kQ = ca.Function("kQ", [q, T0, u0, u, T1, u1, q1, T2, u2, q2, Lb],
-                     [d(v) for v in quintic(q, T0, u0, u, T1, u1, q1, T2, u2, q2, D)], o)
+    kP5 = ca.Function("kP5", [q, T0, u0, u, T1, u1, q1, T2, u2, q2, Lb],
+                      [d(v) for v in quintic(q, T0, u0, u, T1, u1, q1, T2, u2, q2, D)], o) \
+        if nq >= QUINTIC_UNKNOWNS else None
     if not is_tall(blocks) and (grouped or (grouped is None and len(blocks) >= GROUPS_APART)):
         # one small function per kind of group, the quantities apart
         qd = ca.SX.sym("qd", nq)
         kY = ca.Function("kY", [q, u, p, ud, udd, qd], [ca.densify(given((q, u, p, ud, udd), qd))], o) if report else None
-        return [kP, *GroupFunctions(sym, blocks, GROUP_RUN).kernel(kY), kL, kQ]
+        return [kP, *GroupFunctions(sym, blocks, GROUP_RUN).kernel(kY), kL, kP5]
     cs = ca.if_else(is_length, 1, reciprocal(L))  # g_q's columns to O(1): 1 (lengths), 1/L (angles)
     g, Jq, Ju = ca.Function("G", [sym.q, sym.u, sym.p], [sym.g, sym.Jq, sym.Ju])(q, u, p)
     step = solve(Jq, g)
@@ -111,7 +119,7 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
                       ca.vertcat(signs, sigma), y, d(step), *((Jq, D) if tall else ())], o)
     if tall:
         kF = _exact_where_needed(kF, blocks)
-    return [kP, ca.Function("kN", [q, u, p, Lb], [d(step), rs], o), kF, kL, kQ]
+    return [kP, ca.Function("kN", [q, u, p, Lb], [d(step), rs], o), kF, kL, kP5]
 
 
 def _exact_where_needed(kF, blocks) -> ca.Function:
@@ -142,7 +150,7 @@ def state_function(sym, blocks) -> ca.Function:
                        {"cse": True})
 
 
-def vm_step(kP, kN, kF, kL, kQ, nq, nu, max_evals, skip: bool = True) -> ca.Function:
+def vm_step(kP, kN, kF, kL, kP5, nq, nu, max_evals, skip: bool = True) -> ca.Function:
     """One pose for the virtual machine, the compiled loop's arithmetic: where the last pose
     was predicted to within STEP (`near`), kF at the prediction first, its step the last if
     negligible; else kN evaluated until its step is below KERNEL_NEAR (at most max_evals
@@ -157,7 +165,8 @@ def vm_step(kP, kN, kF, kL, kQ, nq, nu, max_evals, skip: bool = True) -> ca.Func
     groups' lengths Lb are an input, computed once per sweep as the compiled loop does.
     Functions written group by group are inlined (`expand`) for the virtual machine; those
     of a tall kernel (numeric linear solves, which have no SX form) stay MX, with `skip`."""
-    kP, kN, kF, kQ = (_expanded(f) for f in (kP, kN, kF, kQ))
+    kP, kN, kF = (_expanded(f) for f in (kP, kN, kF))
+    kP5 = _expanded(kP5) if kP5 is not None else None
     skip = skip or kN.is_a("MXFunction") or kF.is_a("MXFunction")
     X = ca.MX if skip else ca.SX
     q0, J0, T0, u0 = X.sym("q0", nq), X.sym("J0", kF.size1_in(6)), X.sym("T0", nq, nu), X.sym("u0", nu)
@@ -166,7 +175,7 @@ def vm_step(kP, kN, kF, kL, kQ, nq, nu, max_evals, skip: bool = True) -> ca.Func
     ud, udd, T1, u1 = X.sym("ud", nu), X.sym("udd", nu), X.sym("T1", nq, nu), X.sym("u1", nu)
     q1, T2, u2, q2 = X.sym("q1", nq), X.sym("T2", nq, nu), X.sym("u2", nu), X.sym("q2", nq)
     # the C loop's choice of prediction (both evaluated here: the same numbers, chosen)
-    qQ, missQ = kQ(q0, T0, u0, u, T1, u1, q1, T2, u2, q2, Lb)
+    qQ, missQ = kP5(q0, T0, u0, u, T1, u1, q1, T2, u2, q2, Lb) if kP5 is not None else (q0, 0)
     qp = ca.if_else(five, qQ, kP(q0, T0, u0, u, T1, u1, q1))
     converged = lambda rs: ca.logic_and(rs[0] <= thr[0], rs[1] <= thr[1])
     if skip:
@@ -217,7 +226,7 @@ def vm_step(kP, kN, kF, kL, kQ, nq, nu, max_evals, skip: bool = True) -> ca.Func
     info = ca.vertcat(rs, mc, evals, conv)
     near_next = ca.logic_or(evals == 0, mc[1] <= NEAR_TRY * thr[1])
     miss = ca.if_else(five, missQ, mc[1])  # the cubic's error at this pose
-    five_next = ca.logic_and(miss > QUINTIC_ON, miss <= QUINTIC_TRY)
+    five_next = ca.logic_and(miss > QUINTIC_ON, miss <= QUINTIC_TRY) if kP5 is not None else 0 * near
     return ca.Function("kS", [q0, J0, T0, u0, T1, u1, q1, T2, u2, q2, near, five, u, p, L, thr, ud, udd, Lb],
                        [q, J, T, u, T0, u0, q0, T1, u1, q1, near_next, five_next, info, y, meas])
 
@@ -236,7 +245,7 @@ def _expanded(f: ca.Function) -> ca.Function:
 # --- the C loop around them (NQ, NU, NO, NM, NJ: sizes, NM - 1 groups; state s = q, g_q's
 # diagonal blocks, T = dq/du, u at the last pose, then T, u and q at the one before, then at
 # the one before that, then `near` (1: try kF at the prediction first) and `five` (1: predict
-# by kQ, else kP); matrices column-major; L the whole mechanism's length, for the singular
+# by kP5, else kP); matrices column-major; L the whole mechanism's length, for the singular
 # measures' column scale; NEAR_TRY, QUINTIC_ON, QUINTIC_TRY: kincas/core/tolerances.py) ---
 
 SWEEP_C = """
@@ -251,7 +260,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
   casadi_real Lb[NM > 1 ? NM - 1 : 1];  /* each group's length, from the parameters */
   casadi_int k, i, it;
   int near = s[KS_NEAR] != 0;  /* the last pose was predicted well: try kF at the prediction first */
-  int five = s[KS_FIVE] != 0;  /* predict by the quintic (kQ), else the cubic (kP) */
+  int five = s[KS_FIVE] != 0;  /* predict by the quintic (kP5), else the cubic (kP) */
   if (n > 0) {
     arg[0] = U; arg[1] = p; res[0] = Lb;
     if (kL(arg, res, iw, w, 0)) return 0;
@@ -261,9 +270,13 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     int conv = 0;
     arg[0] = s; arg[1] = s + NQ + NJ; arg[2] = s + NQ + NJ + NQ*NU; arg[3] = u;
     arg[4] = s + NQ + NJ + NQ*NU + NU; arg[5] = s + NQ + NJ + 2*NQ*NU + NU;
-    arg[6] = s + NQ + NJ + 2*(NQ*NU + NU); arg[7] = arg[6] + NQ; arg[8] = arg[7] + NQ*NU;
-    arg[9] = arg[8] + NU; arg[10] = Lb; res[0] = qp; res[1] = &miss;
-    if (five ? kQ(arg, res, iw, w, 0) : kP(arg, res, iw, w, 0)) break;
+    arg[6] = s + NQ + NJ + 2*(NQ*NU + NU); res[0] = qp;
+#if HAVE_KP5  /* (arg and res hold as many pointers as the largest function takes: kP5's 11) */
+    arg[7] = arg[6] + NQ; arg[8] = arg[7] + NQ*NU; arg[9] = arg[8] + NU; arg[10] = Lb; res[1] = &miss;
+    if (five ? kP5(arg, res, iw, w, 0) : kP(arg, res, iw, w, 0)) break;
+#else
+    if (kP(arg, res, iw, w, 0)) break;
+#endif
     for (i = 0; i < NQ; ++i) q[i] = qp[i];
     if (near) {  /* kF at the prediction first: where its (next) step is negligible, no kN */
       arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = L; arg[4] = Ud + k*sud; arg[5] = Udd + k*sudd;
@@ -298,7 +311,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     if (!(conv && mc[0] <= thr[2] && mc[1] <= thr[3])) break;
     near = it == 0 || mc[1] <= NEAR_TRY * thr[1];
     if (!five) miss = mc[1];  /* the cubic's error at this pose (kincas/core/prediction.py) */
-    five = miss > QUINTIC_ON && miss <= QUINTIC_TRY;
+    five = HAVE_KP5 && miss > QUINTIC_ON && miss <= QUINTIC_TRY;
     s[KS_NEAR] = near; s[KS_FIVE] = five;  /* kept with the state: a sweep in several calls is one */
     for (i = 0; i < NQ*NU + NU; ++i) s[NQ + NJ + 2*(NQ*NU + NU) + NQ + i] = s[NQ + NJ + NQ*NU + NU + i];
     for (i = 0; i < NQ; ++i) s[NQ + NJ + 3*(NQ*NU + NU) + NQ + i] = s[NQ + NJ + 2*(NQ*NU + NU) + i];

@@ -24,16 +24,14 @@ The quintic is used only where it is well posed and its weights stay small (they
 rounding of q): the step before the last between QUINTIC_RATIO times the last (s - 1 in that
 range), the target at most QUINTIC_REACH steps ahead, the three inputs on one line; else the
 cubic alone (a first or second step, with repeated poses, reads the cubic's own fallbacks:
-l = 0 where u0 = u1). Uniform steps (s = 2, l = 1) give p5(1) = p3(1) + 10 R0 + 3 R1. And
-per unknown, only where p5 - p3 is above QUINTIC_FROM of the unknown's size (its scale, 1
-for an angle or its group's length, or its value if larger): below, the cubic is as good, and
-amplifies the rounding of the solved poses less (a dense sweep).
+l = 0 where u0 = u1). Uniform steps (s = 2, l = 1) give p5(1) = p3(1) + 10 R0 + 3 R1.
 
-Both are kernel functions (kincas/core/kernel.py: kP the cubic, kQ the quintic): the quintic
+Both are kernel functions (kincas/core/kernel.py: kP the cubic, kP5 the quintic): the quintic
 costs about three times the cubic's arithmetic, so the C loop (and the virtual machine alike)
 runs it only where it pays: where the cubic's error at the last pose (the correction Newton
 made to it, or under the quintic p5 - p3) lay between QUINTIC_ON (below, the cubic is
-converged already) and QUINTIC_TRY (above, the quintic would miss by more than STEP too, and
+converged already, and amplifies the rounding of the solved poses less: a dense sweep's
+prediction, and so its quantities, stay at the cubic's rounding, ~1e-15) and QUINTIC_TRY (above, the quintic would miss by more than STEP too, and
 Newton is needed either way: a four-bar at 1 deg steps).
 
 >>> import casadi as ca, numpy as np
@@ -54,7 +52,7 @@ from __future__ import annotations
 
 import casadi as ca
 
-from .tolerances import QUINTIC_FROM, QUINTIC_REACH, QUINTIC_RATIO, STRAIGHT
+from .tolerances import QUINTIC_REACH, QUINTIC_RATIO, STRAIGHT
 
 
 def cubic(q0, T0, u0, u, T1, u1, q1):
@@ -113,10 +111,8 @@ def quintic(q0, T0, u0, u, T1, u1, q1, T2, u2, q2, scale=1):
     wd2 = B
     corr = (w1 * (q1 - q0) + w2 * (q2 - q0) + ca.mtimes(T0, wd0 * dup) + ca.mtimes(T1, wd1 * dup)
             + ca.mtimes(T2, wd2 * dup))
-    # the quintic's weights (at even steps corr = 4 (f1 - f0) + 10 (f2 - f0) + 5 d0 + 16 d1
-    # + 3 d2) amplify the rounding of the solved q's about four times more than the cubic's:
-    # where corr = p5 - p3 (the cubic's error) is at that rounding, the cubic is kept (a
-    # dense sweep's prediction, and so its quantities, stay at the cubic's rounding, ~1e-15)
-    size = ca.fabs(corr)
-    miss = ca.mmax(size / scale) if size.numel() else ca.DM(0)  # the cubic's, scaled
-    return p3 + ca.if_else(size > QUINTIC_FROM * ca.fmax(scale, ca.fabs(q0)), corr, 0), miss
+    # (at even steps corr = 4 (f1 - f0) + 10 (f2 - f0) + 5 d0 + 16 d1 + 3 d2: these weights
+    # amplify the rounding of the solved q's about four times more than the cubic's, which is
+    # why the quintic runs only where the cubic misses by more than that: QUINTIC_ON)
+    miss = ca.mmax(ca.fabs(corr) / scale) if corr.numel() else ca.DM(0)  # the cubic's, scaled
+    return p3 + corr, miss

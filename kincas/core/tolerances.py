@@ -75,7 +75,6 @@ KERNEL_NEAR = 1e-8  # kN's step below which the next is negligible where converg
 # extrapolation's weights grow with the unevenness and amplify rounding
 QUINTIC_RATIO = (0.5, 2.0)
 QUINTIC_REACH = 2.0  # ... and the step predicted is at most this times the last one
-QUINTIC_FROM = 3e-14  # ... and only for an unknown whose cubic prediction is off by more than this relatively
 # the quintic runs at a pose where the cubic's error at the last one (scaled) lay between these
 # (below, the cubic converges: a dense sweep; above, the quintic misses by more than STEP too)
 QUINTIC_ON, QUINTIC_TRY = 5e-14, 3e-10
