@@ -48,7 +48,7 @@ from .compiled import CHUNK, Backend, Library, QuantityEvaluator  # noqa: F401 (
 from .fast_run import INFO, FastRun, _rows, _take  # noqa: F401 (INFO, _rows: their old home)
 from .fast_vm import VM_CHUNKS, VM_FLAT, VM_SKIP, VirtualMachineSweep, _Buffered  # noqa: F401
 from .group_kernel import kernel_sizes
-from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, KERNEL_NEAR, NEAR_TRY, QUINTIC_ON, QUINTIC_TRY, RESIDUAL,  # noqa: F401
+from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, KERNEL_NEAR, QUINTIC_ON, QUINTIC_TRY, RESIDUAL,  # noqa: F401
                      STEP, SWEEP_C,
                      kernel_functions, state_function)
 
@@ -160,7 +160,7 @@ class FastSweeper(VirtualMachineSweep):
     def sweep_macros(self) -> dict:
         """The sizes SWEEP_C is compiled with (kincas/core/kernel.py)."""
         return {"NQ": self.nq, "NU": self.nu, "NO": len(self.report), "NM": len(self.blocks) + 1,
-                "NJ": self.nj, "NEAR_TRY": repr(float(NEAR_TRY)), "QUINTIC_ON": repr(float(QUINTIC_ON)),
+                "NJ": self.nj, "QUINTIC_ON": repr(float(QUINTIC_ON)),
                 "QUINTIC_TRY": repr(float(QUINTIC_TRY)), "HAVE_KP5": int(self.functions[4] is not None)}
 
     def state(self, q, u, p, out=None) -> np.ndarray:

@@ -35,7 +35,7 @@ from .group_kernel import GroupFunctions, _max_abs, group_correction, group_scal
 from .structure import Structure
 from ..model.names import parse_quantity
 from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size, reciprocal, is_tall
-from .tolerances import ACCEPT, CORRECTION, JAC_CHANGE, KERNEL_NEAR, MAX_EVALS, NEAR_TRY, QUINTIC_ON, QUINTIC_TRY, TOL  # noqa: F401
+from .tolerances import ACCEPT, CORRECTION, JAC_CHANGE, KERNEL_NEAR, MAX_EVALS, QUINTIC_ON, QUINTIC_TRY, TOL  # noqa: F401
 
 RESIDUAL = ACCEPT  # max |g| / L at an accepted pose, as on the careful path
 # The next Newton step's largest entry (radians, or lengths / L), applied before stopping: the
@@ -224,7 +224,7 @@ def vm_step(kP, kN, kF, kL, kP5, nq, nu, max_evals, skip: bool = True) -> ca.Fun
     conv = converged(rs)
     q = ca.if_else(conv, q - dq, q)
     info = ca.vertcat(rs, mc, evals, conv)
-    near_next = ca.logic_or(evals == 0, mc[1] <= NEAR_TRY * thr[1])
+    near_next = ca.logic_or(evals == 0, mc[1] <= thr[1])
     miss = ca.if_else(five, missQ, mc[1])  # the cubic's error at this pose
     five_next = ca.logic_and(miss > QUINTIC_ON, miss <= QUINTIC_TRY) if kP5 is not None else 0 * near
     return ca.Function("kS", [q0, J0, T0, u0, T1, u1, q1, T2, u2, q2, near, five, u, p, L, thr, ud, udd, Lb],
@@ -246,7 +246,7 @@ def _expanded(f: ca.Function) -> ca.Function:
 # diagonal blocks, T = dq/du, u at the last pose, then T, u and q at the one before, then at
 # the one before that, then `near` (1: try kF at the prediction first) and `five` (1: predict
 # by kP5, else kP); matrices column-major; L the whole mechanism's length, for the singular
-# measures' column scale; NEAR_TRY, QUINTIC_ON, QUINTIC_TRY: kincas/core/tolerances.py) ---
+# measures' column scale; QUINTIC_ON, QUINTIC_TRY: kincas/core/tolerances.py) ---
 
 SWEEP_C = """
 #define KS_NEAR (NQ + NJ + 3*(NQ*NU + NU) + 2*NQ)
@@ -309,7 +309,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     info[k] = rf[0]; info[ld + k] = rf[1]; info[2*ld + k] = mc[0]; info[3*ld + k] = mc[1];
     info[4*ld + k] = (casadi_real) it;
     if (!(conv && mc[0] <= thr[2] && mc[1] <= thr[3])) break;
-    near = it == 0 || mc[1] <= NEAR_TRY * thr[1];
+    near = it == 0 || mc[1] <= thr[1];
     if (!five) miss = mc[1];  /* the cubic's error at this pose (kincas/core/prediction.py) */
     five = HAVE_KP5 && miss > QUINTIC_ON && miss <= QUINTIC_TRY;
     s[KS_NEAR] = near; s[KS_FIVE] = five;  /* kept with the state: a sweep in several calls is one */

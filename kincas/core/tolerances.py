@@ -78,10 +78,6 @@ QUINTIC_REACH = 2.0  # ... and the step predicted is at most this times the last
 # the quintic runs at a pose where the cubic's error at the last one (scaled) lay between these
 # (below, the cubic converges: a dense sweep; above, the quintic misses by more than STEP too)
 QUINTIC_ON, QUINTIC_TRY = 5e-14, 3e-10
-# The next pose tries kF at the prediction first (no kN) where the last pose's correction was
-# below this times STEP: the prediction of a smooth sweep is about as good from one pose to the
-# next (a pose that missed by a little is followed by one that may not)
-NEAR_TRY = 10.0
 PARAM_STEP = 0.05  # designs loop: largest parameter change per continuation step, relative to the size
 
 # --- assembly modes and starts ---
