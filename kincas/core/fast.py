@@ -4,7 +4,8 @@ The careful path (`kincas.solve`) spends about 70 us per pose in Python. Here on
 a whole stretch of a sweep: pose k is predicted from the last solved pose along the exact
 tangent, q_pred = q_prev + dq/du (u_k - u_prev) with dq/du = -g_q^-1 g_u, plus second- and
 third-order terms from the pose before and its tangent (the cubic through both poses with
-both tangents, kincas/core/kernel.py), then corrected by Newton,
+both tangents; where it pays, the quintic through three: kincas/core/prediction.py), then
+corrected by Newton,
 q <- q - g_q^-1 g, until the next step would be negligible (on a dense sweep the prediction
 usually is already). A pose is *accepted* only when it is verified in the same pass:
 
@@ -108,7 +109,7 @@ class FastSweeper(VirtualMachineSweep):
             self._group_of[np.asarray(b.cols, dtype=np.intp)] = i
         self._groups = self._group_of.tolist()
         self.nj = diagonal_size(self.blocks)  # g_q's diagonal blocks, all the state keeps of it
-        self.state_size = 3 * self.nq + self.nj + 3 * (self.nq * self.nu + self.nu) + 2  # (+ near, five)
+        self.state_size = sum(self.state_parts)
         self._functions, self._size, self._poses, self._calls = None, None, 0, 0  # swept so far
         self._lock = threading.RLock()
         self._local = threading.local()  # the virtual machine's buffers, one set per thread
@@ -162,6 +163,14 @@ class FastSweeper(VirtualMachineSweep):
         return {"NQ": self.nq, "NU": self.nu, "NO": len(self.report), "NM": len(self.blocks) + 1,
                 "NJ": self.nj, "QUINTIC_ON": repr(float(QUINTIC_ON)),
                 "QUINTIC_TRY": repr(float(QUINTIC_TRY)), "HAVE_KP5": int(self.functions[4] is not None)}
+
+    @property
+    def state_parts(self) -> tuple:
+        """The sizes of the kernel state's parts, in order (`state`; SWEEP_C's offsets):
+        q, J (g_q's diagonal blocks), T, u at the last pose, then T, u, q at the pose before
+        and at the one before that, then the flags near and five."""
+        nq, nu = self.nq, self.nu
+        return (nq, self.nj, nq * nu, nu, nq * nu, nu, nq, nq * nu, nu, nq, 1, 1)
 
     def state(self, q, u, p, out=None) -> np.ndarray:
         """(q, J, T = dq/du, u, T, u, q, T, u, q, near, five) at a solved pose, matrices

@@ -35,7 +35,7 @@ VM_CHUNKS = (1, 8, 32, 128, CHUNK)  # poses per call of the virtual machine's sw
 # 240), one flat SX pose, and chunks of VM_FLAT poses, the last one padded: CHUNK for a
 # stretch of at least 4 * CHUNK poses (fewer calls); a short sweep builds only 64 (3 ms).
 VM_SKIP = 2_000
-_ACC = 12  # the accumulated inputs and outputs of `vm_step`: the state's ten parts, `near`, `five`
+_ACC = 12  # the accumulated inputs and outputs of `vm_step`: the state's parts (`state_parts`, flags included)
 VM_FLAT = 64
 
 
@@ -69,21 +69,19 @@ class VirtualMachineSweep:
         if vms is None:
             vms = self._local.vm = {}
         if size not in vms:
-            nq, nu, no, nm = self.nq, self.nu, len(self.report), len(self.blocks) + 1
+            nu, no, nm = self.nu, len(self.report), len(self.blocks) + 1
             F = self._vm_function(size)
             buf, call = F.buffer()
-            scratch = [np.zeros((size, m)) for m in (nq, self.nj, nq * nu, nu, nq * nu, nu, nq, nq * nu, nu, nq,
-                                                     1, 1, 6, no, nm, nu, nu, nu)]
+            scratch = [np.zeros((size, m)) for m in (*self.state_parts, 6, no, nm, nu, nu, nu)]
             for i, a in enumerate(scratch[:_ACC + 3]):
                 buf.set_res(i, memoryview(a))
             vms[size] = (F, buf, call, scratch)  # buf holds raw pointers: keep it
         return vms[size]
 
     def _vm_advance(self, r: FastRun, start: int, stop: int, s: np.ndarray) -> int:
-        nq, nu = self.nq, self.nu
         # the state, its last entries `near` and `five` (the compiled loop's flags: try kF at
         # the prediction first; predict by the quintic)
-        parts = np.split(s.copy(), np.cumsum([nq, self.nj, nq * nu, nu, nq * nu, nu, nq, nq * nu, nu, nq, 1]))
+        parts = np.split(s.copy(), np.cumsum(self.state_parts[:-1]))
         k, sized = start, self.work > VM_SKIP
         flat = CHUNK if stop - start >= 4 * CHUNK else VM_FLAT
         while k < stop:  # a large kernel: the smallest chunk that holds what is left (padded

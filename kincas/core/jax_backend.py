@@ -194,8 +194,8 @@ class JaxDesigns:
         # a kernel written group by group (kincas/core/group_kernel.py) calls SX functions
         # from MX ones: inlined into one SX function each for the translation
         kP, kN, kF, kL = (to_jax(f.expand() if f.is_a("MXFunction") else f) for f in self.sweeper.functions[:4])
-        nq, nu, nj, max_evals = self.nq, self.nu, self.nj, self.sweeper.max_evals
-        cuts = np.cumsum([nq, nj, nq * nu, nu, nq * nu, nu, nq, nq * nu, nu, nq]).tolist()
+        max_evals = self.sweeper.max_evals
+        cuts = np.cumsum(self.sweeper.state_parts[:-2]).tolist()  # (the two flags: one part)
 
         def design(s0, p, L, signs0, U, Ud, Udd, thr):
             (Lb,) = kL(U[0], p)  # each group's length, at the first pose as the C loop has it

@@ -1,6 +1,6 @@
 """The fast sweep's kernel: casadi functions for one pose, and the C loop that drives them.
 
-Three functions, every linear solve done Assur group by Assur group (kincas/core/blocks.py),
+The functions, every linear solve done Assur group by Assur group (kincas/core/blocks.py),
 so their size grows with the number of groups, not with nq^3:
 
 - kP: the prediction from the last two solved poses (tangent, second- and third-order terms);
@@ -175,8 +175,10 @@ def vm_step(kP, kN, kF, kL, kP5, nq, nu, max_evals, skip: bool = True) -> ca.Fun
     ud, udd, T1, u1 = X.sym("ud", nu), X.sym("udd", nu), X.sym("T1", nq, nu), X.sym("u1", nu)
     q1, T2, u2, q2 = X.sym("q1", nq), X.sym("T2", nq, nu), X.sym("u2", nu), X.sym("q2", nq)
     # the C loop's choice of prediction (both evaluated here: the same numbers, chosen)
-    qQ, missQ = kP5(q0, T0, u0, u, T1, u1, q1, T2, u2, q2, Lb) if kP5 is not None else (q0, 0)
-    qp = ca.if_else(five, qQ, kP(q0, T0, u0, u, T1, u1, q1))
+    qp = kP(q0, T0, u0, u, T1, u1, q1)
+    if kP5 is not None:
+        qQ, missQ = kP5(q0, T0, u0, u, T1, u1, q1, T2, u2, q2, Lb)
+        qp = ca.if_else(five, qQ, qp)
     converged = lambda rs: ca.logic_and(rs[0] <= thr[0], rs[1] <= thr[1])
     if skip:
         Y = ca.MX if kN.is_a("MXFunction") else ca.SX
@@ -225,8 +227,11 @@ def vm_step(kP, kN, kF, kL, kP5, nq, nu, max_evals, skip: bool = True) -> ca.Fun
     q = ca.if_else(conv, q - dq, q)
     info = ca.vertcat(rs, mc, evals, conv)
     near_next = ca.logic_or(evals == 0, mc[1] <= thr[1])
-    miss = ca.if_else(five, missQ, mc[1])  # the cubic's error at this pose
-    five_next = ca.logic_and(miss > QUINTIC_ON, miss <= QUINTIC_TRY) if kP5 is not None else 0 * near
+    if kP5 is not None:
+        miss = ca.if_else(five, missQ, mc[1])  # the cubic's error at this pose
+        five_next = ca.logic_and(miss > QUINTIC_ON, miss <= QUINTIC_TRY)
+    else:
+        five_next = 0 * near
     return ca.Function("kS", [q0, J0, T0, u0, T1, u1, q1, T2, u2, q2, near, five, u, p, L, thr, ud, udd, Lb],
                        [q, J, T, u, T0, u0, q0, T1, u1, q1, near_next, five_next, info, y, meas])
 

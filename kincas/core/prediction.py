@@ -55,14 +55,21 @@ import casadi as ca
 from .tolerances import QUINTIC_REACH, QUINTIC_RATIO, STRAIGHT
 
 
+def _along(u0, u, u1):
+    """(du, dup, dd, safe, l): the step u - u0, the last step u0 - u1, its square |dup|^2,
+    that square or 1 where it is 0 (a first step), and l = du.dup / safe, the step in units
+    of the last along its line. Written without if_else: casadi would carry an if_else into
+    every unknown's expression that l multiplies."""
+    du, dup = u - u0, u0 - u1
+    dd = ca.dot(dup, dup)
+    safe = dd + (dd == 0)
+    return du, dup, dd, safe, ca.dot(du, dup) / safe
+
+
 def cubic(q0, T0, u0, u, T1, u1, q1):
     """The unknowns predicted at input u by the cubic through the last two poses (q_i,
     T_i = dq/du, u_i), newest first (see the module text); casadi expressions (SX or DM)."""
-    du, dup = u - u0, u0 - u1
-    # l = du.dup / dup.dup, 0 where dup = 0 (a first step), written without if_else: casadi
-    # would carry an if_else into every unknown's expression that l multiplies
-    dd = ca.dot(dup, dup)
-    lam = ca.dot(du, dup) / (dd + (dd == 0))
+    du, dup, _, _, lam = _along(u0, u, u1)
     # q0 + T0 du + l/2 (T0 - T1) du + c3 E with E = (T0 + T1) dup - 2 (q0 - q1), gathered
     # per tangent: the scalars once, then 7 operations an unknown (with nu = 1)
     c3 = lam * lam * (lam + 1.5)
@@ -76,15 +83,8 @@ def quintic(q0, T0, u0, u, T1, u1, q1, T2, u2, q2, scale=1):
     (see the module text), and max |p5 - p3| / scale, the cubic's error as the quintic sees
     it (0 where it does not apply). `scale`: each unknown's (1 for an angle, its group's
     length for a length). Casadi expressions (SX or DM)."""
-    du, dup = u - u0, u0 - u1
-    dd = ca.dot(dup, dup)
-    safe = dd + (dd == 0)
-    lam = ca.dot(du, dup) / safe  # (as in `cubic`)
-    # q0 + T0 du + l/2 (T0 - T1) du + c3 E with E = (T0 + T1) dup - 2 (q0 - q1), gathered
-    # per tangent: the scalars once, then 7 operations an unknown (with nu = 1)
-    c3 = lam * lam * (lam + 1.5)
-    v0, v1 = du * (1 + 0.5 * lam) + c3 * dup, c3 * dup - (0.5 * lam) * du
-    p3 = q0 + ca.mtimes(T0, v0) + ca.mtimes(T1, v1) - (2 * c3) * (q0 - q1)  # = cubic(...)
+    p3 = cubic(q0, T0, u0, u, T1, u1, q1)
+    _, dup, dd, safe, lam = _along(u0, u, u1)  # (the same expressions: casadi's cse shares them)
     # the third pose at t = -s on the line of the last step, s = 1 + (the step before) / (the last)
     back = u0 - u2
     s = ca.dot(back, dup) / safe
