@@ -2,7 +2,8 @@
 
 `Library` code-generates casadi functions together with a hand-written C driver that calls
 them, pairs each angle's sine and cosine into one call (`pair_sincos`), keeps max and min
-inline (`inline_minmax`), compiles the whole
+inline (`inline_minmax`), drops null-pointer tests that its driver makes needless
+(`trust_pointers`; these rewrites: kincas/core/c_source.py), compiles the whole
 with the C compiler ($CC, else gcc or cc) and keeps the result in the cache directory
 (`cache_dir`) under a hash of its source, the compiler, its flags and casadi's version: a
 second process, or a second run, loads it without compiling. The cache keeps the MAX_CACHED
@@ -26,6 +27,7 @@ import threading
 import time
 from pathlib import Path
 
+from .c_source import _PRELUDE, inline_minmax, pair_sincos, trust_pointers  # noqa: F401 (pair_sincos, inline_minmax: their old home)
 from .caches import Memo
 from .cancel import WAIT, checkpoint
 
@@ -72,13 +74,16 @@ class Library:
 
     `defines` become C macros ahead of the driver (SZ_ARG, SZ_RES, SZ_IW, SZ_W, the largest
     work sizes of the functions, are added); `signatures` gives the ctypes argument types of
-    the driver's entry points (each returns an int). `cached` says whether it was found
+    the driver's entry points (each returns an int). `trusted`: the driver passes a pointer
+    for every input and output (with entries) of every function it calls, so the functions
+    are compiled without casadi's null-pointer tests where no call of theirs needs them
+    (kincas/core/c_source.py `trust_pointers`). `cached` says whether it was found
     built; `times` the seconds spent generating, compiling and loading. `load()` raises on
     any failure.
     """
 
     def __init__(self, tag: str, functions: list[ca.Function], driver: str, defines: dict,
-                 signatures: dict[str, list]):
+                 signatures: dict[str, list], trusted: bool = False):
         t0 = time.perf_counter()
         cg = ca.CodeGenerator(f"{tag}.c", {"with_header": False})
         for f in functions:
@@ -86,7 +91,8 @@ class Library:
         work = {"SZ_ARG": [f.sz_arg() for f in functions], "SZ_RES": [f.sz_res() for f in functions],
                 "SZ_IW": [f.sz_iw() for f in functions], "SZ_W": [f.sz_w() for f in functions]}
         defines = {**{k: max([1, *v]) for k, v in work.items()}, **defines}
-        self.source = (_PRELUDE + inline_minmax(pair_sincos(cg.dump()))
+        code = inline_minmax(pair_sincos(cg.dump()))
+        self.source = (_PRELUDE + (trust_pointers(code) if trusted else code)
                        + "".join(f"#define {k} {v}\n" for k, v in defines.items()) + driver)
         self.cc = os.environ.get("CC") or shutil.which("gcc") or shutil.which("cc")
         key = hashlib.sha256("\n".join([self.source, str(self.cc), *_FLAGS, ca.__version__]).encode())
@@ -252,69 +258,6 @@ class _file_lock:
         if fcntl is not None:
             fcntl.flock(self.fd, fcntl.LOCK_UN)
         os.close(self.fd)
-
-
-# --- sine and cosine of an angle in one call ---
-
-_PRELUDE = """#define _GNU_SOURCE
-#include <math.h>
-#ifdef __GLIBC__
-#define kincas_sincos(x, s, c) sincos(x, s, c)
-#else
-#define kincas_sincos(x, s, c) (*(s) = sin(x), *(c) = cos(x))
-#endif
-/* C99's fmax and fmin (a NaN argument gives the other one), written out so that they stay
-   inline: libm's are calls, and every call spills the live registers */
-static inline double kincas_fmax(double x, double y) { return x != x ? y : y != y ? x : x > y ? x : y; }
-static inline double kincas_fmin(double x, double y) { return x != x ? y : y != y ? x : x < y ? x : y; }
-"""
-_TRIG = re.compile(r"^(\s*)(a\w+)=(sin|cos)\((a\w+)\);$")
-
-
-def pair_sincos(source: str) -> str:
-    r"""Casadi's generated `x=sin(a); ... y=cos(a);` as one sincos call (glibc's, which gives
-    the same values): each angle's sine and cosine cost one call. Most of a sweep's time is
-    this trigonometry, and once the casadi functions are inlined into the C loop the
-    compiler stops pairing them itself. A pair is joined only within one block and while
-    `a` is not reassigned between; anything else is left as it is.
-
-    >>> print(pair_sincos("  a1=sin(a0);\n  a2=(a1*a0);\n  a3=cos(a0);"))
-      casadi_real kt0; kincas_sincos(a0, &a1, &kt0);
-      a2=(a1*a0);
-      a3=kt0;
-    """
-    lines, n = source.split("\n"), 0
-    for i, line in enumerate(lines):
-        m = _TRIG.match(line)
-        if not m or m[2] == m[4]:  # x=sin(x): the angle is overwritten here
-            continue
-        indent, target, f, a = m.groups()
-        for j in range(i + 1, len(lines)):
-            mj = _TRIG.match(lines[j])
-            if mj and mj[4] == a and mj[3] != f:
-                s, c = (target, f"kt{n}") if f == "sin" else (f"kt{n}", target)
-                lines[i] = f"{indent}casadi_real kt{n}; kincas_sincos({a}, &{s}, &{c});"
-                lines[j] = f"{mj[1]}{mj[2]}=kt{n};"
-                n += 1
-                break
-            if "{" in lines[j] or "}" in lines[j] or re.match(rf"^\s*{a}=", lines[j]):
-                break
-    return "\n".join(lines)
-
-
-def inline_minmax(source: str) -> str:
-    """Casadi's `casadi_fmax` and `casadi_fmin` helpers calling the prelude's inline
-    `kincas_fmax` / `kincas_fmin` instead of libm's `fmax` / `fmin`: the same values (C99's
-    rule: a NaN argument gives the other one; only the sign of a zero maximum may differ,
-    and every comparison treats -0 as 0), without a library call per maximum. The kernel's
-    residual and step tests take a maximum per equation and unknown: as calls they cost a
-    fifth of a chained mechanism's pose (the call clobbers every floating-point register).
-
-    >>> inline_minmax("  return fmax(x, y);")
-    '  return kincas_fmax(x, y);'
-    """
-    return source.replace("return fmax(x, y);", "return kincas_fmax(x, y);").replace(
-        "return fmin(x, y);", "return kincas_fmin(x, y);")
 
 
 def _prune(folder: Path) -> None:

@@ -195,7 +195,7 @@ class QuantityEvaluator:
 
     def _library(self) -> Library:
         return Library("kincas_quantities", [self.f], _QUANT_C, {"NQ": self.nq, "NO": self.no},
-                       {"kincas_quantities": [_I, _V, _V, _I, _V, _V, _I, _V, _I, _V, _I]})
+                       {"kincas_quantities": [_I, _V, _V, _I, _V, _V, _I, _V, _I, _V, _I]}, trusted=True)
 
     def evaluate(self, Q, U, p, Ud=None, Udd=None, ok=None) -> np.ndarray:
         """(len(names), N) values at the poses (Q (N, nq), U (N, nu) tables; rates Ud and

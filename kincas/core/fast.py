@@ -156,7 +156,7 @@ class FastSweeper(VirtualMachineSweep):
 
     def _library(self) -> Library:
         return Library("kincas_sweep", self.compiled_functions, SWEEP_C, self.sweep_macros(),
-                       {"kincas_sweep": SWEEP_SIG})
+                       {"kincas_sweep": SWEEP_SIG}, trusted=True)
 
     def sweep_macros(self) -> dict:
         """The sizes SWEEP_C is compiled with (kincas/core/kernel.py)."""

@@ -1,0 +1,175 @@
+"""Rewrites of casadi's generated C that keep every value and cost fewer instructions.
+
+casadi writes each function so that any caller may pass a null pointer for an input (read as
+zeros) or an output (not wanted): every element read is `arg[i]? arg[i][k] : 0` and every
+element written `if (res[i]!=0) res[i][k]=...`, a test and a branch per number. kincas's C
+loops (kincas/core/kernel.py, designs_kernel.py, compiled.py) pass a pointer for every input
+and output; casadi's own calls between its functions pass null only where the call site says
+so. `trust_pointers` drops the tests that no call can need (on 40 chained four-bars, 7 % of
+a pose's instructions). The other two rewrites: each angle's sine and cosine in one call
+(`pair_sincos`), max and min inline (`inline_minmax`).
+
+>>> src = '''/* f:(i0,i1)->(o0) */
+... static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+...   a0=arg[0]? arg[0][0] : 0;
+...   if (res[0]!=0) res[0][0]=a0;
+...   return 0;
+... }'''
+>>> print(trust_pointers(src).splitlines()[2:4])
+['  a0=arg[0][0];', '  res[0][0]=a0;']
+"""
+from __future__ import annotations
+
+import re
+
+_PRELUDE = """#define _GNU_SOURCE
+#include <math.h>
+#ifdef __GLIBC__
+#define kincas_sincos(x, s, c) sincos(x, s, c)
+#else
+#define kincas_sincos(x, s, c) (*(s) = sin(x), *(c) = cos(x))
+#endif
+/* C99's fmax and fmin (a NaN argument gives the other one), written out so that they stay
+   inline: libm's are calls, and every call spills the live registers */
+static inline double kincas_fmax(double x, double y) { return x != x ? y : y != y ? x : x > y ? x : y; }
+static inline double kincas_fmin(double x, double y) { return x != x ? y : y != y ? x : x < y ? x : y; }
+"""
+_TRIG = re.compile(r"^(\s*)(a\w+)=(sin|cos)\((a\w+)\);$")
+
+
+def pair_sincos(source: str) -> str:
+    r"""Casadi's generated `x=sin(a); ... y=cos(a);` as one sincos call (glibc's, which gives
+    the same values): each angle's sine and cosine cost one call. Most of a sweep's time is
+    this trigonometry, and once the casadi functions are inlined into the C loop the
+    compiler stops pairing them itself. A pair is joined only within one block and while
+    `a` is not reassigned between; anything else is left as it is.
+
+    >>> print(pair_sincos("  a1=sin(a0);\n  a2=(a1*a0);\n  a3=cos(a0);"))
+      casadi_real kt0; kincas_sincos(a0, &a1, &kt0);
+      a2=(a1*a0);
+      a3=kt0;
+    """
+    lines, n = source.split("\n"), 0
+    for i, line in enumerate(lines):
+        m = _TRIG.match(line)
+        if not m or m[2] == m[4]:  # x=sin(x): the angle is overwritten here
+            continue
+        indent, target, f, a = m.groups()
+        for j in range(i + 1, len(lines)):
+            mj = _TRIG.match(lines[j])
+            if mj and mj[4] == a and mj[3] != f:
+                s, c = (target, f"kt{n}") if f == "sin" else (f"kt{n}", target)
+                lines[i] = f"{indent}casadi_real kt{n}; kincas_sincos({a}, &{s}, &{c});"
+                lines[j] = f"{mj[1]}{mj[2]}=kt{n};"
+                n += 1
+                break
+            if "{" in lines[j] or "}" in lines[j] or re.match(rf"^\s*{a}=", lines[j]):
+                break
+    return "\n".join(lines)
+
+
+def inline_minmax(source: str) -> str:
+    """Casadi's `casadi_fmax` and `casadi_fmin` helpers calling the prelude's inline
+    `kincas_fmax` / `kincas_fmin` instead of libm's `fmax` / `fmin`: the same values (C99's
+    rule: a NaN argument gives the other one; only the sign of a zero maximum may differ,
+    and every comparison treats -0 as 0), without a library call per maximum. The kernel's
+    residual and step tests take a maximum per equation and unknown: as calls they cost a
+    fifth of a chained mechanism's pose (the call clobbers every floating-point register).
+
+    >>> inline_minmax("  return fmax(x, y);")
+    '  return kincas_fmax(x, y);'
+    """
+    return source.replace("return fmax(x, y);", "return kincas_fmax(x, y);").replace(
+        "return fmin(x, y);", "return kincas_fmin(x, y);")
+
+
+
+
+# --- pointers that no call leaves null ---
+
+_DEF = re.compile(r"^static int (casadi_f\d+)\(const casadi_real\*\* arg, casadi_real\*\* res, ")
+_SIG = re.compile(r"^/\* [\w]+:\((.*)\)->\((.*)\) \*/$")
+_SET = re.compile(r"^\s*(arg1|res1)\[(\d+)\]=([^;]*);$")
+_WR = re.compile(r"^\s*(wr\d+) = (.*);$")
+# what casadi passes for an input or output with entries: its work vectors, a scalar's address,
+# an input read through `wr = arg[i] ? arg[i] : casadi_zeros` (or an offset of one)
+_SAFE = re.compile(r"w\d+|\(&w\d+\)|casadi_c\d+")
+_SAFE_WR = re.compile(r"arg\[(\d+)\] \? arg\[\1\] : casadi_zeros|(wr\d+)\+\d+")
+_CALL = re.compile(r"\b(casadi_f\d+)\(")
+_LOAD = re.compile(r"arg\[(\d+)\]\? arg\[\1\]\[(\d+)\] : 0")
+_STORE = re.compile(r"if \(res\[(\d+)\]!=0\) (res\[\1\]\[\d+\]=)")
+_ALL = None  # a call not understood: every pointer of the callee may be null
+
+
+def _count(items: str) -> int:
+    """The number of inputs (or outputs) in a casadi signature's list `i0[8],i1,i2[0]`."""
+    return len(re.findall(r"\b[io]\d+\b", items))
+
+
+def trust_pointers(source: str) -> str:
+    """casadi's generated C without the null-pointer tests that no call can need, for a
+    library whose C loop passes a pointer for every input and output of the functions it
+    calls (each exported function): an input (output) of an internal function keeps its tests
+    where one of its call sites passes null (0) for it, an argument of its caller (which
+    may be null), or anything this reading does not recognise; a call written in any other
+    way keeps all of the callee's tests. Values are unchanged: only `arg[i]? arg[i][k] : 0`
+    becomes `arg[i][k]` and `if (res[i]!=0) res[i][k]=...` becomes `res[i][k]=...`."""
+    lines = source.split("\n")
+    bodies, sizes, i = {}, {}, 0
+    while i < len(lines):
+        m = _DEF.match(lines[i])
+        if m:
+            sig = _SIG.match(lines[i - 1]) if i else None
+            j = i + 1
+            while j < len(lines) and lines[j] != "}":
+                j += 1
+            bodies[m[1]], sizes[m[1]] = (i, j), ((_count(sig[1]), _count(sig[2])) if sig else None)
+            i = j
+        i += 1
+    nulls = {name: (set(), set()) for name in bodies}  # per function, inputs and outputs that may be null
+
+    def spoil(name):
+        nulls[name] = _ALL
+
+    inside = set()
+    for name, (a, b) in bodies.items():
+        inside.update(range(a, b + 1))
+        safe_wr, given = set(), {"arg1": {}, "res1": {}}
+        for line in lines[a + 1:b]:
+            m = _WR.match(line)
+            if m:
+                w = _SAFE_WR.fullmatch(m[2])
+                (safe_wr.add if w and (w[2] is None or w[2] in safe_wr) else safe_wr.discard)(m[1])
+                continue
+            m = _SET.match(line)
+            if m:
+                given[m[1]][int(m[2])] = m[3].strip()
+                continue
+            for c in _CALL.finditer(line):
+                callee = c[1]
+                if callee not in nulls or nulls[callee] is _ALL:
+                    continue
+                if line.strip() != f"if ({callee}(arg1, res1, iw, w, 0)) return 1;" or sizes[callee] is None:
+                    spoil(callee)
+                    continue
+                for kind, n, bad in (("arg1", sizes[callee][0], nulls[callee][0]),
+                                     ("res1", sizes[callee][1], nulls[callee][1])):
+                    for k in range(n):
+                        e = given[kind].get(k)
+                        if e is None or not (_SAFE.fullmatch(e) or e in safe_wr):
+                            bad.add(k)
+            if _CALL.search(line):
+                given = {"arg1": {}, "res1": {}}  # each call's pointers are set anew before it
+    for i, line in enumerate(lines):  # calls outside any body: the exported functions' own
+        if i not in inside:
+            for c in _CALL.finditer(line):
+                if c[1] in nulls and line.strip() != f"return {c[1]}(arg, res, iw, w, mem);":
+                    spoil(c[1])
+    for name, (a, b) in bodies.items():
+        if nulls[name] is _ALL:
+            continue
+        bad_in, bad_out = nulls[name]
+        for i in range(a + 1, b):
+            lines[i] = _LOAD.sub(lambda m: m[0] if int(m[1]) in bad_in else f"arg[{m[1]}][{m[2]}]", lines[i])
+            lines[i] = _STORE.sub(lambda m: m[0] if int(m[1]) in bad_out else m[2], lines[i])
+    return "\n".join(lines)
