@@ -4,10 +4,12 @@ accepted with no Newton step before it where kF's next step is negligible (the s
 any pose); else Newton goes on from the prediction as before. The compiled loop and both
 forms of the virtual machine take the same decisions (the same unknowns, the same step
 counts), and the answers are the closed forms'."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from kincas import Input, Link, Mechanism
+from kincas import Input, Link, Mechanism, Slide
 from kincas.core.fast import FastSweeper
 
 from test_fast import check_residuals, first_pose, fourbar, fourbar_closed
@@ -99,3 +101,48 @@ def test_predictions_near_step_switch_between_both_ways_alike(monkeypatch, quint
         scale = L * (10.0 if ".v" in name else 1.0)
         assert np.abs(run.values[i, 1:] - cf[name][1:]).max() <= 1e-12 * scale, name
     check_residuals(model, run, p, L, tol=1e-13)
+
+
+def two_inputs():
+    """A four-bar and a slider-crank side by side, each driven by its own crank."""
+    return Mechanism(ground={"A": (0, 0), "D": (4, 0), "E": (0, 5)},
+                     links=[Link.bar("crank", "A", "B", 1.0), Link.bar("coupler", "B", "C", 3.5),
+                            Link.bar("rocker", "D", "C", 3.0), Link.bar("crank2", "E", "F", 1.0),
+                            Link.bar("rod", "F", "S", 3.0)],
+                     slides=[Slide("S", "ground", through=(0, 5), angle=0.0, name="guide")],
+                     inputs=[Input.angle("crank"), Input.angle("crank2")],
+                     guess={"C": (3.6, 2.9), "S": (3.5, 5.0)})
+
+
+@pytest.mark.parametrize("case", ["two inputs", "cam"])
+def test_predictions_of_the_c_loop_are_the_virtual_machines(monkeypatch, case):
+    # The C loop forms the predictions itself from kW's scalars (kincas/core/kernel.py); the
+    # virtual machine evaluates kP and kP5 (kincas/core/prediction.py). Both sum in one order,
+    # so the unknowns are the same bit for bit: with two inputs (the sums over them), with
+    # lengths among the unknowns (a cam's follower: the quintic's error scaled by its group's
+    # length), and the quintic at every pose where it applies (forced on: QUINTIC_ON 0,
+    # QUINTIC_TRY 1).
+    for mod in ("kincas.core.kernel", "kincas.core.fast"):
+        monkeypatch.setattr(f"{mod}.QUINTIC_UNKNOWNS", 1, raising=False)
+        monkeypatch.setattr(f"{mod}.QUINTIC_ON", 0.0)
+        monkeypatch.setattr(f"{mod}.QUINTIC_TRY", 1.0)
+    t = np.linspace(0.0, 2.0, 301)
+    if case == "cam":
+        from kincas.cli import scene
+        sc = scene.load(Path(__file__).parents[1] / "examples" / "eccentric_cam.toml")
+        m, report, U, Ud = sc.mechanism, list(sc.study.report), t[:, None], [3.0]
+    else:
+        m, report = two_inputs(), ["C.x", "S.x", "S.vx", "C.vy"]
+        U, Ud = np.column_stack([0.3 + t, 1.0 + 0.5 * t]), [3.0, -2.0]
+    model, p, L, out = runs(m, report, U, Ud, monkeypatch)
+    assert model.sym.nu == 2 if case == "two inputs" else model.sym.is_length.any()
+    a = out["compiled"]
+    for b in out.values():
+        assert a.first_bad == b.first_bad == len(U)
+        assert np.array_equal(a.Q[1:], b.Q[1:]) and np.array_equal(a.iterations, b.iterations)
+        assert np.array_equal(a.values[:, 1:], b.values[:, 1:])
+    assert (a.iterations[3:] == 0).any()  # predictions accepted as they are
+    check_residuals(model, a, p, L)
+    if case == "two inputs":  # and the closed form: S.x = cos t2 + sqrt(9 - sin^2 t2)
+        sx = np.cos(U[:, 1]) + np.sqrt(9 - np.sin(U[:, 1]) ** 2)
+        assert np.abs(a.values[1, 1:] - sx[1:]).max() <= 1e-12 * L

@@ -120,7 +120,7 @@ class FastSweeper(VirtualMachineSweep):
         """The kernel's C code size in casadi instructions (what compiling costs: a
         function shared by several Assur groups counts once, kincas/core/group_kernel.py)."""
         if self._size is None:
-            code, self._work = kernel_sizes(self.compiled_functions)
+            code, self._work = kernel_sizes([f for f in self.functions[:5] if f is not None])
             self._size = code  # set last: another thread reads _work once it sees _size
         return self._size
 
@@ -140,7 +140,7 @@ class FastSweeper(VirtualMachineSweep):
 
     @property
     def functions(self) -> list[ca.Function]:
-        """kP, kN, kF, kL, kP5 (kincas/core/kernel.py), built when first needed, once per model
+        """kP, kN, kF, kL, kP5, kW (kincas/core/kernel.py), built when first needed, once per model
         and report: the sweepers of one kernel with different `compile` settings share them,
         so they generate the same C code (the same library)."""
         if self._functions is None:
@@ -151,8 +151,10 @@ class FastSweeper(VirtualMachineSweep):
 
     @property
     def compiled_functions(self) -> list[ca.Function]:
-        """The kernel's functions that its C code holds (kP5 only where there is one)."""
-        return [f for f in self.functions if f is not None]
+        """The kernel's functions that its C code holds: kN, kF, kL and kW (the C loop forms
+        the predictions of kP and kP5 itself from kW's scalars, kincas/core/kernel.py)."""
+        kP, kN, kF, kL, kP5, kW = self.functions
+        return [kN, kF, kL, kW]
 
     def _library(self) -> Library:
         return Library("kincas_sweep", self.compiled_functions, SWEEP_C, self.sweep_macros(),
@@ -162,7 +164,9 @@ class FastSweeper(VirtualMachineSweep):
         """The sizes SWEEP_C is compiled with (kincas/core/kernel.py)."""
         return {"NQ": self.nq, "NU": self.nu, "NO": len(self.report), "NM": len(self.blocks) + 1,
                 "NJ": self.nj, "QUINTIC_ON": repr(float(QUINTIC_ON)),
-                "QUINTIC_TRY": repr(float(QUINTIC_TRY)), "HAVE_KP5": int(self.functions[4] is not None)}
+                "QUINTIC_TRY": repr(float(QUINTIC_TRY)), "HAVE_KP5": int(self.functions[4] is not None),
+                "KS_LENGTHS_ANY": int(bool(np.any(self.sym.is_length))), "KS_LENGTHS": "{" + ", ".join(str(g if length else -1) for g, length in
+                                              zip(self._groups, self.sym.is_length)) + "}" if self.nq else "{0}"}
 
     @property
     def state_parts(self) -> tuple:

@@ -50,7 +50,7 @@ class VirtualMachineSweep:
                 self._vmF = {}
             if size not in self._vmF:
                 nu = self.nu
-                kS = getattr(self, "_kS", None) or vm_step(*self.functions, self.nq, nu, self.max_evals,
+                kS = getattr(self, "_kS", None) or vm_step(*self.functions[:5], self.nq, nu, self.max_evals,
                                                            skip=self.work > VM_SKIP)
                 self._kS = kS
                 acc = kS.mapaccum("acc", size, list(range(_ACC)), list(range(_ACC)), {})

@@ -5,6 +5,8 @@ so their size grows with the number of groups, not with nq^3:
 
 - kP: the prediction from the last two solved poses (tangent, second- and third-order terms);
   kP5: from the last three, of fifth order, run while it pays (kincas/core/prediction.py);
+  both evaluated by the virtual machine; the C loop forms the same numbers from kW, their
+  scalars, in a loop over the unknowns of its own (the same operations in the same order);
 - kN: at q, the Newton step g_q^-1 g (Gauss-Newton's (g_q'g_q)^-1 g_q' g for a tall group:
   redundant joints, kincas/core/blocks.py) and the measures that stop Newton (max |g| / L and the
   step's size in radians or lengths / L, each equation and unknown against its own Assur
@@ -30,7 +32,7 @@ from __future__ import annotations
 
 import casadi as ca
 
-from .prediction import cubic, quintic
+from .prediction import cubic, cubic_weights, quintic, quintic_weights
 from .group_kernel import GroupFunctions, _max_abs, group_correction, group_scales
 from .structure import Structure
 from ..model.names import parse_quantity
@@ -55,8 +57,9 @@ GROUP_RUN = 4  # consecutive groups per function written group by group (measure
 # From this many unknowns on, the kernel has the quintic prediction kP5 (kincas/core/
 # prediction.py): where it lets a pose skip its Newton step, it saves a kN (40 chained
 # four-bars, 360 poses over 60 deg: 41k -> 26k instructions a pose). On a small kernel the
-# step costs little and compiling kP5 costs much: gcc took 0.27 -> 0.37 s of CPU for a
-# four-bar's kernel, which a user's first sweeps wait for in the virtual machine.
+# step costs little and the quintic's scalars (kW) cost a four-bar's pose ~150 instructions
+# (its cubic, ~30); written as casadi code the quintic also cost compiling (gcc 0.27 -> 0.37
+# s of CPU for a four-bar's kernel, which a user's first sweeps wait for).
 QUINTIC_UNKNOWNS = 16
 
 
@@ -64,8 +67,10 @@ QUINTIC_UNKNOWNS = 16
 
 
 def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> list[ca.Function]:
-    """[kP, kN, kF, kL, kP5] (see the module text), outputs dense so that C can index them;
-    kP5 None below QUINTIC_UNKNOWNS unknowns.
+    """[kP, kN, kF, kL, kP5, kW] (see the module text), outputs dense so that C can index
+    them; kP5 None below QUINTIC_UNKNOWNS unknowns; kW the scalars of both predictions
+    (v0, v1, c of `cubic_weights`, then use, w1, w2, e0, e1, e2 of `quintic_weights`), for the
+    C loop, which forms the predictions from them (kP and kP5 are the virtual machine's).
     `structure` (the `Structure` whose blocks these are, built from `sym` if not given)
     gives the groups' lengths.
 
@@ -100,11 +105,18 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
     kP5 = ca.Function("kP5", [q, T0, u0, u, T1, u1, q1, T2, u2, q2, Lb],
                       [d(v) for v in quintic(q, T0, u0, u, T1, u1, q1, T2, u2, q2, D)], o) \
         if nq >= QUINTIC_UNKNOWNS else None
+    # kW: the predictions' scalars, from which the C loop forms kP's (and kP5's) numbers
+    # unknown by unknown in a loop of its own (the same operations in the same order:
+    # prediction.py `cubic`, `quintic`) that the compiler vectorises, where casadi's code
+    # for kP5 takes ~40 instructions an unknown (40 chained four-bars: 3k of 25k a pose);
+    # the quintic's scalars only where kP5 is (they cost a four-bar more than its cubic)
+    kW = ca.Function("kW", [u0, u, u1, u2], [d(ca.vertcat(*cubic_weights(u0, u, u1), *(
+        quintic_weights(u0, u, u1, u2) if kP5 is not None else ())))], o)
     if not is_tall(blocks) and (grouped or (grouped is None and len(blocks) >= GROUPS_APART)):
         # one small function per kind of group, the quantities apart
         qd = ca.SX.sym("qd", nq)
         kY = ca.Function("kY", [q, u, p, ud, udd, qd], [ca.densify(given((q, u, p, ud, udd), qd))], o) if report else None
-        return [kP, *GroupFunctions(sym, blocks, GROUP_RUN).kernel(kY), kL, kP5]
+        return [kP, *GroupFunctions(sym, blocks, GROUP_RUN).kernel(kY), kL, kP5, kW]
     cs = ca.if_else(is_length, 1, reciprocal(L))  # g_q's columns to O(1): 1 (lengths), 1/L (angles)
     g, Jq, Ju = ca.Function("G", [sym.q, sym.u, sym.p], [sym.g, sym.Jq, sym.Ju])(q, u, p)
     step = solve(Jq, g)
@@ -119,7 +131,7 @@ def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> li
                       ca.vertcat(signs, sigma), y, d(step), *((Jq, D) if tall else ())], o)
     if tall:
         kF = _exact_where_needed(kF, blocks)
-    return [kP, ca.Function("kN", [q, u, p, Lb], [d(step), rs], o), kF, kL, kP5]
+    return [kP, ca.Function("kN", [q, u, p, Lb], [d(step), rs], o), kF, kL, kP5, kW]
 
 
 def _exact_where_needed(kF, blocks) -> ca.Function:
@@ -254,6 +266,7 @@ def _expanded(f: ca.Function) -> ca.Function:
 # measures' column scale; QUINTIC_ON, QUINTIC_TRY: kincas/core/tolerances.py) ---
 
 SWEEP_C = """
+static const int KS_LENGTH_OF[NQ > 0 ? NQ : 1] = KS_LENGTHS;  /* unknown i: -1 an angle, else its group (Lb) */
 #define KS_NEAR (NQ + NJ + 3*(NQ*NU + NU) + 2*NQ)
 #define KS_FIVE (KS_NEAR + 1)
 int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const casadi_real* L,
@@ -262,8 +275,9 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
                  const casadi_real* Udd, casadi_int sudd, casadi_real* vals, casadi_real* meas) {
   const casadi_real* arg[SZ_ARG]; casadi_real* res[SZ_RES]; casadi_int iw[SZ_IW]; casadi_real w[SZ_W];
   casadi_real qp[NQ], q[NQ], dq[NQ], miss = 0, J[NJ > 0 ? NJ : 1], T[NQ*NU], rs[2], rf[2], mc[2], ms[NM], y[NO > 0 ? NO : 1];
+  casadi_real W[5*NU + 4];  /* the predictions' scalars (kW) */
   casadi_real Lb[NM > 1 ? NM - 1 : 1];  /* each group's length, from the parameters */
-  casadi_int k, i, it;
+  casadi_int k, i, j, it;
   int near = s[KS_NEAR] != 0;  /* the last pose was predicted well: try kF at the prediction first */
   int five = s[KS_FIVE] != 0;  /* predict by the quintic (kP5), else the cubic (kP) */
   if (n > 0) {
@@ -273,15 +287,51 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
   for (k = 0; k < n; ++k) {
     const casadi_real* u = U + k*NU;
     int conv = 0;
-    arg[0] = s; arg[1] = s + NQ + NJ; arg[2] = s + NQ + NJ + NQ*NU; arg[3] = u;
-    arg[4] = s + NQ + NJ + NQ*NU + NU; arg[5] = s + NQ + NJ + 2*NQ*NU + NU;
-    arg[6] = s + NQ + NJ + 2*(NQ*NU + NU); res[0] = qp;
-#if HAVE_KP5  /* (arg and res hold as many pointers as the largest function takes: kP5's 11) */
-    arg[7] = arg[6] + NQ; arg[8] = arg[7] + NQ*NU; arg[9] = arg[8] + NU; arg[10] = Lb; res[1] = &miss;
-    if (five ? kP5(arg, res, iw, w, 0) : kP(arg, res, iw, w, 0)) break;
-#else
-    if (kP(arg, res, iw, w, 0)) break;
-#endif
+    /* the prediction (kincas/core/prediction.py `cubic`, `quintic`): its scalars by kW, then
+       each unknown by the same operations in the same order as kP and kP5 */
+    arg[0] = s + NQ + NJ + NQ*NU; arg[1] = u; arg[2] = s + NQ + NJ + 2*NQ*NU + NU;
+    arg[3] = s + NQ + NJ + 3*NQ*NU + 2*NU + NQ; res[0] = W;
+    if (kW(arg, res, iw, w, 0)) break;
+    {
+      const casadi_real *q0 = s, *T0 = s + NQ + NJ, *T1 = T0 + NQ*NU + NU, *q1 = T1 + NQ*NU + NU;
+      const casadi_real *T2 = q1 + NQ, *q2 = T2 + NQ*NU + NU;
+      const casadi_real *v0 = W, *v1 = W + NU, c = W[2*NU], *e0 = W + 2*NU + 4, *e1 = e0 + NU, *e2 = e1 + NU;
+      miss = 0;
+      if (HAVE_KP5 && five && W[2*NU + 1] != 0) {  /* the quintic applies: cubic and correction */
+        const casadi_real w1 = W[2*NU + 2], w2 = W[2*NU + 3];
+        casadi_real m0 = 0, m1 = 0, m2 = 0, m3 = 0;
+        for (i = 0; i < NQ; ++i) {  /* (no branch, no reduction: the compiler vectorises it) */
+          casadi_real t0 = T0[i]*v0[0], t1 = T1[i]*v1[0], e = T0[i]*e0[0], f = T1[i]*e1[0], g = T2[i]*e2[0];
+          for (j = 1; j < NU; ++j) {
+            t0 = t0 + T0[i + j*NQ]*v0[j]; t1 = t1 + T1[i + j*NQ]*v1[j];
+            e = e + T0[i + j*NQ]*e0[j]; f = f + T1[i + j*NQ]*e1[j]; g = g + T2[i + j*NQ]*e2[j];
+          }
+          dq[i] = (((w1*(q1[i] - q0[i]) + w2*(q2[i] - q0[i])) + e) + f) + g;
+          qp[i] = (((q0[i] + t0) + t1) - c*(q0[i] - q1[i])) + dq[i];
+        }
+        /* the cubic's error as the quintic sees it, max |p5 - p3| / scale: kP5's miss (NaNs
+           skipped as its fmax skips them; where all are NaN, 0 here and NaN there: either way
+           not above QUINTIC_ON, its one use), in four running maxima (one chain of compares
+           would wait on each) */
+        for (i = 0; i < NQ; ++i) {
+          casadi_real a = fabs(dq[i]);
+          if (KS_LENGTHS_ANY && KS_LENGTH_OF[i] >= 0) a = a / Lb[KS_LENGTH_OF[i]];
+          dq[i] = a;
+        }
+        for (i = 0; i + 3 < NQ; i += 4) {
+          m0 = dq[i] > m0 ? dq[i] : m0; m1 = dq[i + 1] > m1 ? dq[i + 1] : m1;
+          m2 = dq[i + 2] > m2 ? dq[i + 2] : m2; m3 = dq[i + 3] > m3 ? dq[i + 3] : m3;
+        }
+        for (; i < NQ; ++i) m0 = dq[i] > m0 ? dq[i] : m0;
+        m0 = m1 > m0 ? m1 : m0; m2 = m3 > m2 ? m3 : m2; miss = m2 > m0 ? m2 : m0;
+      } else {
+        for (i = 0; i < NQ; ++i) {
+          casadi_real t0 = T0[i]*v0[0], t1 = T1[i]*v1[0];
+          for (j = 1; j < NU; ++j) { t0 = t0 + T0[i + j*NQ]*v0[j]; t1 = t1 + T1[i + j*NQ]*v1[j]; }
+          qp[i] = ((q0[i] + t0) + t1) - c*(q0[i] - q1[i]);
+        }
+      }
+    }
     for (i = 0; i < NQ; ++i) q[i] = qp[i];
     if (near) {  /* kF at the prediction first: where its (next) step is negligible, no kN */
       arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = L; arg[4] = Ud + k*sud; arg[5] = Udd + k*sudd;

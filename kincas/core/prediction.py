@@ -66,25 +66,30 @@ def _along(u0, u, u1):
     return du, dup, dd, safe, ca.dot(du, dup) / safe
 
 
-def cubic(q0, T0, u0, u, T1, u1, q1):
-    """The unknowns predicted at input u by the cubic through the last two poses (q_i,
-    T_i = dq/du, u_i), newest first (see the module text); casadi expressions (SX or DM)."""
+def _times(T, v):
+    """T v (T an nq x nu matrix, v an nu-vector) summed in the order the C loop sums it
+    (kincas/core/kernel.py SWEEP_C): T[:, 0] v[0] + T[:, 1] v[1] + ..., so that both give the
+    same numbers."""
+    t = T[:, 0] * v[0]
+    for j in range(1, v.numel()):
+        t = t + T[:, j] * v[j]
+    return t
+
+
+def cubic_weights(u0, u, u1):
+    """(v0, v1, c): the cubic's scalars, p3 = q0 + T0 v0 + T1 v1 - c (q0 - q1) (see the
+    module text): q0 + T0 du + l/2 (T0 - T1) du + c3 E with E = (T0 + T1) dup - 2 (q0 - q1),
+    gathered per tangent, c = 2 c3."""
     du, dup, _, _, lam = _along(u0, u, u1)
-    # q0 + T0 du + l/2 (T0 - T1) du + c3 E with E = (T0 + T1) dup - 2 (q0 - q1), gathered
-    # per tangent: the scalars once, then 7 operations an unknown (with nu = 1)
     c3 = lam * lam * (lam + 1.5)
-    v0, v1 = du * (1 + 0.5 * lam) + c3 * dup, c3 * dup - (0.5 * lam) * du
-    return q0 + ca.mtimes(T0, v0) + ca.mtimes(T1, v1) - (2 * c3) * (q0 - q1)
+    return du * (1 + 0.5 * lam) + c3 * dup, c3 * dup - (0.5 * lam) * du, 2 * c3
 
 
-def quintic(q0, T0, u0, u, T1, u1, q1, T2, u2, q2, scale=1):
-    """(prediction, miss): the unknowns predicted at input u from the last three poses
-    (q_i, T_i = dq/du, u_i), newest first, by the quintic where it applies, else the cubic
-    (see the module text), and max |p5 - p3| / scale, the cubic's error as the quintic sees
-    it (0 where it does not apply). `scale`: each unknown's (1 for an angle, its group's
-    length for a length). Casadi expressions (SX or DM)."""
-    p3 = cubic(q0, T0, u0, u, T1, u1, q1)
-    _, dup, dd, safe, lam = _along(u0, u, u1)  # (the same expressions: casadi's cse shares them)
+def quintic_weights(u0, u, u1, u2):
+    """(use, w1, w2, e0, e1, e2): whether the quintic applies (1 or 0) and the scalars of its
+    correction p5 - p3 = w1 (q1 - q0) + w2 (q2 - q0) + T0 e0 + T1 e1 + T2 e2 (see the module
+    text; finite whether or not it applies)."""
+    _, dup, dd, safe, lam = _along(u0, u, u1)
     # the third pose at t = -s on the line of the last step, s = 1 + (the step before) / (the last)
     back = u0 - u2
     s = ca.dot(back, dup) / safe
@@ -97,22 +102,39 @@ def quintic(q0, T0, u0, u, T1, u1, q1, T2, u2, q2, scale=1):
     ws, dws = s * s * (s - 1) ** 2, -2 * s * (1 - s) * (1 - 2 * s)  # w(-s), w'(-s)
     wl = lam * lam * (lam + 1) ** 2
     # p5(l) - p3(l) = w(l) (g + b (l + s)) = A R0 + B R1, A and B scalars
-    A = ca.if_else(use, wl * (1 / ws - (lam + s) * dws / (ws * ws)), 0)
-    B = ca.if_else(use, wl * (lam + s) / ws, 0)
+    A = wl * (1 / ws - (lam + s) * dws / (ws * ws))
+    B = wl * (lam + s) / ws
     # R0 = f2 - p3(-s) and R1 = d2 - p3'(-s) are linear in (f1 - f0, f2 - f0, d0, d1, d2)
     # (p3's c2 and E written out), so A R0 + B R1 is too: its five weights are scalars,
     # computed once, and each unknown costs five multiply-adds. Relative to q0 (q1 - q0 and
     # q2 - q0 are exact where the poses are close): no rounding at the size of q inside.
     s2, s3 = s * s, s * s * s
     w1 = A * (2 * s3 - 3 * s2) + B * (6 * s - 6 * s2)  # f1 - f0
-    w2 = A  # f2 - f0
     wd0 = A * (s3 - 2 * s2 + s) + B * (4 * s - 3 * s2 - 1)
     wd1 = A * (s3 - s2) + B * (2 * s - 3 * s2)
-    wd2 = B
-    corr = (w1 * (q1 - q0) + w2 * (q2 - q0) + ca.mtimes(T0, wd0 * dup) + ca.mtimes(T1, wd1 * dup)
-            + ca.mtimes(T2, wd2 * dup))
-    # (at even steps corr = 4 (f1 - f0) + 10 (f2 - f0) + 5 d0 + 16 d1 + 3 d2: these weights
-    # amplify the rounding of the solved q's about four times more than the cubic's, which is
-    # why the quintic runs only where the cubic misses by more than that: QUINTIC_ON)
+    return use, w1, A, wd0 * dup, wd1 * dup, B * dup
+    # (at even steps the correction is 4 (f1 - f0) + 10 (f2 - f0) + 5 d0 + 16 d1 + 3 d2: these
+    # weights amplify the rounding of the solved q's about four times more than the cubic's,
+    # which is why the quintic runs only where the cubic misses by more than that: QUINTIC_ON)
+
+
+def cubic(q0, T0, u0, u, T1, u1, q1):
+    """The unknowns predicted at input u by the cubic through the last two poses (q_i,
+    T_i = dq/du, u_i), newest first (see the module text); casadi expressions (SX or DM).
+    Each unknown: ((q0 + T0 v0) + T1 v1) - c (q0 - q1), in this order, as the C loop."""
+    v0, v1, c = cubic_weights(u0, u, u1)
+    return ((q0 + _times(T0, v0)) + _times(T1, v1)) - c * (q0 - q1)
+
+
+def quintic(q0, T0, u0, u, T1, u1, q1, T2, u2, q2, scale=1):
+    """(prediction, miss): the unknowns predicted at input u from the last three poses
+    (q_i, T_i = dq/du, u_i), newest first, by the quintic where it applies, else the cubic
+    (see the module text), and max |p5 - p3| / scale, the cubic's error as the quintic sees
+    it (0 where it does not apply). `scale`: each unknown's (1 for an angle, its group's
+    length for a length). Casadi expressions (SX or DM); each unknown's correction summed
+    in the C loop's order (kincas/core/kernel.py SWEEP_C)."""
+    p3 = cubic(q0, T0, u0, u, T1, u1, q1)
+    use, w1, w2, e0, e1, e2 = quintic_weights(u0, u, u1, u2)
+    corr = (((w1 * (q1 - q0) + w2 * (q2 - q0)) + _times(T0, e0)) + _times(T1, e1)) + _times(T2, e2)
     miss = ca.mmax(ca.fabs(corr) / scale) if corr.numel() else ca.DM(0)  # the cubic's, scaled
-    return p3 + corr, miss
+    return ca.if_else(use, p3 + corr, p3), ca.if_else(use, miss, 0)
