@@ -267,14 +267,25 @@ def _expanded(f: ca.Function) -> ca.Function:
 
 SWEEP_C = """
 static const int KS_LENGTH_OF[NQ > 0 ? NQ : 1] = KS_LENGTHS;  /* unknown i: -1 an angle, else its group (Lb) */
-#define KS_NEAR (NQ + NJ + 3*(NQ*NU + NU) + 2*NQ)
+#define KS_T0 (NQ + NJ)  /* T, u at the last pose (then q1, T1, u1, ... as state_parts) */
+#define KS_T1 (KS_T0 + NQ*NU + NU)
+#define KS_Q1 (KS_T1 + NQ*NU + NU)
+#define KS_T2 (KS_Q1 + NQ)
+#define KS_Q2 (KS_T2 + NQ*NU + NU)
+#define KS_NEAR (KS_Q2 + NQ)
 #define KS_FIVE (KS_NEAR + 1)
 int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const casadi_real* L,
                  const casadi_real* thr, casadi_int max_evals, casadi_real* s, casadi_real* Q,
                  casadi_real* info, casadi_int ld, const casadi_real* Ud, casadi_int sud,
                  const casadi_real* Udd, casadi_int sudd, casadi_real* vals, casadi_real* meas) {
   const casadi_real* arg[SZ_ARG]; casadi_real* res[SZ_RES]; casadi_int iw[SZ_IW]; casadi_real w[SZ_W];
-  casadi_real qp[NQ], q[NQ], dq[NQ], miss = 0, J[NJ > 0 ? NJ : 1], T[NQ*NU], rs[2], rf[2], mc[2], ms[NM], y[NO > 0 ? NO : 1];
+  casadi_real qp[NQ], dq[NQ], miss = 0, rs[2], rf[2], mc[2], ms[NM], y[NO > 0 ? NO : 1];
+  /* the state's poses in slots, (q, T, u) each: the last three (P0, P1, P2) and the next (PS),
+     g_q's blocks at the last and the next (J0, JS); a pose accepted turns the slots round
+     instead of copying them (written back to s in its layout when the loop ends) */
+  casadi_real ring[4][NQ + NQ*NU + NU], jring[2][NJ > 0 ? NJ : 1];
+  casadi_real *P0 = ring[0], *P1 = ring[1], *P2 = ring[2], *PS = ring[3], *J0 = jring[0], *JS = jring[1], *t_;
+  casadi_real *q = PS;
   casadi_real W[5*NU + 4];  /* the predictions' scalars (kW) */
   casadi_real Lb[NM > 1 ? NM - 1 : 1];  /* each group's length, from the parameters */
   casadi_int k, i, j, it;
@@ -284,17 +295,18 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     arg[0] = U; arg[1] = p; res[0] = Lb;
     if (kL(arg, res, iw, w, 0)) return 0;
   }
+  for (i = 0; i < NQ; ++i) { P0[i] = s[i]; P1[i] = s[KS_Q1 + i]; P2[i] = s[KS_Q2 + i]; }
+  for (i = 0; i < NQ*NU + NU; ++i) { P0[NQ + i] = s[KS_T0 + i]; P1[NQ + i] = s[KS_T1 + i]; P2[NQ + i] = s[KS_T2 + i]; }
+  for (i = 0; i < NJ; ++i) J0[i] = s[NQ + i];
   for (k = 0; k < n; ++k) {
     const casadi_real* u = U + k*NU;
     int conv = 0;
     /* the prediction (kincas/core/prediction.py `cubic`, `quintic`): its scalars by kW, then
        each unknown by the same operations in the same order as kP and kP5 */
-    arg[0] = s + NQ + NJ + NQ*NU; arg[1] = u; arg[2] = s + NQ + NJ + 2*NQ*NU + NU;
-    arg[3] = s + NQ + NJ + 3*NQ*NU + 2*NU + NQ; res[0] = W;
+    arg[0] = P0 + NQ + NQ*NU; arg[1] = u; arg[2] = P1 + NQ + NQ*NU; arg[3] = P2 + NQ + NQ*NU; res[0] = W;
     if (kW(arg, res, iw, w, 0)) break;
     {
-      const casadi_real *q0 = s, *T0 = s + NQ + NJ, *T1 = T0 + NQ*NU + NU, *q1 = T1 + NQ*NU + NU;
-      const casadi_real *T2 = q1 + NQ, *q2 = T2 + NQ*NU + NU;
+      const casadi_real *q0 = P0, *T0 = P0 + NQ, *q1 = P1, *T1 = P1 + NQ, *q2 = P2, *T2 = P2 + NQ;
       const casadi_real *v0 = W, *v1 = W + NU, c = W[2*NU], *e0 = W + 2*NU + 4, *e1 = e0 + NU, *e2 = e1 + NU;
       miss = 0;
       if (HAVE_KP5 && five && W[2*NU + 1] != 0) {  /* the quintic applies: cubic and correction */
@@ -335,8 +347,8 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     for (i = 0; i < NQ; ++i) q[i] = qp[i];
     if (near) {  /* kF at the prediction first: where its (next) step is negligible, no kN */
       arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = L; arg[4] = Ud + k*sud; arg[5] = Udd + k*sudd;
-      arg[6] = s + NQ; arg[7] = qp; arg[8] = Lb;
-      res[0] = J; res[1] = T; res[2] = rf; res[3] = mc; res[4] = ms; res[5] = y; res[6] = dq;
+      arg[6] = J0; arg[7] = qp; arg[8] = Lb;
+      res[0] = JS; res[1] = PS + NQ; res[2] = rf; res[3] = mc; res[4] = ms; res[5] = y; res[6] = dq;
       if (kF(arg, res, iw, w, 0)) break;
       if (rf[0] <= thr[0] && rf[1] <= thr[1]) { it = 0; goto evaluated; }
       /* else kF's step is Newton's first (kN's there is the same): applied, and counted */
@@ -352,8 +364,8 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
       }
     }
     arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = L; arg[4] = Ud + k*sud; arg[5] = Udd + k*sudd;
-    arg[6] = s + NQ; arg[7] = qp; arg[8] = Lb;
-    res[0] = J; res[1] = T; res[2] = rf; res[3] = mc; res[4] = ms; res[5] = y; res[6] = dq;
+    arg[6] = J0; arg[7] = qp; arg[8] = Lb;
+    res[0] = JS; res[1] = PS + NQ; res[2] = rf; res[3] = mc; res[4] = ms; res[5] = y; res[6] = dq;
     if (kF(arg, res, iw, w, 0)) break;
   evaluated:
     conv = rf[0] <= thr[0] && rf[1] <= thr[1];  /* the next step is negligible: apply it */
@@ -368,15 +380,13 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     if (!five) miss = mc[1];  /* the cubic's error at this pose (kincas/core/prediction.py) */
     five = HAVE_KP5 && miss > QUINTIC_ON && miss <= QUINTIC_TRY;
     s[KS_NEAR] = near; s[KS_FIVE] = five;  /* kept with the state: a sweep in several calls is one */
-    for (i = 0; i < NQ*NU + NU; ++i) s[NQ + NJ + 2*(NQ*NU + NU) + NQ + i] = s[NQ + NJ + NQ*NU + NU + i];
-    for (i = 0; i < NQ; ++i) s[NQ + NJ + 3*(NQ*NU + NU) + NQ + i] = s[NQ + NJ + 2*(NQ*NU + NU) + i];
-    for (i = 0; i < NQ*NU + NU; ++i) s[NQ + NJ + NQ*NU + NU + i] = s[NQ + NJ + i];
-    for (i = 0; i < NQ; ++i) s[NQ + NJ + 2*(NQ*NU + NU) + i] = s[i];
-    for (i = 0; i < NQ; ++i) s[i] = q[i];
-    for (i = 0; i < NJ; ++i) s[NQ + i] = J[i];
-    for (i = 0; i < NQ*NU; ++i) s[NQ + NJ + i] = T[i];
-    for (i = 0; i < NU; ++i) s[NQ + NJ + NQ*NU + i] = u[i];
+    for (i = 0; i < NU; ++i) PS[NQ + NQ*NU + i] = u[i];
+    t_ = P2; P2 = P1; P1 = P0; P0 = PS; PS = q = t_;  /* this pose is the last now */
+    t_ = J0; J0 = JS; JS = t_;
   }
+  for (i = 0; i < NQ; ++i) { s[i] = P0[i]; s[KS_Q1 + i] = P1[i]; s[KS_Q2 + i] = P2[i]; }
+  for (i = 0; i < NQ*NU + NU; ++i) { s[KS_T0 + i] = P0[NQ + i]; s[KS_T1 + i] = P1[NQ + i]; s[KS_T2 + i] = P2[NQ + i]; }
+  for (i = 0; i < NJ; ++i) s[NQ + i] = J0[i];
   return (int) k;
 }
 """
