@@ -76,7 +76,8 @@ def test_passed_on_arguments_and_unknown_calls_keep_their_tests():
 
 
 @pytest.mark.skipif(compiling_disabled(), reason="compiling disabled")
-def test_compiled_without_the_tests_gives_casadis_numbers():
+def test_compiled_without_the_tests_gives_casadis_numbers(monkeypatch):
+    monkeypatch.setenv("KINCAS_LIBM_TRIG", "1")  # (casadi's sines: libm's)
     f, g, h = _functions()
     driver = """
 int kincas_gh(const casadi_real* c, const casadi_real* a, casadi_real* o) {
@@ -98,3 +99,48 @@ int kincas_gh(const casadi_real* c, const casadi_real* a, casadi_real* o) {
         assert lib.kincas_gh(c.ctypes.data, a.ctypes.data, o.ctypes.data) == 0
         want = np.concatenate([np.asarray(v).ravel() for v in (*g(a), h(c[0], a))])
         assert np.array_equal(o, want)
+
+
+SINCOS_DRIVER = """
+int kincas_test_trig(casadi_int n, const double* x, double* out) {
+  casadi_int k;
+  for (k = 0; k < n; ++k) {
+    kincas_sincos(x[k], out + 4*k, out + 4*k + 1);
+    out[4*k + 2] = kincas_sin(x[k]); out[4*k + 3] = kincas_cos(x[k]);
+  }
+  return 0;
+}
+"""
+
+
+@pytest.mark.skipif(compiling_disabled(), reason="compiling disabled")
+def test_compiled_sines_and_cosines_are_within_an_ulp(monkeypatch):
+    # the compiled kernels' sin and cos (fdlibm's, kincas/core/c_source.py SINCOS_C) against
+    # 40-digit mpmath: angles of mechanisms (a few turns, many turns), next to multiples of
+    # pi/2 (where the reduction cancels), tiny and huge ones, and what libm answers itself
+    mpmath = pytest.importorskip("mpmath")
+    monkeypatch.delenv("KINCAS_LIBM_TRIG", raising=False)
+    _V, _I = ctypes.c_void_p, ctypes.c_longlong
+    try:
+        lib = Library("kincas_test_trig", [], SINCOS_DRIVER, {}, {"kincas_test_trig": [_I, _V, _V]}).load()
+    except (RuntimeError, OSError) as e:
+        pytest.skip(f"no working C compiler: {e}")
+    rng = np.random.default_rng(11)
+    halves = np.array([k * np.pi / 2 for k in range(-40, 41)])
+    x = np.concatenate([rng.uniform(-4, 4, 800), rng.uniform(-200, 200, 600), rng.uniform(-1e6, 1e6, 200),
+                        10.0 ** rng.uniform(-300, 6, 300) * rng.choice([-1, 1], 300),
+                        halves, np.nextafter(halves, np.inf), np.nextafter(halves, -np.inf),
+                        [np.pi / 4, np.nextafter(np.pi / 4, 1), 5e-324, 1e-310, 1.6e6, 1.7e6, 1e22, 3.0e300]])
+    out = np.empty((len(x), 4))
+    assert lib.kincas_test_trig(len(x), x.ctypes.data, out.ctypes.data) == 0
+    assert np.array_equal(out[:, 0], out[:, 2]) and np.array_equal(out[:, 1], out[:, 3])  # one arithmetic
+    mpmath.mp.dps = 40
+    for xi, (s, c, _, _) in zip(x, out):
+        for got, ref in ((s, mpmath.sin(mpmath.mpf(float(xi)))), (c, mpmath.cos(mpmath.mpf(float(xi))))):
+            ulp = np.spacing(abs(float(ref))) if float(ref) else 5e-324
+            assert float(abs(mpmath.mpf(float(got)) - ref)) <= ulp, (xi, got)
+    special = np.array([0.0, -0.0, np.inf, -np.inf, np.nan])
+    out = np.empty((len(special), 4))
+    lib.kincas_test_trig(len(special), special.ctypes.data, out.ctypes.data)
+    assert np.signbit(out[1, 0]) and out[1, 1] == 1 and out[0, 0] == 0 and not np.signbit(out[0, 0])
+    assert np.isnan(out[2:, :]).all()

@@ -3,7 +3,8 @@ was predicted to within STEP, the next pose is tried with kF at the prediction f
 accepted with no Newton step before it where kF's next step is negligible (the same tests as
 any pose); else Newton goes on from the prediction as before. The compiled loop and both
 forms of the virtual machine take the same decisions (the same unknowns, the same step
-counts), and the answers are the closed forms'."""
+counts; compiled with libm's sines and cosines, as the virtual machine takes them), and the
+answers are the closed forms'."""
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +21,9 @@ def cache(tmp_path_factory):
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("KINCAS_CACHE", str(tmp_path_factory.mktemp("kincas-cache")))
         mp.delenv("KINCAS_NO_COMPILE", raising=False)
+        # the compiled loop held to the virtual machine bit for bit: libm's sin and cos in both
+        # (kincas/core/c_library.py libm_trig; compiled kernels take fdlibm's otherwise)
+        mp.setenv("KINCAS_LIBM_TRIG", "1")
         yield
 
 

@@ -10,7 +10,7 @@ second process, or a second run, loads it without compiling. The cache keeps the
 most recently used libraries. When to compile is `kincas.core.compiled.Backend`'s choice.
 
 >>> pair_sincos("  a1=sin(a0);").strip()
-'a1=sin(a0);'
+'a1=kincas_sin(a0);'
 """
 from __future__ import annotations
 
@@ -64,6 +64,13 @@ def cache_dir() -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "kincas"
 
 
+def libm_trig() -> bool:
+    """$KINCAS_LIBM_TRIG set (to anything but 0): compiled code takes sin and cos from libm,
+    as the virtual machine does (else fdlibm's, inline: kincas/core/c_source.py SINCOS_C),
+    so that both give the same numbers bit for bit."""
+    return os.environ.get("KINCAS_LIBM_TRIG", "") not in ("", "0")
+
+
 def compiling_disabled() -> bool:
     """$KINCAS_NO_COMPILE set (to anything but 0): always use the virtual machine."""
     return os.environ.get("KINCAS_NO_COMPILE", "") not in ("", "0")
@@ -92,7 +99,8 @@ class Library:
                 "SZ_IW": [f.sz_iw() for f in functions], "SZ_W": [f.sz_w() for f in functions]}
         defines = {**{k: max([1, *v]) for k, v in work.items()}, **defines}
         code = inline_minmax(pair_sincos(cg.dump()))
-        self.source = (_PRELUDE + (trust_pointers(code) if trusted else code)
+        self.source = (("#define KINCAS_LIBM_TRIG 1\n" if libm_trig() else "") + _PRELUDE
+                       + (trust_pointers(code) if trusted else code)
                        + "".join(f"#define {k} {v}\n" for k, v in defines.items()) + driver)
         self.cc = os.environ.get("CC") or shutil.which("gcc") or shutil.which("cc")
         key = hashlib.sha256("\n".join([self.source, str(self.cc), *_FLAGS, ca.__version__]).encode())

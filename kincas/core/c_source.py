@@ -22,13 +22,106 @@ from __future__ import annotations
 
 import re
 
-_PRELUDE = """#define _GNU_SOURCE
-#include <math.h>
+# Sine and cosine of one angle together, as fdlibm computes them (FreeBSD msun: e_rem_pio2.c's
+# medium case, k_sin.c, k_cos.c): x reduced by Cody and Waite's three-part pi/2 to y0 + y1,
+# |y0| <= pi/4, then the kernels' minimax polynomials, each result within 1 ulp, as glibc's
+# (tests/test_c_source.py checks it against 40-digit mpmath). Inline, it costs about half of a
+# call of glibc's sincos (which takes a more exact path, and whose call spills the live
+# registers): 40 chained four-bars 25.0k -> 22.4k instructions a pose, a four-bar 1.39k ->
+# 1.23k, Jansen's leg 3.8k -> 3.4k (360 poses). Beyond |x| = 2^20 pi/2, infinities and NaNs:
+# libm's. The virtual machine keeps casadi's sin and cos (libm's), so compiled and virtual
+# machine sweeps agree to rounding, not bit for bit; KINCAS_LIBM_TRIG=1 (`libm_trig`) compiles
+# libm's instead, which the tests that hold the C loop to the virtual machine bit for bit use.
+SINCOS_C = """#ifdef KINCAS_LIBM_TRIG
 #ifdef __GLIBC__
 #define kincas_sincos(x, s, c) sincos(x, s, c)
 #else
 #define kincas_sincos(x, s, c) (*(s) = sin(x), *(c) = cos(x))
 #endif
+#define kincas_sin(x) sin(x)
+#define kincas_cos(x) cos(x)
+#else
+#if defined(__GNUC__) || defined(__clang__)
+#define KINCAS_INLINE static inline __attribute__((always_inline))
+#else
+#define KINCAS_INLINE static inline
+#endif
+/*
+ * ====================================================
+ * Copyright (C) 1993 by Sun Microsystems, Inc. All rights reserved.
+ *
+ * Developed at SunPro, a Sun Microsystems, Inc. business.
+ * Permission to use, copy, modify, and distribute this
+ * software is freely granted, provided that this notice
+ * is preserved.
+ * ====================================================
+ * (fdlibm's __ieee754_rem_pio2 medium case, __kernel_sin and __kernel_cos, as in FreeBSD's msun.)
+ */
+static inline double kincas_ksin(double x, double y, int iy) {
+  const double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03,
+    S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06,
+    S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
+  double z = x*x, w = z*z, r = S2 + z*(S3 + z*S4) + z*w*(S5 + z*S6), v = z*x;
+  if (iy == 0) return x + v*(S1 + z*r);
+  return x - ((z*(0.5*y - v*r) - y) - v*S1);
+}
+static inline double kincas_kcos(double x, double y) {
+  const double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03,
+    C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07,
+    C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
+  double z = x*x, w = z*z, r = z*(C1 + z*(C2 + z*C3)) + w*w*(C4 + z*(C5 + z*C6));
+  double hz = 0.5*z;
+  w = 1.0 - hz;
+  return w + (((1.0 - w) - hz) + (z*r - x*y));
+}
+static inline uint32_t kincas_high(double x) { uint64_t b; memcpy(&b, &x, 8); return (uint32_t) (b >> 32); }
+KINCAS_INLINE void kincas_sincos(double x, double* s, double* c) {
+  const double invpio2 = 6.36619772367581382433e-01, pio2_1 = 1.57079632673412561417e+00,
+    pio2_1t = 6.07710050650619224932e-11, pio2_2 = 6.07710050630396597660e-11,
+    pio2_2t = 2.02226624879595063154e-21, pio2_3 = 2.02226624871116645580e-21,
+    pio2_3t = 8.47842766036889956997e-32, shift = 6755399441055744.0;  /* 1.5 * 2^52 */
+  uint32_t ix = kincas_high(x) & 0x7fffffff;
+  double fn, r, w, t, y0, y1, sn, cs;
+  int32_t j, i;
+  if (ix < 0x3e400000) { *s = x; *c = 1.0; return; }  /* |x| < 2^-27: x (and -0 stays -0), 1 */
+  if (ix <= 0x3fe921fb) { *s = kincas_ksin(x, 0.0, 0); *c = kincas_kcos(x, 0.0); return; }  /* |x| <= pi/4 */
+  if (ix > 0x413921fb) {  /* |x| > 2^20 pi/2, inf, NaN: libm's */
+#ifdef __GLIBC__
+    sincos(x, s, c);
+#else
+    *s = sin(x); *c = cos(x);
+#endif
+    return;
+  }
+  fn = (x*invpio2 + shift) - shift;  /* x / (pi/2) to the nearest integer */
+  r = x - fn*pio2_1;
+  w = fn*pio2_1t;  /* first round, good to 85 bits */
+  y0 = r - w;
+  j = (int32_t) (ix >> 20);
+  i = j - (int32_t) ((kincas_high(y0) >> 20) & 0x7ff);
+  if (i > 16) {  /* second round, good to 118 bits */
+    t = r; w = fn*pio2_2; r = t - w; w = fn*pio2_2t - ((t - r) - w); y0 = r - w;
+    i = j - (int32_t) ((kincas_high(y0) >> 20) & 0x7ff);
+    if (i > 49) { t = r; w = fn*pio2_3; r = t - w; w = fn*pio2_3t - ((t - r) - w); y0 = r - w; }
+  }
+  y1 = (r - y0) - w;
+  sn = kincas_ksin(y0, y1, 1); cs = kincas_kcos(y0, y1);
+  switch (((int) fn) & 3) {
+    case 0: *s = sn; *c = cs; break;
+    case 1: *s = cs; *c = -sn; break;
+    case 2: *s = -sn; *c = -cs; break;
+    default: *s = -cs; *c = sn;
+  }
+}
+static inline double kincas_sin(double x) { double s, c; kincas_sincos(x, &s, &c); return s; }
+static inline double kincas_cos(double x) { double s, c; kincas_sincos(x, &s, &c); return c; }
+#endif
+"""
+_PRELUDE = """#define _GNU_SOURCE
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+""" + SINCOS_C + """
 /* C99's fmax and fmin (a NaN argument gives the other one), written out so that they stay
    inline: libm's are calls, and every call spills the live registers */
 static inline double kincas_fmax(double x, double y) { return x != x ? y : y != y ? x : x > y ? x : y; }
@@ -38,16 +131,18 @@ _TRIG = re.compile(r"^(\s*)(a\w+)=(sin|cos)\((a\w+)\);$")
 
 
 def pair_sincos(source: str) -> str:
-    r"""Casadi's generated `x=sin(a); ... y=cos(a);` as one sincos call (glibc's, which gives
-    the same values): each angle's sine and cosine cost one call. Most of a sweep's time is
+    r"""Casadi's generated `x=sin(a); ... y=cos(a);` as one call of `kincas_sincos` (SINCOS_C),
+    a sine or cosine alone as `kincas_sin` / `kincas_cos` (the same arithmetic): each
+    angle's sine and cosine cost one call. Most of a sweep's time is
     this trigonometry, and once the casadi functions are inlined into the C loop the
     compiler stops pairing them itself. A pair is joined only within one block and while
     `a` is not reassigned between; anything else is left as it is.
 
-    >>> print(pair_sincos("  a1=sin(a0);\n  a2=(a1*a0);\n  a3=cos(a0);"))
+    >>> print(pair_sincos("  a1=sin(a0);\n  a2=(a1*a0);\n  a3=cos(a0);\n  a4=cos(a2);"))
       casadi_real kt0; kincas_sincos(a0, &a1, &kt0);
       a2=(a1*a0);
       a3=kt0;
+      a4=kincas_cos(a2);
     """
     lines, n = source.split("\n"), 0
     for i, line in enumerate(lines):
@@ -65,6 +160,10 @@ def pair_sincos(source: str) -> str:
                 break
             if "{" in lines[j] or "}" in lines[j] or re.match(rf"^\s*{a}=", lines[j]):
                 break
+    for i, line in enumerate(lines):  # a sine or cosine alone: the same function's
+        m = _TRIG.match(line)
+        if m:
+            lines[i] = f"{m[1]}{m[2]}=kincas_{m[3]}({m[4]});"
     return "\n".join(lines)
 
 
