@@ -112,6 +112,7 @@ class FastSweeper(VirtualMachineSweep):
         self.state_size = sum(self.state_parts)
         self._functions, self._size, self._poses, self._calls = None, None, 0, 0  # swept so far
         self._lock = threading.RLock()
+        self._layouts: dict = {}  # where each part of a run's block starts, per sizes (kincas/core/fast_run.py)
         self._local = threading.local()  # the virtual machine's buffers, one set per thread
         self.backend = Backend(compile, self._library, "fast sweep kernel")
 
@@ -246,17 +247,19 @@ class FastSweeper(VirtualMachineSweep):
             self.backend.start()  # (compile=None only; the virtual machine serves meanwhile)
         k, last, going = 0, None, False  # going: the last block ended with no rejection
 
-        def tick(a, b):  # news at every 256th pose passed, as the careful path gives it
-            if progress is not None and b // 256 > a // 256:
-                progress(b - b % 256, r.n)
+        tick = None  # news at every 256th pose passed, as the careful path gives it
         if progress is not None:
+            def tick(a, b):
+                if b // 256 > a // 256:
+                    progress(b - b % 256, r.n)
             progress(0, r.n)
         while k < r.n:
             if last is not None and self.nq and self.nu:
                 stop = r.n if progress is None else k + BLOCK
                 bad = r.advance(k, *((None, None) if going else (r.Q[last], r.U[last])), stop)
                 last, going = (bad - 1 if bad > k else last), bad == min(stop, r.n)
-                tick(k, bad)
+                if tick is not None:
+                    tick(k, bad)
                 k = bad
                 if going or k == r.n:
                     continue
@@ -265,7 +268,8 @@ class FastSweeper(VirtualMachineSweep):
                 bad = self._from_guess(r, k, first(k), stop)
                 if bad > k:  # the kernel solved pose k from the placed guess, and went on
                     last, going = bad - 1, bad == min(stop, r.n)
-                    tick(k, bad)
+                    if tick is not None:
+                        tick(k, bad)
                     k = bad
                     if going or k == r.n:
                         continue  # else pose k was rejected: the careful path, as after any pass
@@ -275,7 +279,8 @@ class FastSweeper(VirtualMachineSweep):
                 last, going, k = k, True, k + 1  # the kernel took the pose over: go on from it
             else:
                 last, k, going = (k if sol.ok else last), k + 1, False
-            tick(k - 1, k)
+            if tick is not None:
+                tick(k - 1, k)
         slow = np.flatnonzero(r.solved & ~r.accepted) if r.recorded and self.report else ()
         if len(slow):
             ev = evaluator_for(self.model, self.report)
