@@ -35,6 +35,12 @@ def input_table(m: Mechanism, inputs, what: str, default: float | None, keys=Non
             c = _floats(c, what, keys[0])
         if c.ndim <= 1 and c.size and np.count_nonzero(np.isfinite(c)) == c.size:  # (.all(): 2x)
             return c.reshape(-1, 1)
+    return _table(m, inputs, what, default, keys)
+
+
+def _table(m: Mechanism, inputs, what: str, default: float | None, keys: list) -> np.ndarray:
+    """`input_table` past its usual case (its comprehensions here: in `input_table` they would
+    make cells of the names they read at every call)."""
     if type(inputs) is dict and len(inputs) == len(keys) and keys:  # one plain number per
         # input (a pose of kincas.solve): the row as it is, without a column per input
         row = [inputs.get(k, inputs) for k in keys]

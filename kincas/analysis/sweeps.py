@@ -128,23 +128,11 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     p, L = pm.p, pm.size
     g = pm.with_guess(guess)
     events = []
-
-    def first(k):
-        """Where the careful path would start Newton for pose k, no pose solved yet."""
-        return pm.placement(model, U[k], g)
-
-    def careful(k, j, run):
-        """Pose k, which the fast pass did not accept, from the last solved pose j."""
-        placed = first(k) if j is None else None  # the first pose: a function of inputs and guess,
-        if placed is not None:                    # solved once per placement (warm calls reuse it)
-            return placed.solved(lambda: careful_pose(model, m, U, p, L, g, k, j, run, events))
-        return careful_pose(model, m, U, p, L, g, k, j, run, events)
-
     # The fast pass (compiled, checked pose by pose) solves what it can; every pose it does
-    # not accept goes to the careful path above, and the fast pass restarts after it.
-    # (a tall system, with redundant joints, has no compiled pass: its g_q is not square)
-    # Which pass solves which pose is the method's choice (kincas/analysis/methods.py).
-    run = solver.sweep(SweepProblem(model, pm, names, report, U, Ud, Udd, p, L, careful, first, progress))
+    # not accept goes to the careful path (`SweepProblem.careful`), and the fast pass restarts
+    # after it. (a tall system, with redundant joints, has no compiled pass: its g_q is not
+    # square) Which pass solves which pose is the method's choice (kincas/analysis/methods.py).
+    run = solver.sweep(SweepProblem(model, pm, names, report, U, Ud, Udd, p, L, m, g, events, progress))
     ok, Q = run.solved, run.Q
     every = np.count_nonzero(ok) == n  # (a ufunc's reduction costs twice as much)
     if m.gears and ok.any():  # gear centre distances at the first solved pose
@@ -164,25 +152,17 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         events += found
     values = run.values
     if Uddd is not None:  # the inputs' jerks enter only the third derivatives
-        third = [i for i, nm in enumerate(report) if needs_jerk(nm)]
-        if third and ok.any():
-            got = model.third_derivatives([report[i] for i in third], Q[ok], U[ok], p, Ud[ok], Udd[ok], Uddd[ok])
-            values = np.array(values, dtype=float)
-            values[np.ix_(third, np.flatnonzero(ok))] = got
+        values = _with_jerks(model, report, values, Q, U, p, Ud, Udd, Uddd, ok)
     if at is not None and at.any():  # no wrong number at a singular pose
         null_derivatives(model, report, values, Q, U, p, at)
     keys = pm.keys
     if events:
-        events.sort(key=lambda e: e["pose"])
-        for e in events:
-            e.setdefault("inputs", {kk: float(U[e["pose"], j]) for j, kk in enumerate(keys)})
+        _sort_events(events, U, keys)
     if len(keys) == 1:  # (one input: no view of the caller's array, no comprehension)
         k0 = keys[0]
         ins, rts, accs = {k0: U.ravel().copy()}, {k0: Ud[:, 0]}, {k0: Udd[:, 0]}
     else:
-        ins = {k: U[:, j].copy() for j, k in enumerate(keys)}
-        rts = {k: Ud[:, j] for j, k in enumerate(keys)}  # (tables of this call's own)
-        accs = {k: Udd[:, j] for j, k in enumerate(keys)}
+        ins, rts, accs = _columns(keys, U, Ud, Udd)
     its = run.info[4] if getattr(run, "attempted", False) else run.iterations  # (whole numbers:
     # the Sweep makes them integers when first read)
     out = Sweep._built(n, status, flags, its, inputs=ins, rates=rts, accelerations=accs,
@@ -193,9 +173,44 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         return out  # the guess picks the assembly, whatever poses its branch loses
     # no guess: where the default assembly loses poses, one of the first pose's others that
     # runs them all (kincas/analysis/choice.py), said in an "assembly" event
-    rerun = lambda guess: sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
-                                guess=guess, progress=progress, method=method, compile=compile, jerks=jerks)
+    rerun = _rerun(m, inputs, rates, accelerations, report, progress, method, compile, jerks)
     return choose_assembly(model, m, U, p, L, out, rerun) or out
+
+
+# (the helpers below hold what `sweep` does on its rarer roads: a comprehension or a closure
+# in `sweep` itself would make a cell of each name it reads, at every call)
+
+
+def _with_jerks(model, report, values, Q, U, p, Ud, Udd, Uddd, ok):
+    """The reported values with the third derivatives that the inputs' jerks enter."""
+    third = [i for i, nm in enumerate(report) if needs_jerk(nm)]
+    if third and ok.any():
+        got = model.third_derivatives([report[i] for i in third], Q[ok], U[ok], p, Ud[ok], Udd[ok], Uddd[ok])
+        values = np.array(values, dtype=float)
+        values[np.ix_(third, np.flatnonzero(ok))] = got
+    return values
+
+
+def _sort_events(events, U, keys) -> None:
+    """Events in the order of their poses, each with its inputs' values."""
+    events.sort(key=lambda e: e["pose"])
+    for e in events:
+        e.setdefault("inputs", {kk: float(U[e["pose"], j]) for j, kk in enumerate(keys)})
+
+
+def _columns(keys, U, Ud, Udd) -> tuple:
+    """Per input key: its values (a copy), rates and accelerations (tables of this call's own)."""
+    ins = {k: U[:, j].copy() for j, k in enumerate(keys)}
+    rts = {k: Ud[:, j] for j, k in enumerate(keys)}
+    accs = {k: Udd[:, j] for j, k in enumerate(keys)}
+    return ins, rts, accs
+
+
+def _rerun(m, inputs, rates, accelerations, report, progress, method, compile, jerks):
+    """The same sweep from another guess (`choose_assembly`). (Made here, not in `sweep`: a
+    closure there would make cells of its arguments at every call.)"""
+    return lambda guess: sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
+                               guess=guess, progress=progress, method=method, compile=compile, jerks=jerks)
 
 
 def _per_pose(m, values, what: str, default: float, n: int, keys) -> np.ndarray:
@@ -219,13 +234,26 @@ class SweepProblem:
     """A sweep prepared for its method (kincas/analysis/methods.py): `n` poses, the `report`
     names, and the two passes a method composes."""
 
-    __slots__ = ("model", "pm", "names", "report", "U", "Ud", "Udd", "p", "L", "careful",
-                 "first", "progress", "n")
+    __slots__ = ("model", "pm", "names", "report", "U", "Ud", "Udd", "p", "L", "m", "guess", "events",
+                 "progress", "n")
 
-    def __init__(self, model, pm, names, report, U, Ud, Udd, p, L, careful, first, progress):
+    def __init__(self, model, pm, names, report, U, Ud, Udd, p, L, m, guess, events, progress):
         self.model, self.pm, self.names, self.report, self.U, self.Ud, self.Udd = model, pm, names, report, U, Ud, Udd
-        self.p, self.L, self.careful, self.first, self.progress = p, L, careful, first, progress
+        self.p, self.L, self.m, self.guess, self.events, self.progress = p, L, m, guess, events, progress
         self.n = U.shape[0]
+
+    def first(self, k):
+        """Where the careful path would start Newton for pose k, no pose solved yet."""
+        return self.pm.placement(self.model, self.U[k], self.guess)
+
+    def careful(self, k, j, run):
+        """Pose k, which the fast pass did not accept, from the last solved pose j (events
+        met on the way go to `events`)."""
+        model, m, U, p, L, g, events = self.model, self.m, self.U, self.p, self.L, self.guess, self.events
+        placed = self.first(k) if j is None else None  # the first pose: a function of inputs
+        if placed is not None:  # and guess, solved once per placement (warm calls reuse it)
+            return placed.solved(lambda: careful_pose(model, m, U, p, L, g, k, j, run, events))
+        return careful_pose(model, m, U, p, L, g, k, j, run, events)
 
     def fast_pass(self, compile=None):
         """The compiled pass (every pose it does not accept on the careful path), or None

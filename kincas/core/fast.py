@@ -247,12 +247,8 @@ class FastSweeper(VirtualMachineSweep):
             self.backend.start()  # (compile=None only; the virtual machine serves meanwhile)
         k, last, going = 0, None, False  # going: the last block ended with no rejection
 
-        tick = None  # news at every 256th pose passed, as the careful path gives it
-        if progress is not None:
-            def tick(a, b):
-                if b // 256 > a // 256:
-                    progress(b - b % 256, r.n)
-            progress(0, r.n)
+        tick = None if progress is None else _ticks(progress, r.n)  # (a closure made here
+        # would make cells of `progress` and `r` at every call)
         while k < r.n:
             if last is not None and self.nq and self.nu:
                 stop = r.n if progress is None else k + BLOCK
@@ -342,6 +338,16 @@ class FastSweeper(VirtualMachineSweep):
         r.Q[k], r.info[:, k], r.measures[:, k] = kept
         r.solved[k] = True
         return False
+
+
+def _ticks(progress, n: int):
+    """tick(a, b): news at every 256th pose passed from a to b, as the careful path gives it
+    (`FastSweeper.sweep`); the first news, progress(0, n), given now."""
+    def tick(a, b):
+        if b // 256 > a // 256:
+            progress(b - b % 256, n)
+    progress(0, n)
+    return tick
 
 
 def _moved_within(q, q0, w, groups: list, group_of: np.ndarray, n_groups: int) -> bool:
