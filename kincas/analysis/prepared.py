@@ -37,7 +37,7 @@ from ..core.numeric import Solution
 from ..model.mechanism import Mechanism, check_guess
 
 _PLAIN = (float, int, np.float64)  # numbers a guess gives as they are (not bool: not a number)
-_F8 = np.dtype(np.float64)
+_F8, _ND = np.dtype(np.float64), np.ndarray
 RECENT = 32  # mechanisms kept per structure
 PLACEMENTS = 8  # first-pose placements kept per mechanism (inputs and guesses of its sweeps)
 
@@ -114,7 +114,7 @@ class Prepared:
         assembly found group by group). Computed once per inputs and guess."""
         if not self.plain or model.nq == 0:
             return None
-        key = (u.tobytes() if type(u) is np.ndarray and u.dtype == _F8 else np.asarray(u, float).tobytes(),
+        key = (u.tobytes() if type(u) is _ND and u.dtype == _F8 else np.asarray(u, float).tobytes(),
                None if guess is self.guess else tuple(sorted(guess.items())))  # (the usual case)
         out = self._places.peek(key, self)  # (self: not kept; a placement may be None)
         return self._placed(key, model, u, guess) if out is self else out

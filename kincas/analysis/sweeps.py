@@ -40,6 +40,8 @@ _model_of = compile  # for sweep(), whose `compile` argument hides the name
 
 NO_ASSEMBLY = "no assembly"
 REPORTS_KEPT = 64  # lists of reported names remembered as checked, per mechanism
+# (numpy's names every sweep calls, looked up once: `np.name` is a module look-up a call)
+_count, _zeros, _empty = np.count_nonzero, np.zeros, np.empty
 
 
 # --- sweeps ---
@@ -134,7 +136,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     # square) Which pass solves which pose is the method's choice (kincas/analysis/methods.py).
     run = solver.sweep(SweepProblem(model, pm, names, report, U, Ud, Udd, p, L, m, g, events, progress))
     ok, Q = run.solved, run.Q
-    every = np.count_nonzero(ok) == n  # (a ufunc's reduction costs twice as much)
+    every = _count(ok) == n  # (a ufunc's reduction costs twice as much)
     if m.gears and ok.any():  # gear centre distances at the first solved pose
         check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
     # status None: every pose "ok" (the Sweep makes the array when first read)
@@ -219,11 +221,11 @@ def _per_pose(m, values, what: str, default: float, n: int, keys) -> np.ndarray:
     pays every microsecond): the usual cases, none given or one number for the one input,
     without building a table first."""
     if values is None:
-        return np.zeros((n, len(keys))) if default == 0.0 else np.full((n, len(keys)), default)
+        return _zeros((n, len(keys))) if default == 0.0 else np.full((n, len(keys)), default)
     if len(keys) == 1 and type(values) is dict and len(values) == 1:
         v = values.get(keys[0])
         if type(v) is float and math.isfinite(v) or type(v) is int:
-            out = np.empty((n, 1))  # (np.full checks its arguments: twice the time)
+            out = _empty((n, 1))  # (np.full checks its arguments: twice the time)
             out.fill(v)
             return out
     return np.array(derivative_table(m, values, what, default, n, keys), dtype=float)  # (a copy:

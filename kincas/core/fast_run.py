@@ -26,6 +26,8 @@ if TYPE_CHECKING:
 INFO = ("residual", "step", "jac_change", "correction", "steps")
 _HEAD = np.array([np.nan, RESIDUAL, STEP, JAC_CHANGE, CORRECTION, KERNEL_NEAR])  # L, then thresholds
 _F8 = np.dtype(np.float64)
+# (numpy's names each run calls, looked up once: `np.name` is a module look-up a call)
+_ND, _empty, _zeros = np.ndarray, np.empty, np.zeros
 LAYOUTS_KEPT = 64  # layouts remembered per sweeper (sweeps of many lengths: kept bounded)
 
 
@@ -95,12 +97,12 @@ class FastRun:
 
     def __init__(self, sweeper: "FastSweeper", U, p, L, Ud=None, Udd=None):
         self.sweeper, nu = sweeper, sweeper.nu
-        if not (type(U) is np.ndarray and U.ndim == 2 and U.shape[1] == nu and U.dtype == _F8):
+        if not (type(U) is _ND and U.ndim == 2 and U.shape[1] == nu and U.dtype == _F8):
             U = table(U, nu)
         self.n = n = U.shape[0]
         Ud, sud = _rows(np.ones(nu) if Ud is None else Ud, n, nu)
         Udd, sudd = _rows(np.zeros(nu) if Udd is None else Udd, n, nu)
-        if not (type(p) is np.ndarray and p.dtype == _F8 and p.ndim == 1):  # (a mechanism's
+        if not (type(p) is _ND and p.dtype == _F8 and p.ndim == 1):  # (a mechanism's
             p = np.asarray(p, dtype=float).ravel()  # prepared values are: no call for them)
         # everything the kernel reads or writes of this run in one block of memory: L and
         # the thresholds, copies of the inputs (U, rates, accelerations: a table, or one row
@@ -114,7 +116,7 @@ class FastRun:
         if lay is None:
             lay = _layout(sweeper, key)
         o = self._off = lay.off
-        block = self._block = np.empty(o[11])
+        block = self._block = _empty(o[11])
         # (a slice assigned each: a quarter less than one np.concatenate of the five)
         block[:6] = _HEAD  # the thresholds, then L in its place
         block[0] = L
@@ -127,7 +129,7 @@ class FastRun:
         self.values = block[o[4]:o[5]].reshape(lay.values_shape)
         self._lay, self._sud, self._sudd = lay, sud, sudd
         self._U = self._Ud = self._Udd = self._p = self._measures = self._state_view = self._accepted = None
-        self._ok = ok = np.zeros((2, n), dtype=bool)  # accepted, solved: one table, set by one call
+        self._ok = ok = _zeros((2, n), dtype=bool)  # accepted, solved: one table, set by one call
         self.solved = ok[1]
         self.first_bad, self._s, self._addr, self.recorded = 0, None, None, 0
         self.attempted = False  # True once every pose was attempted (`FastSweeper.sweep`)
@@ -264,7 +266,7 @@ class FastRun:
 def _rows(a, n: int, width: int) -> tuple[np.ndarray, int]:
     """`rows` (kincas/core/compiled.py) with its usual cases first: a C-contiguous (n, width)
     table as it is, one row (or a table broadcast from one) as that row with stride 0."""
-    if not (type(a) is np.ndarray and a.dtype == _F8):  # (np.asarray's keywords cost more)
+    if not (type(a) is _ND and a.dtype == _F8):  # (np.asarray's keywords cost more)
         a = np.asarray(a, dtype=float)
     if a.ndim == 2 and a.shape == (n, width) and width:
         if a.strides[0] == 0:
