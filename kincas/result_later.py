@@ -77,17 +77,18 @@ def wrap_angles(values: dict) -> None:
         values[k] = wrap_angle(values[k])
 
 
-def built(cls, n: int, status, flags, iterations, **fields):
+def built(cls, n: int, status, flags, iterations, fields: dict):
     """A sweep's result as `kincas.sweep` builds it (`Sweep._built`), without `__init__`'s
-    checks: status None (every pose "ok"), flags None (none) and float iterations are made
-    when first read; the angles reported are wrapped."""
+    checks: `fields` (name -> value, a dict of the caller's own) becomes its attributes;
+    status None (every pose "ok"), flags None (none) and float iterations are made when
+    first read; the angles reported are wrapped. (A dict handed over, not keywords: a call
+    with a dozen keywords and the copy of them cost as much as the rest.)"""
     out = cls.__new__(cls)
-    d = out.__dict__
-    d.update(fields)
-    d["_status"] = _Later(all_ok, n) if status is None else status
-    d["_flags"] = _Later(no_flags, n) if flags is None else flags
-    d["_iterations"] = iterations if iterations.dtype.kind == "i" else _Later(whole, iterations)
+    fields["_status"] = _Later(all_ok, n) if status is None else status
+    fields["_flags"] = _Later(no_flags, n) if flags is None else flags
+    fields["_iterations"] = iterations if iterations.dtype.kind == "i" else _Later(whole, iterations)
     wrap_angles(fields["values"])
+    out.__dict__ = fields
     return out
 
 

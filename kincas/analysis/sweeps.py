@@ -167,10 +167,11 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         ins, rts, accs = _columns(keys, U, Ud, Udd)
     its = run.info[4] if getattr(run, "attempted", False) else run.iterations  # (whole numbers:
     # the Sweep makes them integers when first read)
-    out = Sweep._built(n, status, flags, its, inputs=ins, rates=rts, accelerations=accs,
-                       values=dict(zip(report, values)),  # (each row a view, as indexing gives it)
-                       q=Q, residual=run.residual, unknowns=model.unknown_names, size=L,
-                       events=events, info={"fast pass": getattr(run, "backend", None)})
+    out = Sweep._built(n, status, flags, its, {
+        "inputs": ins, "rates": rts, "accelerations": accs,
+        "values": dict(zip(report, values)),  # (each row a view, as indexing gives it)
+        "q": Q, "residual": run.residual, "unknowns": model.unknown_names, "size": L,
+        "events": events, "info": {"fast pass": getattr(run, "backend", None)}})
     if g or every:
         return out  # the guess picks the assembly, whatever poses its branch loses
     # no guess: where the default assembly loses poses, one of the first pose's others that
