@@ -271,6 +271,8 @@ def test_a_first_poses_correction_summed_by_numpy_is_pythons_sum():
     for trial in range(300):
         nq, ng = int(rng.integers(1, 40)), int(rng.integers(1, 6))
         of = rng.integers(0, ng + 1, nq)  # (ng: an unknown of no group)
+        if trial % 5 == 0:  # one group holding every unknown
+            ng, of = 1, np.zeros(nq, dtype=int)
         q0, w = rng.normal(size=nq), rng.uniform(0.1, 10.0, nq)
         q = q0 + rng.normal(size=nq) * CORRECTION * rng.choice([0.01, 0.3, 1.0, 3.0])
         if trial % 7 == 0:  # exactly at the bound in one group
@@ -287,3 +289,5 @@ def test_a_first_poses_correction_summed_by_numpy_is_pythons_sum():
         got_list = _moved_within(q, q0.tolist(), w.tolist(), of.tolist(), of, ng)
         got_numpy = _moved_within(q, q0, w, of.tolist(), of, ng)
         assert got_list == got_numpy == want, (trial, moved)
+        if ng == 1 and not of.any():  # one group holding every unknown: its sum alone
+            assert _moved_within(q, q0.tolist(), w.tolist(), None, of, 1) == want, (trial, moved)

@@ -108,6 +108,8 @@ class FastSweeper(VirtualMachineSweep):
         for i, b in enumerate(self.blocks):
             self._group_of[np.asarray(b.cols, dtype=np.intp)] = i
         self._groups = self._group_of.tolist()
+        # (for `_moved_within` summing in Python: None where every unknown is in the one group)
+        self._groups_few = None if len(self.blocks) == 1 and not any(self._groups) else self._groups
         self.nj = diagonal_size(self.blocks)  # g_q's diagonal blocks, all the state keeps of it
         self.state_size = sum(self.state_parts)
         self._functions, self._size, self._poses, self._calls = None, None, 0, 0  # swept so far
@@ -320,8 +322,8 @@ class FastSweeper(VirtualMachineSweep):
         r._state[:] = s
         r._s = r._state
         bad = r.advance(k, None, None, stop)
-        if bad > k and r.modes_at(k) == before and _moved_within(r.Q[k], q0s, inv_qs, self._groups, self._group_of,
-                                                                   len(self.blocks)):
+        if bad > k and r.modes_at(k) == before and _moved_within(r.Q[k], q0s, inv_qs, self._groups_few,
+                                                                   self._group_of, len(self.blocks)):
             return bad
         r._s = None  # nothing of this attempt is kept: the careful path starts afresh
         r.Q[k:bad + 1] = r.values[:, k:bad + 1] = r.measures[:, k:bad + 1] = np.nan
@@ -353,9 +355,14 @@ def _ticks(progress, n: int):
 def _moved_within(q, q0, w, groups: list, group_of: np.ndarray, n_groups: int) -> bool:
     """Whether each group's sum of |q - q0| w over its own unknowns (in the order of q) is
     at most CORRECTION (`FastSweeper._from_guess`): q0 and w as lists (a few unknowns, summed
-    in Python) or as arrays (np.bincount adds each group's terms in the same order, so the
+    in Python; `groups` None where every unknown is in the one group) or as arrays (np.bincount adds each group's terms in the same order, so the
     sums are the same numbers; where one is NaN, Python's max decides as it always did)."""
     if type(q0) is list:
+        if groups is None:  # every unknown in the one group: its sum alone, in the same order
+            moved = 0.0
+            for a, b, x in zip(q.tolist(), q0, w):
+                moved += abs(a - b) * x
+            return moved <= CORRECTION  # (NaN: not, as max([nan]) is nan)
         moved = [0.0] * (n_groups + 1)  # (the last: unknowns of no group)
         for g, a, b, x in zip(groups, q.tolist(), q0, w):
             moved[g] += abs(a - b) * x
