@@ -319,8 +319,8 @@ class FastSweeper(VirtualMachineSweep):
         if not regular:  # a group singular at q0: its mode is not the guess's to choose
             r._s = None
             return k
-        r._state[:] = s
-        r._s = r._state
+        st = r._s = r._state
+        st[:] = s
         bad = r.advance(k, None, None, stop)
         if bad > k and r.modes_at(k) == before and _moved_within(r.Q[k], q0s, inv_qs, self._groups_few,
                                                                    self._group_of, len(self.blocks)):
