@@ -394,3 +394,24 @@ def test_one_sweeper_runs_rates_given_as_one_row_and_as_a_table_in_turn():
         run = fs.run(U, p, 4.0, q0, U[0], start=0, Ud=w)
         assert run.first_bad == 120
         assert np.abs(run.values - w.ravel() * d1).max() < 1e-6 * np.abs(w).max()
+
+
+def test_threads_reading_a_field_made_later_at_once_get_one_object():
+    """Status, flags and iterations made on first read: four threads reading them together
+    get the same objects (made once), each what the sweep solved."""
+    m, th = fourbar(), np.linspace(0.1, 6.0, 40)
+    for _ in range(20):
+        sw = kincas.sweep(m, {"crank.angle": th}, report=REPORT)
+        got, barrier = [], threading.Barrier(4)
+
+        def read():
+            barrier.wait()
+            got.append((sw.status, sw.flags, sw.iterations))
+        threads = [threading.Thread(target=read) for _ in range(4)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        assert all(g[i] is got[0][i] for g in got for i in range(3))
+        assert got[0][0].tolist() == ["ok"] * 40 and got[0][1] == [None] * 40
+        assert got[0][2].dtype.kind == "i" and (got[0][2] >= 0).all()
