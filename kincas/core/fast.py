@@ -46,7 +46,7 @@ import numpy as np
 
 from .blocks import diagonal_size, numeric_signs
 from .compiled import CHUNK, Backend, Library, QuantityEvaluator  # noqa: F401 (CHUNK: its old home)
-from .fast_run import INFO, FastRun, _rows, _take  # noqa: F401 (INFO, _rows: their old home)
+from .fast_run import INFO, FastRun, _moved_within, _rows, _take, _ticks  # noqa: F401 (INFO, _rows: their old home)
 from .fast_vm import VM_CHUNKS, VM_FLAT, VM_SKIP, VirtualMachineSweep, _Buffered  # noqa: F401
 from .group_kernel import kernel_sizes
 from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, KERNEL_NEAR, QUINTIC_ON, QUINTIC_TRY, RESIDUAL,  # noqa: F401
@@ -340,40 +340,6 @@ class FastSweeper(VirtualMachineSweep):
         r.Q[k], r.info[:, k], r.measures[:, k] = kept
         r.solved[k] = True
         return False
-
-
-def _ticks(progress, n: int):
-    """tick(a, b): news at every 256th pose passed from a to b, as the careful path gives it
-    (`FastSweeper.sweep`); the first news, progress(0, n), given now."""
-    def tick(a, b):
-        if b // 256 > a // 256:
-            progress(b - b % 256, n)
-    progress(0, n)
-    return tick
-
-
-def _moved_within(q, q0, w, groups: list, group_of: np.ndarray, n_groups: int) -> bool:
-    """Whether each group's sum of |q - q0| w over its own unknowns (in the order of q) is
-    at most CORRECTION (`FastSweeper._from_guess`): q0 and w as lists (a few unknowns, summed
-    in Python; `groups` None where every unknown is in the one group) or as arrays (np.bincount adds each group's terms in the same order, so the
-    sums are the same numbers; where one is NaN, Python's max decides as it always did)."""
-    if type(q0) is list:
-        if groups is None:  # every unknown in the one group: its sum alone, in the same order
-            moved = 0.0
-            for a, b, x in zip(q.tolist(), q0, w):
-                moved += abs(a - b) * x
-            return moved <= CORRECTION  # (NaN: not, as max([nan]) is nan)
-        moved = [0.0] * (n_groups + 1)  # (the last: unknowns of no group)
-        for g, a, b, x in zip(groups, q.tolist(), q0, w):
-            moved[g] += abs(a - b) * x
-        return max(moved[:-1], default=0.0) <= CORRECTION
-    d = np.abs(q - q0)
-    d *= w
-    moved = np.bincount(group_of, d, n_groups + 1)
-    top = moved[:-1].max() if n_groups else 0.0
-    if top == top:  # (no NaN: the largest, as Python's max finds it)
-        return bool(top <= CORRECTION)
-    return _moved_within(q, q0.tolist(), w.tolist(), groups, group_of, n_groups)
 
 
 def _diagonal_signs(d: np.ndarray, blocks) -> np.ndarray:

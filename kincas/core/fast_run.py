@@ -5,7 +5,9 @@ writes for it (L and the acceptance thresholds, the state of the last solved pos
 unknowns, the measures of INFO, the reported quantities and the singular measures), and
 `advance` hands its addresses to the compiled C loop, else to the virtual machine of its
 `FastSweeper` (kincas/core/fast.py, which decides what to do with a rejected pose). `_rows`
-and `_take` read rates and accelerations given as a table or as one row for every pose.
+and `_take` read rates and accelerations given as a table or as one row for every pose;
+`_moved_within` is the test of a first pose the kernel solved from a placed guess
+(`FastSweeper._from_guess`), `_ticks` the news of a sweep's progress.
 
 >>> _rows([1.0, 2.0], 5, 2)[1], _rows(np.zeros((5, 2)), 5, 2)[1]
 (0, 2)
@@ -292,3 +294,40 @@ def _rows_of(a: np.ndarray, stride: int, width: int) -> np.ndarray:
 def _take(table, idx):
     a, stride = table
     return a if stride == 0 else a[idx]
+
+
+# --- a sweep's first pose from a placed guess, and news of progress (`FastSweeper.sweep`) ---
+
+
+def _ticks(progress, n: int):
+    """tick(a, b): news at every 256th pose passed from a to b, as the careful path gives it
+    (`FastSweeper.sweep`); the first news, progress(0, n), given now."""
+    def tick(a, b):
+        if b // 256 > a // 256:
+            progress(b - b % 256, n)
+    progress(0, n)
+    return tick
+
+
+def _moved_within(q, q0, w, groups: list, group_of: np.ndarray, n_groups: int) -> bool:
+    """Whether each group's sum of |q - q0| w over its own unknowns (in the order of q) is
+    at most CORRECTION (`FastSweeper._from_guess`): q0 and w as lists (a few unknowns, summed
+    in Python; `groups` None where every unknown is in the one group) or as arrays (np.bincount adds each group's terms in the same order, so the
+    sums are the same numbers; where one is NaN, Python's max decides as it always did)."""
+    if type(q0) is list:
+        if groups is None:  # every unknown in the one group: its sum alone, in the same order
+            moved = 0.0
+            for a, b, x in zip(q.tolist(), q0, w):
+                moved += abs(a - b) * x
+            return moved <= CORRECTION  # (NaN: not, as max([nan]) is nan)
+        moved = [0.0] * (n_groups + 1)  # (the last: unknowns of no group)
+        for g, a, b, x in zip(groups, q.tolist(), q0, w):
+            moved[g] += abs(a - b) * x
+        return max(moved[:-1], default=0.0) <= CORRECTION
+    d = np.abs(q - q0)
+    d *= w
+    moved = np.bincount(group_of, d, n_groups + 1)
+    top = moved[:-1].max() if n_groups else 0.0
+    if top == top:  # (no NaN: the largest, as Python's max finds it)
+        return bool(top <= CORRECTION)
+    return _moved_within(q, q0.tolist(), w.tolist(), groups, group_of, n_groups)
