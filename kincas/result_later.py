@@ -5,40 +5,32 @@ array of 360 "ok" strings (and counting them again in `Sweep.ok`), a list of 360
 integer copy of Newton's step counts as a third of the compiled solve of a four-bar; most
 callers read none of them. `kincas.sweep` hands `Sweep._built` None for "every pose ok" and
 "no flag" and the kernel's float counts; the Sweep keeps a `_Later` for each, whose array is
-made on the first read, once (under a lock: two threads reading at once get the same array,
-so a change made to it stays the Sweep's). What users see is unchanged: `status` is an object
-array, `flags` a list, `iterations` integers; a set replaces them as before.
+made on the first read, once, and kept in its place (under a lock: two threads reading at
+once get the same array, so a change made to it stays the Sweep's). What users see is
+unchanged: `status` is an object array, `flags` a list, `iterations` integers; a set
+replaces them as before.
 
->>> later = _Later(all_ok, 3)
->>> later.get().tolist(), later.get() is later.get()
+>>> class Fields:
+...     status = _lazy_field("status", "statuses")
+>>> r = Fields()
+>>> r.__dict__["_status"] = _Later(all_ok, 3)
+>>> r.status.tolist(), r.status is r.status
 (['ok', 'ok', 'ok'], True)
 >>> angle_names(("C.x", "crank.angle", "d(crank.angle)/d(a)", "cam.phi"))
 ('crank.angle', 'cam.phi')
 """
 from __future__ import annotations
 
+import functools
 import threading
 
 import numpy as np
 
 
-class _Later:
-    """A result's array made when first read (`Sweep._built`): `make(*args)`, once, whichever
-    thread asks first (the others get the same object)."""
-
-    __slots__ = ("make", "args", "value")
-
-    def __init__(self, make, *args):
-        self.make, self.args, self.value = make, args, None
-
-    def get(self):
-        value = self.value
-        if value is None:
-            with _LATER:
-                if self.value is None:
-                    self.value = self.make(*self.args)
-                value = self.value
-        return value
+# A result's array made when first read (`Sweep._built`): `_Later(make, *args)`, a
+# functools.partial (made in C: a class of our own with an __init__ cost three times as much,
+# three a sweep); the field holds it until first read, then the array it made (`_made`).
+_Later = functools.partial
 
 
 _LATER = threading.Lock()
@@ -77,17 +69,18 @@ def wrap_angles(values: dict) -> None:
         values[k] = wrap_angle(values[k])
 
 
-def built(cls, n: int, status, flags, iterations, **fields):
+def built(cls, n: int, status, flags, iterations, fields: dict):
     """A sweep's result as `kincas.sweep` builds it (`Sweep._built`), without `__init__`'s
-    checks: status None (every pose "ok"), flags None (none) and float iterations are made
-    when first read; the angles reported are wrapped."""
+    checks: `fields` (name -> value, a dict of the caller's own) becomes its attributes;
+    status None (every pose "ok"), flags None (none) and float iterations are made when
+    first read; the angles reported are wrapped. (A dict handed over, not keywords: a call
+    with a dozen keywords and the copy of them cost as much as the rest.)"""
     out = cls.__new__(cls)
-    d = out.__dict__
-    d.update(fields)
-    d["_status"] = _Later(all_ok, n) if status is None else status
-    d["_flags"] = _Later(no_flags, n) if flags is None else flags
-    d["_iterations"] = iterations if iterations.dtype.kind == "i" else _Later(whole, iterations)
+    fields["_status"] = _Later(all_ok, n) if status is None else status
+    fields["_flags"] = _Later(no_flags, n) if flags is None else flags
+    fields["_iterations"] = iterations if iterations.dtype.kind == "i" else _Later(whole, iterations)
     wrap_angles(fields["values"])
+    out.__dict__ = fields
     return out
 
 
@@ -113,12 +106,22 @@ def _lazy_field(name: str, doc: str, convert=None):
 
     def get(self):
         v = self.__dict__[key]
-        return v.get() if type(v) is _Later else v
+        return _made(self.__dict__, key) if type(v) is _Later else v
 
     def set(self, value):
         self.__dict__[key] = value if convert is None else convert(value)
     get.__doc__ = doc
     return property(get, set, doc=doc)
+
+
+def _made(d: dict, key: str):
+    """The value of field `key` left for later (a `_Later` in `d`, a result's __dict__), made
+    by the first thread to read it and kept in its place; the others get the same object."""
+    with _LATER:
+        v = d[key]
+        if type(v) is _Later:
+            v = d[key] = v()
+    return v
 
 
 def _object_status(st):

@@ -340,7 +340,7 @@ class Sweep(Result):
         ([True, True], [True, True])
         """
         st = self.__dict__["_status"]
-        if type(st) is _Later and st.value is None:  # never read (nor set): every pose "ok"
+        if type(st) is _Later:  # never read (nor set): every pose "ok"
             return trues(st.args[0])
         st, n = self.status, len(self.status)  # every pose solved (the usual sweep): list.count
         if type(st) is np.ndarray and st.dtype == object and st.ndim == 1 and st.tolist().count("ok") == n:

@@ -197,16 +197,23 @@ def nothing_met_measures(M, flat=None) -> bool:
     number of groups exactly where that holds for every group (a NaN mode makes it NaN).
     Then no mode is NaN, and nothing was met exactly where every sigma exceeds the bound
     (the smallest, NaN if any is). Anything else is left to `nothing_met`."""
-    n, g = M.shape[0], M.shape[1] - 1
+    n, g = M.shape
+    g -= 1
     if n == 0:
         return False
-    sums = np.dot(_ones(n), M)  # (BLAS: a matrix-vector product)
-    if not (all(abs(v) == n for v in sums.tolist()[:g]) if g <= 8 else  # (a few: in Python)
-            np.dot(sums[:g], M[0, :g]) == n * g):  # (NaN: not)
+    sums = _dot(_ones(n), M)  # (BLAS: a matrix-vector product)
+    if g <= 8:  # (a few: in Python, a plain loop)
+        for v in sums.tolist()[:g]:
+            if abs(v) != n:  # (NaN: not n)
+                return nothing_met(np.ones(n, dtype=bool), M[:, :-1], M[:, -1], True)
+    elif not _dot(sums[:g], M[0, :g]) == n * g:  # (NaN: not)
         return nothing_met(np.ones(n, dtype=bool), M[:, :-1], M[:, -1], True)
-    return bool(M[:, g].min() > _SIGMA_BOUND)
+    sigma = M[:, g]
+    return bool(sigma[sigma.argmin()] > _SIGMA_BOUND)  # (the smallest, NaN if any is: argmin
+    # takes NaN for the least; a third of a ufunc's reduction, which .min() goes through)
 
 
+_dot = np.dot
 _SIGMA_BOUND = max(NEAR_SINGULAR, 1e3 * FLAG_SIGMA)  # sigma above it everywhere: nothing near singular
 _ONES: dict = {}  # N -> N ones, read only
 

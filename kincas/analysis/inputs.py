@@ -18,6 +18,8 @@ from ..errors import ModelError
 from ..model.mechanism import Mechanism
 
 _PLAIN = (float, int, np.float64)  # numbers an input gives as they are (not bool)
+# (numpy's names the usual case calls, looked up once: `np.name` is a module look-up a call)
+_ND, _F8, _count, _isfinite = np.ndarray, np.dtype(np.float64), np.count_nonzero, np.isfinite
 
 
 def input_table(m: Mechanism, inputs, what: str, default: float | None, keys=None) -> np.ndarray:
@@ -31,10 +33,16 @@ def input_table(m: Mechanism, inputs, what: str, default: float | None, keys=Non
     if len(keys) == 1 and (type(inputs) is dict or isinstance(inputs, Mapping)) and len(inputs) == 1 \
             and keys[0] in inputs:
         c = inputs[keys[0]]  # the common case, one input: no copy
-        if not (type(c) is np.ndarray and c.dtype == np.float64):
+        if not (type(c) is _ND and c.dtype == _F8):
             c = _floats(c, what, keys[0])
-        if c.ndim <= 1 and c.size and np.count_nonzero(np.isfinite(c)) == c.size:  # (.all(): 2x)
+        if c.ndim <= 1 and c.size and _count(_isfinite(c)) == c.size:  # (.all(): 2x)
             return c.reshape(-1, 1)
+    return _table(m, inputs, what, default, keys)
+
+
+def _table(m: Mechanism, inputs, what: str, default: float | None, keys: list) -> np.ndarray:
+    """`input_table` past its usual case (its comprehensions here: in `input_table` they would
+    make cells of the names they read at every call)."""
     if type(inputs) is dict and len(inputs) == len(keys) and keys:  # one plain number per
         # input (a pose of kincas.solve): the row as it is, without a column per input
         row = [inputs.get(k, inputs) for k in keys]

@@ -37,6 +37,7 @@ from ..core.numeric import Solution
 from ..model.mechanism import Mechanism, check_guess
 
 _PLAIN = (float, int, np.float64)  # numbers a guess gives as they are (not bool: not a number)
+_F8, _ND = np.dtype(np.float64), np.ndarray
 RECENT = 32  # mechanisms kept per structure
 PLACEMENTS = 8  # first-pose placements kept per mechanism (inputs and guesses of its sweeps)
 
@@ -113,10 +114,15 @@ class Prepared:
         assembly found group by group). Computed once per inputs and guess."""
         if not self.plain or model.nq == 0:
             return None
-        key = (np.asarray(u, float).tobytes(),
+        key = (u.tobytes() if type(u) is _ND and u.dtype == _F8 else np.asarray(u, float).tobytes(),
                None if guess is self.guess else tuple(sorted(guess.items())))  # (the usual case)
         out = self._places.peek(key, self)  # (self: not kept; a placement may be None)
-        return self._places.get_or_build(key, lambda: self._place(model, u, guess)) if out is self else out
+        return self._placed(key, model, u, guess) if out is self else out
+
+    def _placed(self, key, model, u, guess):
+        """`placement` not found: made (once per key, `Memo.get_or_build`). (A closure made
+        in `placement` would make cells of its arguments at every call.)"""
+        return self._places.get_or_build(key, lambda: self._place(model, u, guess))
 
     def _place(self, model, u, guess):
         u = np.array(u, float)
@@ -180,9 +186,14 @@ def model_and_prepared(m: Mechanism, model_of):
     seen = _SEEN.peek(id(m))  # (the usual case: no lock, no closure)
     if seen is not None and seen[0] is m:
         return seen[1], seen[2]
+    _, model, pm = _SEEN.get_or_build(id(m), _builder(m, model_of))
+    return model, pm
 
+
+def _builder(m: Mechanism, model_of):
+    """build() -> (m, model, prepared) for `model_and_prepared` (a closure made there would
+    make cells of its arguments at every call)."""
     def build():
         model = model_of(m)
         return m, model, prepared(model, m)
-    _, model, pm = _SEEN.get_or_build(id(m), build)
-    return model, pm
+    return build

@@ -28,18 +28,20 @@ from ..results import Pose, Sweep
 from ..core.symbolic import needs_jerk
 from ..model.names import default_report
 from .choice import choose_assembly
-from .continuation import careful_pose
 from .resume import unlabelled_resumes
 from .events import nothing_met, nothing_met_measures, null_derivatives, sweep_events
 from ..core.joints import check_first_pose
 from .inputs import derivative_table, input_table as _input_table
 from .prepared import model_and_prepared
 from .methods import SweepMethod, method_of
+from .problem import SweepProblem
 
 _model_of = compile  # for sweep(), whose `compile` argument hides the name
 
 NO_ASSEMBLY = "no assembly"
 REPORTS_KEPT = 64  # lists of reported names remembered as checked, per mechanism
+# (numpy's names every sweep calls, looked up once: `np.name` is a module look-up a call)
+_count, _zeros, _empty = np.count_nonzero, np.zeros, np.empty
 
 
 # --- sweeps ---
@@ -128,25 +130,13 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     p, L = pm.p, pm.size
     g = pm.with_guess(guess)
     events = []
-
-    def first(k):
-        """Where the careful path would start Newton for pose k, no pose solved yet."""
-        return pm.placement(model, U[k], g)
-
-    def careful(k, j, run):
-        """Pose k, which the fast pass did not accept, from the last solved pose j."""
-        placed = first(k) if j is None else None  # the first pose: a function of inputs and guess,
-        if placed is not None:                    # solved once per placement (warm calls reuse it)
-            return placed.solved(lambda: careful_pose(model, m, U, p, L, g, k, j, run, events))
-        return careful_pose(model, m, U, p, L, g, k, j, run, events)
-
     # The fast pass (compiled, checked pose by pose) solves what it can; every pose it does
-    # not accept goes to the careful path above, and the fast pass restarts after it.
-    # (a tall system, with redundant joints, has no compiled pass: its g_q is not square)
-    # Which pass solves which pose is the method's choice (kincas/analysis/methods.py).
-    run = solver.sweep(SweepProblem(model, pm, names, report, U, Ud, Udd, p, L, careful, first, progress))
+    # not accept goes to the careful path (`SweepProblem.careful`), and the fast pass restarts
+    # after it. (a tall system, with redundant joints, has no compiled pass: its g_q is not
+    # square) Which pass solves which pose is the method's choice (kincas/analysis/methods.py).
+    run = solver.sweep(SweepProblem(model, pm, names, report, U, Ud, Udd, p, L, m, g, events, progress))
     ok, Q = run.solved, run.Q
-    every = np.count_nonzero(ok) == n  # (a ufunc's reduction costs twice as much)
+    every = _count(ok) == n  # (a ufunc's reduction costs twice as much)
     if m.gears and ok.any():  # gear centre distances at the first solved pose
         check_first_pose(model, Q[ok.argmax()], U[ok.argmax()], p, L)
     # status None: every pose "ok" (the Sweep makes the array when first read)
@@ -164,38 +154,66 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
         events += found
     values = run.values
     if Uddd is not None:  # the inputs' jerks enter only the third derivatives
-        third = [i for i, nm in enumerate(report) if needs_jerk(nm)]
-        if third and ok.any():
-            got = model.third_derivatives([report[i] for i in third], Q[ok], U[ok], p, Ud[ok], Udd[ok], Uddd[ok])
-            values = np.array(values, dtype=float)
-            values[np.ix_(third, np.flatnonzero(ok))] = got
+        values = _with_jerks(model, report, values, Q, U, p, Ud, Udd, Uddd, ok)
     if at is not None and at.any():  # no wrong number at a singular pose
         null_derivatives(model, report, values, Q, U, p, at)
     keys = pm.keys
     if events:
-        events.sort(key=lambda e: e["pose"])
-        for e in events:
-            e.setdefault("inputs", {kk: float(U[e["pose"], j]) for j, kk in enumerate(keys)})
+        _sort_events(events, U, keys)
     if len(keys) == 1:  # (one input: no view of the caller's array, no comprehension)
         k0 = keys[0]
         ins, rts, accs = {k0: U.ravel().copy()}, {k0: Ud[:, 0]}, {k0: Udd[:, 0]}
     else:
-        ins = {k: U[:, j].copy() for j, k in enumerate(keys)}
-        rts = {k: Ud[:, j] for j, k in enumerate(keys)}  # (tables of this call's own)
-        accs = {k: Udd[:, j] for j, k in enumerate(keys)}
+        ins, rts, accs = _columns(keys, U, Ud, Udd)
     its = run.info[4] if getattr(run, "attempted", False) else run.iterations  # (whole numbers:
     # the Sweep makes them integers when first read)
-    out = Sweep._built(n, status, flags, its, inputs=ins, rates=rts, accelerations=accs,
-                       values=dict(zip(report, values)),  # (each row a view, as indexing gives it)
-                       q=Q, residual=run.residual, unknowns=model.unknown_names, size=L,
-                       events=events, info={"fast pass": getattr(run, "backend", None)})
+    out = Sweep._built(n, status, flags, its, {
+        "inputs": ins, "rates": rts, "accelerations": accs,
+        "values": dict(zip(report, values)),  # (each row a view, as indexing gives it)
+        "q": Q, "residual": run.residual, "unknowns": model.unknown_names, "size": L,
+        "events": events, "info": {"fast pass": getattr(run, "backend", None)}})
     if g or every:
         return out  # the guess picks the assembly, whatever poses its branch loses
     # no guess: where the default assembly loses poses, one of the first pose's others that
     # runs them all (kincas/analysis/choice.py), said in an "assembly" event
-    rerun = lambda guess: sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
-                                guess=guess, progress=progress, method=method, compile=compile, jerks=jerks)
+    rerun = _rerun(m, inputs, rates, accelerations, report, progress, method, compile, jerks)
     return choose_assembly(model, m, U, p, L, out, rerun) or out
+
+
+# (the helpers below hold what `sweep` does on its rarer roads: a comprehension or a closure
+# in `sweep` itself would make a cell of each name it reads, at every call)
+
+
+def _with_jerks(model, report, values, Q, U, p, Ud, Udd, Uddd, ok):
+    """The reported values with the third derivatives that the inputs' jerks enter."""
+    third = [i for i, nm in enumerate(report) if needs_jerk(nm)]
+    if third and ok.any():
+        got = model.third_derivatives([report[i] for i in third], Q[ok], U[ok], p, Ud[ok], Udd[ok], Uddd[ok])
+        values = np.array(values, dtype=float)
+        values[np.ix_(third, np.flatnonzero(ok))] = got
+    return values
+
+
+def _sort_events(events, U, keys) -> None:
+    """Events in the order of their poses, each with its inputs' values."""
+    events.sort(key=lambda e: e["pose"])
+    for e in events:
+        e.setdefault("inputs", {kk: float(U[e["pose"], j]) for j, kk in enumerate(keys)})
+
+
+def _columns(keys, U, Ud, Udd) -> tuple:
+    """Per input key: its values (a copy), rates and accelerations (tables of this call's own)."""
+    ins = {k: U[:, j].copy() for j, k in enumerate(keys)}
+    rts = {k: Ud[:, j] for j, k in enumerate(keys)}
+    accs = {k: Udd[:, j] for j, k in enumerate(keys)}
+    return ins, rts, accs
+
+
+def _rerun(m, inputs, rates, accelerations, report, progress, method, compile, jerks):
+    """The same sweep from another guess (`choose_assembly`). (Made here, not in `sweep`: a
+    closure there would make cells of its arguments at every call.)"""
+    return lambda guess: sweep(m, inputs, rates=rates, accelerations=accelerations, report=report,
+                               guess=guess, progress=progress, method=method, compile=compile, jerks=jerks)
 
 
 def _per_pose(m, values, what: str, default: float, n: int, keys) -> np.ndarray:
@@ -204,102 +222,15 @@ def _per_pose(m, values, what: str, default: float, n: int, keys) -> np.ndarray:
     pays every microsecond): the usual cases, none given or one number for the one input,
     without building a table first."""
     if values is None:
-        return np.zeros((n, len(keys))) if default == 0.0 else np.full((n, len(keys)), default)
+        return _zeros((n, len(keys))) if default == 0.0 else np.full((n, len(keys)), default)
     if len(keys) == 1 and type(values) is dict and len(values) == 1:
         v = values.get(keys[0])
         if type(v) is float and math.isfinite(v) or type(v) is int:
-            out = np.empty((n, 1))  # (np.full checks its arguments: twice the time)
+            out = _empty((n, 1))  # (np.full checks its arguments: twice the time)
             out.fill(v)
             return out
     return np.array(derivative_table(m, values, what, default, n, keys), dtype=float)  # (a copy:
     # the user's array stays theirs)
-
-
-class SweepProblem:
-    """A sweep prepared for its method (kincas/analysis/methods.py): `n` poses, the `report`
-    names, and the two passes a method composes."""
-
-    __slots__ = ("model", "pm", "names", "report", "U", "Ud", "Udd", "p", "L", "careful",
-                 "first", "progress", "n")
-
-    def __init__(self, model, pm, names, report, U, Ud, Udd, p, L, careful, first, progress):
-        self.model, self.pm, self.names, self.report, self.U, self.Ud, self.Udd = model, pm, names, report, U, Ud, Udd
-        self.p, self.L, self.careful, self.first, self.progress = p, L, careful, first, progress
-        self.n = U.shape[0]
-
-    def fast_pass(self, compile=None):
-        """The compiled pass (every pose it does not accept on the careful path), or None
-        where there is none worth running: a kernel too large to pay for itself on this sweep (unless compile is False)."""
-        fast = self.pm.sweeper(self.model, self.names, compile)
-        if fast is None or not (compile is False or fast.worth_it(self.n)):
-            return None
-        return fast.sweep(self.U, self.p, self.L, self.careful, Ud=self.Ud, Udd=self.Udd,
-                          progress=self.progress, first=self.first)
-
-    def careful_pass(self):
-        """Every pose on the careful path (continuation with step cutting)."""
-        return _careful_only(self.model, self.report, self.U, self.Ud, self.Udd, self.p, self.L,
-                             self.careful, self.progress)
-
-
-class _CarefulRun:
-    """The arrays of a sweep solved on the careful path alone (as `FastRun` has them)."""
-
-    def __init__(self, n, nq, nr, ng):
-        self.Q, self.solved = np.full((n, nq), np.nan), np.zeros(n, dtype=bool)
-        self.residual, self.iterations = np.full(n, np.nan), np.zeros(n, dtype=int)
-        self.values, self.jacobian = np.full((nr, n), np.nan), np.full((n, ng, nq), np.nan)
-
-
-def _careful_only(model, report, U, Ud, Udd, p, L, careful, progress) -> _CarefulRun:
-    n = U.shape[0]
-    run, j = _CarefulRun(n, model.nq, len(report), model.ng), None
-    for k in range(n):
-        if progress is not None and k % 256 == 0:
-            progress(k, n)
-        sol = careful(k, j, run)
-        run.residual[k], run.iterations[k] = sol.residual, sol.iterations
-        if sol.ok:
-            run.Q[k], run.solved[k], j = sol.q, True, k
-            run.jacobian[k] = sol.J if sol.J is not None else model.jac(sol.q, U[k], p)
-    if progress is not None:
-        progress(n, n)
-    ok = run.solved
-    run.values[:, ok] = model.quantities(report, run.Q[ok], U[ok], p, Ud[ok], Udd[ok])
-    run.signs, run.sigma = _measures(model, run.jacobian, ok, L)
-    return run
-
-
-def _measures(model: Model, J, ok, L):
-    """What the fast kernel gives per pose, from g_q at every pose: each group's mode (N,
-    groups), or for a tall g_q an orientation that changes sign where the sweep crosses a
-    singular position ((N, 1)), 0 where unsolved; and the smallest singular value of the
-    scaled g_q relative to max(1, its largest) (a group's conditioning, for a square one)."""
-    n, idx = len(ok), np.flatnonzero(ok)
-    dets, sigma = np.zeros(n), np.full(n, np.nan)
-    if model.nq == 0 or not len(idx):
-        return dets[:, None], sigma
-    if model.square:  # each Assur group's mode, as the kernel gives it (see core/assembly.py)
-        from ..core.assembly import modes
-        signs = np.zeros((n, len(model.blocks)))
-        signs[idx], cond = modes(model, J[idx], L)
-        sigma[idx] = cond.min(axis=1, initial=1.0)
-        return signs, sigma
-    # tall (redundant joints): no determinant, so chain the relative test of _same_branch
-    # along the sweep: the orientation flips from pose k to the next where det(Q_k' J_next)
-    # and det R_k differ in sign (J_k = Q_k R_k).
-    J = J[idx] * model.column_scale(L)
-    Qk, Rk = np.linalg.qr(J)
-    dR = np.prod(np.diagonal(Rk, axis1=1, axis2=2), axis=1)
-    o = 1.0
-    for a in range(len(idx)):
-        dets[idx[a]] = o * abs(dR[a])
-        if a + 1 < len(idx):
-            flip = np.sign(dR[a]) * np.sign(np.linalg.det(Qk[a].T @ J[a + 1]))
-            o = o * flip if flip != 0 else o
-    sv = np.linalg.svd(J, compute_uv=False)
-    sigma[idx] = sv[:, -1] / np.maximum(sv[:, 0], 1.0)
-    return np.sign(dets)[:, None], sigma
 
 
 def solve(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=None,

@@ -46,7 +46,7 @@ import numpy as np
 
 from .blocks import diagonal_size, numeric_signs
 from .compiled import CHUNK, Backend, Library, QuantityEvaluator  # noqa: F401 (CHUNK: its old home)
-from .fast_run import INFO, FastRun, _rows, _take  # noqa: F401 (INFO, _rows: their old home)
+from .fast_run import INFO, FastRun, _moved_within, _rows, _take, _ticks  # noqa: F401 (INFO, _rows: their old home)
 from .fast_vm import VM_CHUNKS, VM_FLAT, VM_SKIP, VirtualMachineSweep, _Buffered  # noqa: F401
 from .group_kernel import kernel_sizes
 from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, KERNEL_NEAR, QUINTIC_ON, QUINTIC_TRY, RESIDUAL,  # noqa: F401
@@ -108,10 +108,13 @@ class FastSweeper(VirtualMachineSweep):
         for i, b in enumerate(self.blocks):
             self._group_of[np.asarray(b.cols, dtype=np.intp)] = i
         self._groups = self._group_of.tolist()
+        # (for `_moved_within` summing in Python: None where every unknown is in the one group)
+        self._groups_few = None if len(self.blocks) == 1 and not any(self._groups) else self._groups
         self.nj = diagonal_size(self.blocks)  # g_q's diagonal blocks, all the state keeps of it
         self.state_size = sum(self.state_parts)
         self._functions, self._size, self._poses, self._calls = None, None, 0, 0  # swept so far
         self._lock = threading.RLock()
+        self._layouts: dict = {}  # where each part of a run's block starts, per sizes (kincas/core/fast_run.py)
         self._local = threading.local()  # the virtual machine's buffers, one set per thread
         self.backend = Backend(compile, self._library, "fast sweep kernel")
 
@@ -250,17 +253,15 @@ class FastSweeper(VirtualMachineSweep):
             self.backend.start()  # (compile=None only; the virtual machine serves meanwhile)
         k, last, going = 0, None, False  # going: the last block ended with no rejection
 
-        def tick(a, b):  # news at every 256th pose passed, as the careful path gives it
-            if progress is not None and b // 256 > a // 256:
-                progress(b - b % 256, r.n)
-        if progress is not None:
-            progress(0, r.n)
+        tick = None if progress is None else _ticks(progress, r.n)  # (a closure made here
+        # would make cells of `progress` and `r` at every call)
         while k < r.n:
             if last is not None and self.nq and self.nu:
                 stop = r.n if progress is None else k + BLOCK
                 bad = r.advance(k, *((None, None) if going else (r.Q[last], r.U[last])), stop)
                 last, going = (bad - 1 if bad > k else last), bad == min(stop, r.n)
-                tick(k, bad)
+                if tick is not None:
+                    tick(k, bad)
                 k = bad
                 if going or k == r.n:
                     continue
@@ -269,7 +270,8 @@ class FastSweeper(VirtualMachineSweep):
                 bad = self._from_guess(r, k, first(k), stop)
                 if bad > k:  # the kernel solved pose k from the placed guess, and went on
                     last, going = bad - 1, bad == min(stop, r.n)
-                    tick(k, bad)
+                    if tick is not None:
+                        tick(k, bad)
                     k = bad
                     if going or k == r.n:
                         continue  # else pose k was rejected: the careful path, as after any pass
@@ -279,7 +281,8 @@ class FastSweeper(VirtualMachineSweep):
                 last, going, k = k, True, k + 1  # the kernel took the pose over: go on from it
             else:
                 last, k, going = (k if sol.ok else last), k + 1, False
-            tick(k - 1, k)
+            if tick is not None:
+                tick(k - 1, k)
         slow = np.flatnonzero(r.solved & ~r.accepted) if r.recorded and self.report else ()
         if len(slow):
             ev = evaluator_for(self.model, self.report)
@@ -320,11 +323,11 @@ class FastSweeper(VirtualMachineSweep):
         if not regular:  # a group singular at q0: its mode is not the guess's to choose
             r._s = None
             return k
-        r._state[:] = s
-        r._s = r._state
+        st = r._s = r._state
+        st[:] = s
         bad = r.advance(k, None, None, stop)
-        if bad > k and r.modes_at(k) == before and _moved_within(r.Q[k], q0s, inv_qs, self._groups, self._group_of,
-                                                                   len(self.blocks)):
+        if bad > k and r.modes_at(k) == before and _moved_within(r.Q[k], q0s, inv_qs, self._groups_few,
+                                                                   self._group_of, len(self.blocks)):
             return bad
         r._s = None  # nothing of this attempt is kept: the careful path starts afresh
         r.Q[k:bad + 1] = r.values[:, k:bad + 1] = r.measures[:, k:bad + 1] = np.nan
@@ -341,25 +344,6 @@ class FastSweeper(VirtualMachineSweep):
         r.Q[k], r.info[:, k], r.measures[:, k] = kept
         r.solved[k] = True
         return False
-
-
-def _moved_within(q, q0, w, groups: list, group_of: np.ndarray, n_groups: int) -> bool:
-    """Whether each group's sum of |q - q0| w over its own unknowns (in the order of q) is
-    at most CORRECTION (`FastSweeper._from_guess`): q0 and w as lists (a few unknowns, summed
-    in Python) or as arrays (np.bincount adds each group's terms in the same order, so the
-    sums are the same numbers; where one is NaN, Python's max decides as it always did)."""
-    if type(q0) is list:
-        moved = [0.0] * (n_groups + 1)  # (the last: unknowns of no group)
-        for g, a, b, x in zip(groups, q.tolist(), q0, w):
-            moved[g] += abs(a - b) * x
-        return max(moved[:-1], default=0.0) <= CORRECTION
-    d = np.abs(q - q0)
-    d *= w
-    moved = np.bincount(group_of, d, n_groups + 1)
-    top = moved[:-1].max() if n_groups else 0.0
-    if top == top:  # (no NaN: the largest, as Python's max finds it)
-        return bool(top <= CORRECTION)
-    return _moved_within(q, q0.tolist(), w.tolist(), groups, group_of, n_groups)
 
 
 def _diagonal_signs(d: np.ndarray, blocks) -> np.ndarray:

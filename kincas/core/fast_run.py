@@ -5,7 +5,9 @@ writes for it (L and the acceptance thresholds, the state of the last solved pos
 unknowns, the measures of INFO, the reported quantities and the singular measures), and
 `advance` hands its addresses to the compiled C loop, else to the virtual machine of its
 `FastSweeper` (kincas/core/fast.py, which decides what to do with a rejected pose). `_rows`
-and `_take` read rates and accelerations given as a table or as one row for every pose.
+and `_take` read rates and accelerations given as a table or as one row for every pose;
+`_moved_within` is the test of a first pose the kernel solved from a placed guess
+(`FastSweeper._from_guess`), `_ticks` the news of a sweep's progress.
 
 >>> _rows([1.0, 2.0], 5, 2)[1], _rows(np.zeros((5, 2)), 5, 2)[1]
 (0, 2)
@@ -26,6 +28,49 @@ if TYPE_CHECKING:
 INFO = ("residual", "step", "jac_change", "correction", "steps")
 _HEAD = np.array([np.nan, RESIDUAL, STEP, JAC_CHANGE, CORRECTION, KERNEL_NEAR])  # L, then thresholds
 _F8 = np.dtype(np.float64)
+# (numpy's names each run calls, looked up once: `np.name` is a module look-up a call)
+_ND, _empty, _zeros = np.ndarray, np.empty, np.zeros
+LAYOUTS_KEPT = 64  # layouts remembered per sweeper (sweeps of many lengths: kept bounded)
+
+
+class _Layout:
+    """Where each part of a run's block starts (`FastRun`), for one sweeper and one set of
+    sizes (poses, the strides of rates and accelerations, parameters): `off` as `FastRun._off`
+    reads it, the shapes of the views, and `whole`, the byte offsets of the addresses that
+    `advance` hands the C loop for a call over every pose (start 0, stop N)."""
+
+    __slots__ = ("off", "q_shape", "info_shape", "values_shape", "whole")
+
+    def __init__(self, off, q_shape, info_shape, values_shape, whole):
+        self.off, self.q_shape, self.info_shape, self.values_shape, self.whole = off, q_shape, info_shape, values_shape, whole
+
+
+def _layout(sweeper, key) -> _Layout:
+    """The `_Layout` of `key` = (n, rate stride, acceleration stride, parameters), made once
+    per sweeper (a table kept by it; two threads making one at once make the same)."""
+    n, sud, sudd, n_p = key
+    nq, nu = sweeper.nq, sweeper.nu
+    no, nm = len(sweeper.report), len(sweeper.blocks) + 1
+    at_ud = 6 + n * nu  # where each part starts: U at 6, then the rates, ...
+    at_udd = at_ud + (n if sud else 1) * nu
+    at_p = at_udd + (n if sudd else 1) * nu
+    at_s = at_p + n_p
+    at_q = at_s + sweeper.state_size
+    at_info = at_q + n * nq
+    at_values = at_info + 5 * n
+    at_m = at_values + no * n
+    # (the order `advance` and the views read them in: state, Q, info, values, measures,
+    # U, rates, accelerations, parameters, then the ends of the parameters and measures)
+    o = (0, at_s, at_q, at_info, at_values, at_m, 6, at_ud, at_udd, at_p, at_s, at_m + nm * n)
+    # the C loop's addresses at start 0, in bytes from the block's: U, p, state, Q, info,
+    # rates, accelerations, values, measures
+    whole = tuple(8 * o[i] for i in (6, 9, 1, 2, 3, 7, 8, 4, 5))
+    lay = _Layout(o, (n, nq), (5, n), (no, n), whole)
+    kept = sweeper._layouts
+    if len(kept) >= LAYOUTS_KEPT:
+        kept.clear()
+    kept[key] = lay
+    return lay
 
 
 class FastRun:
@@ -45,44 +90,48 @@ class FastRun:
     # (slots: a sweep makes one run, and each attribute stored in a __dict__ of twenty costs
     # it more; `__dict__` stays for what callers add, such as `crossed`)
     __slots__ = ("sweeper", "n", "_off", "_block", "Q", "info", "values", "_ok", "solved", "_accepted",
-                 "_measures", "_state_view", "_sud", "_sudd", "_U", "_Ud", "_Udd", "_p", "first_bad", "_s",
+                 "_measures", "_state_view", "_sud", "_sudd", "_U", "_Ud", "_Udd", "_p", "first_bad", "_s", "_lay",
                  "_addr", "recorded", "attempted", "backend", "__dict__")
 
+    crossed = ()  # steps across a gap the careful path found (kincas/analysis/continuation.py
+    # sets a list of its own where it finds one; read by `kincas.sweep` without a getattr
+    # that fails, whose exception costs a microsecond)
+
     def __init__(self, sweeper: "FastSweeper", U, p, L, Ud=None, Udd=None):
-        self.sweeper, nq, nu = sweeper, sweeper.nq, sweeper.nu
-        if not (type(U) is np.ndarray and U.ndim == 2 and U.shape[1] == nu and U.dtype == _F8):
+        self.sweeper, nu = sweeper, sweeper.nu
+        if not (type(U) is _ND and U.ndim == 2 and U.shape[1] == nu and U.dtype == _F8):
             U = table(U, nu)
         self.n = n = U.shape[0]
         Ud, sud = _rows(np.ones(nu) if Ud is None else Ud, n, nu)
         Udd, sudd = _rows(np.zeros(nu) if Udd is None else Udd, n, nu)
-        if not (type(p) is np.ndarray and p.dtype == _F8 and p.ndim == 1):  # (a mechanism's
+        if not (type(p) is _ND and p.dtype == _F8 and p.ndim == 1):  # (a mechanism's
             p = np.asarray(p, dtype=float).ravel()  # prepared values are: no call for them)
         # everything the kernel reads or writes of this run in one block of memory: L and
         # the thresholds, copies of the inputs (U, rates, accelerations: a table, or one row
         # for every pose) and the parameters, then the state, Q, info, values, measures (one
         # address per run: numpy's array interface costs ~1.5 us an array). The views a warm
         # sweep does not read (the measures, the state, the inputs) are made when first asked.
-        no, nm = len(sweeper.report), len(sweeper.blocks) + 1
-        at_ud = 6 + n * nu  # where each part starts: U at 6, then the rates, ...
-        at_udd = at_ud + (n if sud else 1) * nu
-        at_p = at_udd + (n if sudd else 1) * nu
-        at_s = at_p + p.size
-        at_q = at_s + sweeper.state_size
-        at_info = at_q + n * nq
-        at_values = at_info + 5 * n
-        at_m = at_values + no * n
-        # (the order `advance` and the views read them in: state, Q, info, values, measures,
-        # U, rates, accelerations, parameters, then the ends of the parameters and measures)
-        o = self._off = (0, at_s, at_q, at_info, at_values, at_m, 6, at_ud, at_udd, at_p, at_s, at_m + nm * n)
-        block = self._block = np.empty(o[-1])
-        np.concatenate((_HEAD, U.ravel(), Ud.ravel(), Udd.ravel(), p), out=block[:at_s])  # the
-        block[0] = L  # thresholds, then L in its place
-        self.Q = block[at_q:at_info].reshape(n, nq)
-        self.info = block[at_info:at_values].reshape(5, n)
-        self.values = block[at_values:at_m].reshape(no, n)
-        self._sud, self._sudd, self._U, self._Ud, self._Udd, self._p = sud, sudd, None, None, None, None
-        self._measures = self._state_view = self._accepted = None
-        self._ok = ok = np.zeros((2, n), dtype=bool)  # accepted, solved: one table, set by one call
+        # Where each part starts depends on the sizes alone: worked out once per sweeper and
+        # sizes (`_Layout`).
+        key = (n, sud, sudd, p.size)
+        lay = sweeper._layouts.get(key)
+        if lay is None:
+            lay = _layout(sweeper, key)
+        o = self._off = lay.off
+        block = self._block = _empty(o[11])
+        # (a slice assigned each: a quarter less than one np.concatenate of the five)
+        block[:6] = _HEAD  # the thresholds, then L in its place
+        block[0] = L
+        block[6:o[7]] = U.ravel()
+        block[o[7]:o[8]] = Ud.ravel()
+        block[o[8]:o[9]] = Udd.ravel()
+        block[o[9]:o[10]] = p
+        self.Q = block[o[2]:o[3]].reshape(lay.q_shape)
+        self.info = block[o[3]:o[4]].reshape(lay.info_shape)
+        self.values = block[o[4]:o[5]].reshape(lay.values_shape)
+        self._lay, self._sud, self._sudd = lay, sud, sudd
+        self._U = self._Ud = self._Udd = self._p = self._measures = self._state_view = self._accepted = None
+        self._ok = ok = _zeros((2, n), dtype=bool)  # accepted, solved: one table, set by one call
         self.solved = ok[1]
         self.first_bad, self._s, self._addr, self.recorded = 0, None, None, 0
         self.attempted = False  # True once every pose was attempted (`FastSweeper.sweep`)
@@ -176,17 +225,27 @@ class FastRun:
         if q_last is not None or self._s is None:
             self._s = sw.state(q_last, u_last, self.p, out=self._state)
         s = self._s  # the C loop leaves the last accepted pose's state in it
-        lib = sw.backend.compiled(self.n)
+        lib = sw.backend.lib  # (loaded: `Backend.compiled` would answer it)
+        if lib is None:
+            lib = sw.backend.compiled(self.n)
         self.backend = "virtual machine" if lib is None else "compiled"
         if lib is not None:
-            if self._addr is None:  # the address of the run's block (inputs included): a
-                # ctypes view of the (writable, contiguous) block costs a third of `ptr`'s
-                self._addr = ctypes.addressof(ctypes.c_char.from_buffer(self._block))
-            a, o, sud, sudd, nq, nu = self._addr, self._off, self._sud, self._sudd, sw.nq, sw.nu
-            k = start + lib.kincas_sweep(
-                stop - start, a + 8 * (o[6] + start * nu), a + 8 * o[9], a, a + 8, sw.max_evals, a + 8 * o[1],
-                a + 8 * (o[2] + start * nq), a + 8 * (o[3] + start), self.n, a + 8 * (o[7] + start * sud), sud,
-                a + 8 * (o[8] + start * sudd), sudd, a + 8 * (o[4] + start), a + 8 * (o[5] + start * (len(sw.blocks) + 1)))
+            a = self._addr
+            if a is None:  # the address of the run's block (inputs included): a ctypes view
+                # of the (writable, contiguous) block costs a third of `ptr`'s
+                a = self._addr = ctypes.addressof(ctypes.c_char.from_buffer(self._block))
+            if start == 0 and stop == self.n:  # (the usual warm sweep: its addresses from
+                # byte offsets worked out once per layout, `_Layout.whole`)
+                b = self._lay.whole
+                k = lib.kincas_sweep(stop, a + b[0], a + b[1], a, a + 8, sw.max_evals, a + b[2], a + b[3],
+                                     a + b[4], stop, a + b[5], self._sud, a + b[6], self._sudd, a + b[7], a + b[8])
+            else:
+                o, sud, sudd, nq, nu = self._off, self._sud, self._sudd, sw.nq, sw.nu
+                k = start + lib.kincas_sweep(
+                    stop - start, a + 8 * (o[6] + start * nu), a + 8 * o[9], a, a + 8, sw.max_evals, a + 8 * o[1],
+                    a + 8 * (o[2] + start * nq), a + 8 * (o[3] + start), self.n, a + 8 * (o[7] + start * sud), sud,
+                    a + 8 * (o[8] + start * sudd), sudd, a + 8 * (o[4] + start),
+                    a + 8 * (o[5] + start * (len(sw.blocks) + 1)))
         else:
             k = sw._vm_advance(self, start, stop, s)
         if start == 0 and k == self.n:  # (the usual warm sweep: every pose at once)
@@ -209,7 +268,8 @@ class FastRun:
 def _rows(a, n: int, width: int) -> tuple[np.ndarray, int]:
     """`rows` (kincas/core/compiled.py) with its usual cases first: a C-contiguous (n, width)
     table as it is, one row (or a table broadcast from one) as that row with stride 0."""
-    a = np.asarray(a, dtype=float)
+    if not (type(a) is _ND and a.dtype == _F8):  # (np.asarray's keywords cost more)
+        a = np.asarray(a, dtype=float)
     if a.ndim == 2 and a.shape == (n, width) and width:
         if a.strides[0] == 0:
             return np.ascontiguousarray(a[0]), 0
@@ -234,3 +294,40 @@ def _rows_of(a: np.ndarray, stride: int, width: int) -> np.ndarray:
 def _take(table, idx):
     a, stride = table
     return a if stride == 0 else a[idx]
+
+
+# --- a sweep's first pose from a placed guess, and news of progress (`FastSweeper.sweep`) ---
+
+
+def _ticks(progress, n: int):
+    """tick(a, b): news at every 256th pose passed from a to b, as the careful path gives it
+    (`FastSweeper.sweep`); the first news, progress(0, n), given now."""
+    def tick(a, b):
+        if b // 256 > a // 256:
+            progress(b - b % 256, n)
+    progress(0, n)
+    return tick
+
+
+def _moved_within(q, q0, w, groups: list, group_of: np.ndarray, n_groups: int) -> bool:
+    """Whether each group's sum of |q - q0| w over its own unknowns (in the order of q) is
+    at most CORRECTION (`FastSweeper._from_guess`): q0 and w as lists (a few unknowns, summed
+    in Python; `groups` None where every unknown is in the one group) or as arrays (np.bincount adds each group's terms in the same order, so the
+    sums are the same numbers; where one is NaN, Python's max decides as it always did)."""
+    if type(q0) is list:
+        if groups is None:  # every unknown in the one group: its sum alone, in the same order
+            moved = 0.0
+            for a, b, x in zip(q.tolist(), q0, w):
+                moved += abs(a - b) * x
+            return moved <= CORRECTION  # (NaN: not, as max([nan]) is nan)
+        moved = [0.0] * (n_groups + 1)  # (the last: unknowns of no group)
+        for g, a, b, x in zip(groups, q.tolist(), q0, w):
+            moved[g] += abs(a - b) * x
+        return max(moved[:-1], default=0.0) <= CORRECTION
+    d = np.abs(q - q0)
+    d *= w
+    moved = np.bincount(group_of, d, n_groups + 1)
+    top = moved[:-1].max() if n_groups else 0.0
+    if top == top:  # (no NaN: the largest, as Python's max finds it)
+        return bool(top <= CORRECTION)
+    return _moved_within(q, q0.tolist(), w.tolist(), groups, group_of, n_groups)
