@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 import signal
 import sys
@@ -16,6 +17,13 @@ import numpy as np
 # child then gets back as the default disposition.
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
+
+# Compiled kernels take libm's sines and cosines in the tests, as CasADi's virtual machine
+# does, so that the many tests holding a compiled sweep to its virtual-machine form (or a
+# sweep to the same sweep run before a background compile landed) can ask for the same bits.
+# By default kincas compiles fdlibm's (kincas/core/c_source.py), within an ulp: tested by
+# tests/test_fdlibm_kernels.py and tests/test_c_source.py, which unset this.
+os.environ.setdefault("KINCAS_LIBM_TRIG", "1")
 
 TESTS = Path(__file__).resolve().parent
 ROOT = TESTS.parent
