@@ -20,6 +20,8 @@ pytestmark = pytest.mark.skipif(compiling_disabled(), reason="compiling disabled
 @pytest.fixture(autouse=True)
 def fdlibm(monkeypatch, tmp_path):
     monkeypatch.delenv("KINCAS_LIBM_TRIG", raising=False)
+    # (a four-bar's kernel takes libm's by default, below INLINE_TRIG_UNKNOWNS: forced here)
+    monkeypatch.setattr("kincas.core.fast.INLINE_TRIG_UNKNOWNS", 1)
     monkeypatch.setenv("KINCAS_CACHE", str(tmp_path))
     monkeypatch.delenv("KINCAS_NO_COMPILE", raising=False)
 
@@ -82,3 +84,12 @@ def test_long_chain_written_group_by_group_is_its_closed_form():
     assert np.abs(run.values[1, 1:] - prev[1, 1:]).max() <= 1e-12 * L
     assert np.abs(run.Q[1:] - vm.Q[1:]).max() <= 1e-13
     check_residuals(model, run, p, L)
+
+
+def test_small_kernels_take_libms_sines_and_large_ones_fdlibms(monkeypatch):
+    monkeypatch.setattr("kincas.core.fast.INLINE_TRIG_UNKNOWNS", 16)
+    small = FastSweeper(kincas.model_of(fourbar()), ["C.x"], compile=True)
+    large = FastSweeper(kincas.model_of(chain(8)), ["T8.x"], compile=True)
+    assert small.nq < 16 <= large.nq
+    assert small._library().source.startswith("#define KINCAS_LIBM_TRIG 1")
+    assert not large._library().source.startswith("#define KINCAS_LIBM_TRIG")

@@ -84,13 +84,14 @@ class Library:
     the driver's entry points (each returns an int). `trusted`: the driver passes a pointer
     for every input and output (with entries) of every function it calls, so the functions
     are compiled without casadi's null-pointer tests where no call of theirs needs them
-    (kincas/core/c_source.py `trust_pointers`). `cached` says whether it was found
+    (kincas/core/c_source.py `trust_pointers`). `libm`: sines and cosines from libm's calls
+    rather than fdlibm's inline (c_source.py SINCOS_C), which compile faster. `cached` says whether it was found
     built; `times` the seconds spent generating, compiling and loading. `load()` raises on
     any failure.
     """
 
     def __init__(self, tag: str, functions: list[ca.Function], driver: str, defines: dict,
-                 signatures: dict[str, list], trusted: bool = False):
+                 signatures: dict[str, list], trusted: bool = False, libm: bool = False):
         t0 = time.perf_counter()
         cg = ca.CodeGenerator(f"{tag}.c", {"with_header": False})
         for f in functions:
@@ -99,7 +100,7 @@ class Library:
                 "SZ_IW": [f.sz_iw() for f in functions], "SZ_W": [f.sz_w() for f in functions]}
         defines = {**{k: max([1, *v]) for k, v in work.items()}, **defines}
         code = inline_minmax(pair_sincos(cg.dump()))
-        self.source = (("#define KINCAS_LIBM_TRIG 1\n" if libm_trig() else "") + _PRELUDE
+        self.source = (("#define KINCAS_LIBM_TRIG 1\n" if libm or libm_trig() else "") + _PRELUDE
                        + (trust_pointers(code) if trusted else code)
                        + "".join(f"#define {k} {v}\n" for k, v in defines.items()) + driver)
         self.cc = os.environ.get("CC") or shutil.which("gcc") or shutil.which("cc")

@@ -31,7 +31,8 @@ import re
 # 1.23k, Jansen's leg 3.8k -> 3.4k (360 poses); compiling takes longer (gcc -O3, CPU: a
 # four-bar's kernel 0.23 -> 0.27 s, 40 chained four-bars' 1.3 -> 2.3 s; a call that is not
 # inlined: 0.24 s and 1.8 s, but a third of the gain). Beyond |x| = 2^20 pi/2, infinities and NaNs:
-# libm's. The virtual machine keeps casadi's sin and cos (libm's), so compiled and virtual
+# libm's. Used in kernels of INLINE_TRIG_UNKNOWNS unknowns or more (kincas/core/kernel.py;
+# `Library(libm=True)` below). The virtual machine keeps casadi's sin and cos (libm's), so compiled and virtual
 # machine sweeps agree to rounding, not bit for bit; KINCAS_LIBM_TRIG=1 (`libm_trig`) compiles
 # libm's instead, which the tests that hold the C loop to the virtual machine bit for bit use.
 SINCOS_C = """#ifdef KINCAS_LIBM_TRIG

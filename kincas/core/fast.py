@@ -50,6 +50,7 @@ from .fast_run import INFO, FastRun, _moved_within, _rows, _take, _ticks  # noqa
 from .fast_vm import VM_CHUNKS, VM_FLAT, VM_SKIP, VirtualMachineSweep, _Buffered  # noqa: F401
 from .group_kernel import kernel_sizes
 from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, KERNEL_NEAR, QUINTIC_ON, QUINTIC_TRY, RESIDUAL,  # noqa: F401
+                     INLINE_TRIG_UNKNOWNS,
                      STEP, SWEEP_C,
                      kernel_functions, state_function)
 
@@ -161,7 +162,14 @@ class FastSweeper(VirtualMachineSweep):
 
     def _library(self) -> Library:
         return Library("kincas_sweep", self.compiled_functions, SWEEP_C, self.sweep_macros(),
-                       {"kincas_sweep": SWEEP_SIG}, trusted=True)
+                       {"kincas_sweep": SWEEP_SIG}, trusted=True, libm=self.libm)
+
+    @property
+    def libm(self) -> bool:
+        """Whether the compiled kernel takes libm's sines and cosines (the virtual machine's,
+        bit for bit) rather than fdlibm's inline (kincas/core/c_source.py): below
+        INLINE_TRIG_UNKNOWNS unknowns, where compiling time rules a user's first sweeps."""
+        return self.nq < INLINE_TRIG_UNKNOWNS
 
     def sweep_macros(self) -> dict:
         """The sizes SWEEP_C is compiled with (kincas/core/kernel.py)."""

@@ -61,6 +61,13 @@ GROUP_RUN = 4  # consecutive groups per function written group by group (measure
 # (its cubic, ~30); written as casadi code the quintic also cost compiling (gcc 0.27 -> 0.37
 # s of CPU for a four-bar's kernel, which a user's first sweeps wait for).
 QUINTIC_UNKNOWNS = 16
+# From this many unknowns on, the compiled kernel computes sines and cosines by fdlibm's
+# algorithm inline (kincas/core/c_source.py SINCOS_C: 40 chained four-bars 25.0k -> 22.4k
+# instructions a pose); below, by libm's calls, as the virtual machine: inline, they double
+# gcc's time on Jansen's leg (0.45 -> 0.8 s of CPU), and a small mechanism's first sweeps run
+# in the virtual machine until its library is built (issue [15]: 1,000 first calls of
+# Jansen's leg went from 0.73x to 1.33x pylinkage's time).
+INLINE_TRIG_UNKNOWNS = 16
 
 
 # --- the casadi functions ---
