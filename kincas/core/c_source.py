@@ -32,15 +32,16 @@ import re
 # four-bar's kernel 0.23 -> 0.27 s, 40 chained four-bars' 1.3 -> 2.3 s; a call that is not
 # inlined: 0.24 s and 1.8 s, but a third of the gain). Beyond |x| = 2^20 pi/2, infinities and NaNs:
 # libm's. Used in kernels of INLINE_TRIG_UNKNOWNS unknowns or more (kincas/core/kernel.py;
-# `Library(libm=True)` below). The virtual machine keeps casadi's sin and cos (libm's), so compiled and virtual
-# machine sweeps agree to rounding, not bit for bit; KINCAS_LIBM_TRIG=1 (`libm_trig`) compiles
+# the others are built with c_library.Library's `libm`). The virtual machine keeps casadi's
+# sin and cos (libm's), so compiled and virtual machine sweeps agree to rounding, not bit for bit; KINCAS_LIBM_TRIG=1 (`libm_trig`) compiles
 # libm's instead, which the tests that hold the C loop to the virtual machine bit for bit use.
-SINCOS_C = """#ifdef KINCAS_LIBM_TRIG
-#ifdef __GLIBC__
-#define kincas_sincos(x, s, c) sincos(x, s, c)
+SINCOS_C = """#ifdef __GLIBC__
+#define kincas_libm_sincos(x, s, c) sincos(x, s, c)
 #else
-#define kincas_sincos(x, s, c) (*(s) = sin(x), *(c) = cos(x))
+#define kincas_libm_sincos(x, s, c) (*(s) = sin(x), *(c) = cos(x))
 #endif
+#ifdef KINCAS_LIBM_TRIG
+#define kincas_sincos(x, s, c) kincas_libm_sincos(x, s, c)
 #define kincas_sin(x) sin(x)
 #define kincas_cos(x) cos(x)
 #else
@@ -88,14 +89,7 @@ KINCAS_INLINE void kincas_sincos(double x, double* s, double* c) {
   int32_t j, i;
   if (ix < 0x3e400000) { *s = x; *c = 1.0; return; }  /* |x| < 2^-27: x (and -0 stays -0), 1 */
   if (ix <= 0x3fe921fb) { *s = kincas_ksin(x, 0.0, 0); *c = kincas_kcos(x, 0.0); return; }  /* |x| <= pi/4 */
-  if (ix > 0x413921fb) {  /* |x| > 2^20 pi/2, inf, NaN: libm's */
-#ifdef __GLIBC__
-    sincos(x, s, c);
-#else
-    *s = sin(x); *c = cos(x);
-#endif
-    return;
-  }
+  if (ix > 0x413921fb) { kincas_libm_sincos(x, s, c); return; }  /* |x| > 2^20 pi/2, inf, NaN: libm's */
   fn = (x*invpio2 + shift) - shift;  /* x / (pi/2) to the nearest integer */
   r = x - fn*pio2_1;
   w = fn*pio2_1t;  /* first round, good to 85 bits */

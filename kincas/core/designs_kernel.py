@@ -166,10 +166,10 @@ int kincas_designs_full(casadi_int nd, casadi_int n, const casadi_real* U, const
     arg[0] = q; arg[1] = U; arg[2] = p; res[0] = s + NQ; res[1] = s + NQ + NJ;
     if (kT(arg, res, iw, w, 0)) continue;
     for (i = 0; i < NQ; ++i) s[i] = q[i];
-    for (i = 0; i < NU; ++i) s[NQ + NJ + NQ*NU + i] = U[i];
+    for (i = 0; i < NU; ++i) s[KS_T0 + NQ*NU + i] = U[i];
     for (i = 0; i < NQ*NU + NU; ++i)  /* the poses before: this one (predictions start linear) */
-      s[NQ + NJ + NQ*NU + NU + i] = s[NQ + NJ + 2*(NQ*NU + NU) + NQ + i] = s[NQ + NJ + i];
-    for (i = 0; i < NQ; ++i) s[NQ + NJ + 2*(NQ*NU + NU) + i] = s[NQ + NJ + 3*(NQ*NU + NU) + NQ + i] = q[i];
+      s[KS_T1 + i] = s[KS_T2 + i] = s[KS_T0 + i];
+    for (i = 0; i < NQ; ++i) s[KS_Q1 + i] = s[KS_Q2 + i] = q[i];
     s[KS_NEAR] = s[KS_FIVE] = 0;
     k = kincas_sweep(n, U, p, Ls + d, thr, max_evals, s, q, info, n, Ud, sud, Udd, sudd, vals + d*NO*n, 0);
     while (k > 0 && k < n && kincas_substeps(k, U, p, Ls + d, thr, max_evals, s, Ud + k*sud,

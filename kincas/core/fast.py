@@ -176,8 +176,13 @@ class FastSweeper(VirtualMachineSweep):
         return {"NQ": self.nq, "NU": self.nu, "NO": len(self.report), "NM": len(self.blocks) + 1,
                 "NJ": self.nj, "QUINTIC_ON": repr(float(QUINTIC_ON)),
                 "QUINTIC_TRY": repr(float(QUINTIC_TRY)), "HAVE_KP5": int(self.functions[4] is not None),
-                "KS_LENGTHS_ANY": int(bool(np.any(self.sym.is_length))), "KS_LENGTHS": "{" + ", ".join(str(g if length else -1) for g, length in
-                                              zip(self._groups, self.sym.is_length)) + "}" if self.nq else "{0}"}
+                "KS_LENGTHS_ANY": int(bool(np.any(self.sym.is_length))), "KS_LENGTHS": self._lengths_of()}
+
+    def _lengths_of(self) -> str:
+        """SWEEP_C's KS_LENGTHS: per unknown, the group whose length scales it, -1 an angle."""
+        if not self.nq:
+            return "{0}"
+        return "{" + ", ".join(str(g if length else -1) for g, length in zip(self._groups, self.sym.is_length)) + "}"
 
     @property
     def state_parts(self) -> tuple:

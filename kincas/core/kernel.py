@@ -76,8 +76,8 @@ INLINE_TRIG_UNKNOWNS = 16
 def kernel_functions(sym, blocks, report=(), structure=None, grouped=None) -> list[ca.Function]:
     """[kP, kN, kF, kL, kP5, kW] (see the module text), outputs dense so that C can index
     them; kP5 None below QUINTIC_UNKNOWNS unknowns; kW the scalars of both predictions
-    (v0, v1, c of `cubic_weights`, then use, w1, w2, e0, e1, e2 of `quintic_weights`), for the
-    C loop, which forms the predictions from them (kP and kP5 are the virtual machine's).
+    (v0, v1, c of `cubic_weights`, then, with kP5, use, w1, w2, e0, e1, e2 of
+    `quintic_weights`), for the C loop, which forms the predictions from them (kP and kP5 are the virtual machine's).
     `structure` (the `Structure` whose blocks these are, built from `sym` if not given)
     gives the groups' lengths.
 
@@ -281,6 +281,13 @@ static const int KS_LENGTH_OF[NQ > 0 ? NQ : 1] = KS_LENGTHS;  /* unknown i: -1 a
 #define KS_Q2 (KS_T2 + NQ*NU + NU)
 #define KS_NEAR (KS_Q2 + NQ)
 #define KS_FIVE (KS_NEAR + 1)
+/* row i of T (NQ x NU, column-major) times v, summed input by input (prediction.py `_times`) */
+static inline casadi_real ks_times(const casadi_real* T, const casadi_real* v, casadi_int i) {
+  casadi_real t = T[i]*v[0];
+  casadi_int j;
+  for (j = 1; j < NU; ++j) t = t + T[i + j*NQ]*v[j];
+  return t;
+}
 int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const casadi_real* L,
                  const casadi_real* thr, casadi_int max_evals, casadi_real* s, casadi_real* Q,
                  casadi_real* info, casadi_int ld, const casadi_real* Ud, casadi_int sud,
@@ -295,7 +302,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
   casadi_real *q = PS;
   casadi_real W[5*NU + 4];  /* the predictions' scalars (kW) */
   casadi_real Lb[NM > 1 ? NM - 1 : 1];  /* each group's length, from the parameters */
-  casadi_int k, i, j, it;
+  casadi_int k, i, it;
   int near = s[KS_NEAR] != 0;  /* the last pose was predicted well: try kF at the prediction first */
   int five = s[KS_FIVE] != 0;  /* predict by the quintic (kP5), else the cubic (kP) */
   if (n > 0) {
@@ -315,18 +322,15 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
     {
       const casadi_real *q0 = P0, *T0 = P0 + NQ, *q1 = P1, *T1 = P1 + NQ, *q2 = P2, *T2 = P2 + NQ;
       const casadi_real *v0 = W, *v1 = W + NU, c = W[2*NU], *e0 = W + 2*NU + 4, *e1 = e0 + NU, *e2 = e1 + NU;
+#define KS_CUBIC(i) (((q0[i] + ks_times(T0, v0, i)) + ks_times(T1, v1, i)) - c*(q0[i] - q1[i]))  /* `cubic` */
       miss = 0;
       if (HAVE_KP5 && five && W[2*NU + 1] != 0) {  /* the quintic applies: cubic and correction */
         const casadi_real w1 = W[2*NU + 2], w2 = W[2*NU + 3];
         casadi_real m0 = 0, m1 = 0, m2 = 0, m3 = 0;
         for (i = 0; i < NQ; ++i) {  /* (no branch, no reduction: the compiler vectorises it) */
-          casadi_real t0 = T0[i]*v0[0], t1 = T1[i]*v1[0], e = T0[i]*e0[0], f = T1[i]*e1[0], g = T2[i]*e2[0];
-          for (j = 1; j < NU; ++j) {
-            t0 = t0 + T0[i + j*NQ]*v0[j]; t1 = t1 + T1[i + j*NQ]*v1[j];
-            e = e + T0[i + j*NQ]*e0[j]; f = f + T1[i + j*NQ]*e1[j]; g = g + T2[i + j*NQ]*e2[j];
-          }
-          dq[i] = (((w1*(q1[i] - q0[i]) + w2*(q2[i] - q0[i])) + e) + f) + g;
-          qp[i] = (((q0[i] + t0) + t1) - c*(q0[i] - q1[i])) + dq[i];
+          dq[i] = (((w1*(q1[i] - q0[i]) + w2*(q2[i] - q0[i])) + ks_times(T0, e0, i)) + ks_times(T1, e1, i))
+                  + ks_times(T2, e2, i);
+          qp[i] = KS_CUBIC(i) + dq[i];
         }
         /* the cubic's error as the quintic sees it, max |p5 - p3| / scale: kP5's miss (NaNs
            skipped as its fmax skips them; where all are NaN, 0 here and NaN there: either way
@@ -344,11 +348,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
         for (; i < NQ; ++i) m0 = dq[i] > m0 ? dq[i] : m0;
         m0 = m1 > m0 ? m1 : m0; m2 = m3 > m2 ? m3 : m2; miss = m2 > m0 ? m2 : m0;
       } else {
-        for (i = 0; i < NQ; ++i) {
-          casadi_real t0 = T0[i]*v0[0], t1 = T1[i]*v1[0];
-          for (j = 1; j < NU; ++j) { t0 = t0 + T0[i + j*NQ]*v0[j]; t1 = t1 + T1[i + j*NQ]*v1[j]; }
-          qp[i] = ((q0[i] + t0) + t1) - c*(q0[i] - q1[i]);
-        }
+        for (i = 0; i < NQ; ++i) qp[i] = KS_CUBIC(i);
       }
     }
     for (i = 0; i < NQ; ++i) q[i] = qp[i];
