@@ -114,15 +114,18 @@ int kincas_test_trig(casadi_int n, const double* x, double* out) {
 
 
 @pytest.mark.skipif(compiling_disabled(), reason="compiling disabled")
-def test_compiled_sines_and_cosines_are_within_an_ulp(monkeypatch):
-    # the compiled kernels' sin and cos (fdlibm's, kincas/core/c_source.py SINCOS_C) against
+@pytest.mark.parametrize("trig", ["inline", "call"])
+def test_compiled_sines_and_cosines_are_within_an_ulp(monkeypatch, trig):
+    # the compiled kernels' sin and cos (fdlibm's, kincas/core/c_source.py SINCOS_C, inline
+    # and as a function each use calls) against
     # 40-digit mpmath: angles of mechanisms (a few turns, many turns), next to multiples of
     # pi/2 (where the reduction cancels), tiny and huge ones, and what libm answers itself
     mpmath = pytest.importorskip("mpmath")
     monkeypatch.delenv("KINCAS_LIBM_TRIG", raising=False)
     _V, _I = ctypes.c_void_p, ctypes.c_longlong
     try:
-        lib = Library("kincas_test_trig", [], SINCOS_DRIVER, {}, {"kincas_test_trig": [_I, _V, _V]}).load()
+        built = Library("kincas_test_trig", [], SINCOS_DRIVER, {}, {"kincas_test_trig": [_I, _V, _V]}, trig=trig)
+        lib = built.load()
     except (RuntimeError, OSError) as e:
         pytest.skip(f"no working C compiler: {e}")
     rng = np.random.default_rng(11)
@@ -131,6 +134,7 @@ def test_compiled_sines_and_cosines_are_within_an_ulp(monkeypatch):
                         10.0 ** rng.uniform(-300, 6, 300) * rng.choice([-1, 1], 300),
                         halves, np.nextafter(halves, np.inf), np.nextafter(halves, -np.inf),
                         [np.pi / 4, np.nextafter(np.pi / 4, 1), 5e-324, 1e-310, 1.6e6, 1.7e6, 1e22, 3.0e300]])
+    assert ("#define KINCAS_TRIG_CALL" in built.source) == (trig == "call")
     out = np.empty((len(x), 4))
     assert lib.kincas_test_trig(len(x), x.ctypes.data, out.ctypes.data) == 0
     assert np.array_equal(out[:, 0], out[:, 2]) and np.array_equal(out[:, 1], out[:, 3])  # one arithmetic

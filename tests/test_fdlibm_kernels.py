@@ -1,5 +1,6 @@
-"""The compiled kernels as users get them: sines and cosines by fdlibm's algorithm, inline
-(kincas/core/c_source.py SINCOS_C; the rest of the suite compiles libm's, tests/conftest.py).
+"""The compiled kernels as users get them: sines and cosines by fdlibm's algorithm, inline or as
+a function each use calls (kincas/core/c_source.py SINCOS_C; the rest of the suite compiles
+libm's, tests/conftest.py).
 The answers are the closed forms' to 1e-12 of the size, every pose closes its loops, and the
 compiled sweep agrees with the virtual machine's (libm's sines) to rounding."""
 from __future__ import annotations
@@ -8,7 +9,7 @@ import numpy as np
 import pytest
 
 import kincas
-from kincas.core.c_library import compiling_disabled
+from kincas.core.c_library import Library, compiling_disabled
 from kincas.core.fast import FastSweeper
 
 from test_fast import FOURBAR_REPORT, check_residuals, first_pose, fourbar, fourbar_closed
@@ -17,11 +18,11 @@ from test_group_kernel import chain
 pytestmark = pytest.mark.skipif(compiling_disabled(), reason="compiling disabled")
 
 
-@pytest.fixture(autouse=True)
-def fdlibm(monkeypatch, tmp_path):
+@pytest.fixture(autouse=True, params=["inline", "call"])
+def fdlibm(request, monkeypatch, tmp_path):
     monkeypatch.delenv("KINCAS_LIBM_TRIG", raising=False)
-    # (a four-bar's kernel takes libm's by default, below INLINE_TRIG_UNKNOWNS: forced here)
-    monkeypatch.setattr("kincas.core.fast.INLINE_TRIG_UNKNOWNS", 1)
+    # (a four-bar's kernel calls fdlibm's by default, below INLINE_TRIG_UNKNOWNS; inline, forced)
+    monkeypatch.setattr("kincas.core.fast.INLINE_TRIG_UNKNOWNS", 1 if request.param == "inline" else 10 ** 6)
     monkeypatch.setenv("KINCAS_CACHE", str(tmp_path))
     monkeypatch.delenv("KINCAS_NO_COMPILE", raising=False)
 
@@ -30,7 +31,9 @@ def _runs(m, report, U, Ud):
     model, p, L, q0 = first_pose(m, U)
     fast = FastSweeper(model, report, compile=True)
     a = fast.run(U, p, L, q0, U[0], start=1, Ud=Ud)
-    assert "#define KINCAS_LIBM_TRIG" not in fast.backend.library.source  # fdlibm's, as users get it
+    src = fast.backend.library.source
+    assert "#define KINCAS_LIBM_TRIG" not in src  # fdlibm's, as users get it
+    assert ("#define KINCAS_TRIG_CALL" in src) == (fast.nq < kincas.core.fast.INLINE_TRIG_UNKNOWNS)
     b = FastSweeper(model, report, compile=False).run(U, p, L, q0, U[0], start=1, Ud=Ud)
     assert a.first_bad == b.first_bad == len(U)
     return model, p, L, a, b
@@ -86,10 +89,15 @@ def test_long_chain_written_group_by_group_is_its_closed_form():
     check_residuals(model, run, p, L)
 
 
-def test_small_kernels_take_libms_sines_and_large_ones_fdlibms(monkeypatch):
+def test_small_kernels_call_fdlibms_sines_and_large_ones_have_them_inline(monkeypatch):
     monkeypatch.setattr("kincas.core.fast.INLINE_TRIG_UNKNOWNS", 16)
     small = FastSweeper(kincas.model_of(fourbar()), ["C.x"], compile=True)
     large = FastSweeper(kincas.model_of(chain(8)), ["T8.x"], compile=True)
     assert small.nq < 16 <= large.nq
-    assert small._library().source.startswith("#define KINCAS_LIBM_TRIG 1")
-    assert not large._library().source.startswith("#define KINCAS_LIBM_TRIG")
+    assert small._library().source.startswith("#define KINCAS_TRIG_CALL 1\n")
+    assert not large._library().source.startswith("#define KINCAS_")
+    monkeypatch.setenv("KINCAS_LIBM_TRIG", "1")  # libm's, whatever the size
+    assert small._library().source.startswith("#define KINCAS_LIBM_TRIG 1\n")
+    assert large._library().source.startswith("#define KINCAS_LIBM_TRIG 1\n")
+    with pytest.raises(ValueError, match="trig"):
+        Library("kincas_x", [], "", {}, {}, trig="fast")

@@ -64,9 +64,13 @@ def cache_dir() -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "kincas"
 
 
+# the line each choice of `Library`'s trig puts before the prelude (c_source.py SINCOS_C)
+TRIG = {"inline": "", "call": "#define KINCAS_TRIG_CALL 1\n", "libm": "#define KINCAS_LIBM_TRIG 1\n"}
+
+
 def libm_trig() -> bool:
     """$KINCAS_LIBM_TRIG set (to anything but 0): compiled code takes sin and cos from libm,
-    as the virtual machine does (else fdlibm's, inline: kincas/core/c_source.py SINCOS_C),
+    as the virtual machine does (else fdlibm's: kincas/core/c_source.py SINCOS_C),
     so that both give the same numbers bit for bit."""
     return os.environ.get("KINCAS_LIBM_TRIG", "") not in ("", "0")
 
@@ -84,14 +88,16 @@ class Library:
     the driver's entry points (each returns an int). `trusted`: the driver passes a pointer
     for every input and output (with entries) of every function it calls, so the functions
     are compiled without casadi's null-pointer tests where no call of theirs needs them
-    (kincas/core/c_source.py `trust_pointers`). `libm`: sines and cosines from libm's calls
-    rather than fdlibm's inline (c_source.py SINCOS_C), which compile faster. `cached` says whether it was found
-    built; `times` the seconds spent generating, compiling and loading. `load()` raises on
-    any failure.
+    (kincas/core/c_source.py `trust_pointers`). `trig`: how sines and cosines are computed
+    (c_source.py SINCOS_C): "inline", fdlibm's algorithm at every use; "call", the same
+    algorithm as one function that each use calls (compiles as fast as libm's calls, most of
+    the inline speed); "libm", libm's calls, as the virtual machine (also wherever
+    $KINCAS_LIBM_TRIG is set). `cached` says whether it was found built; `times` the seconds
+    spent generating, compiling and loading. `load()` raises on any failure.
     """
 
     def __init__(self, tag: str, functions: list[ca.Function], driver: str, defines: dict,
-                 signatures: dict[str, list], trusted: bool = False, libm: bool = False):
+                 signatures: dict[str, list], trusted: bool = False, trig: str = "inline"):
         t0 = time.perf_counter()
         cg = ca.CodeGenerator(f"{tag}.c", {"with_header": False})
         for f in functions:
@@ -100,7 +106,10 @@ class Library:
                 "SZ_IW": [f.sz_iw() for f in functions], "SZ_W": [f.sz_w() for f in functions]}
         defines = {**{k: max([1, *v]) for k, v in work.items()}, **defines}
         code = inline_minmax(pair_sincos(cg.dump()))
-        self.source = (("#define KINCAS_LIBM_TRIG 1\n" if libm or libm_trig() else "") + _PRELUDE
+        if trig not in TRIG:
+            raise ValueError(f"trig: {trig!r} is not one of {', '.join(TRIG)}")
+        trig = "libm" if libm_trig() else trig
+        self.source = (TRIG[trig] + _PRELUDE
                        + (trust_pointers(code) if trusted else code)
                        + "".join(f"#define {k} {v}\n" for k, v in defines.items()) + driver)
         self.cc = os.environ.get("CC") or shutil.which("gcc") or shutil.which("cc")

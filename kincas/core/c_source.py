@@ -25,16 +25,18 @@ import re
 # Sine and cosine of one angle together, as fdlibm computes them (FreeBSD msun: e_rem_pio2.c's
 # medium case, k_sin.c, k_cos.c): x reduced by Cody and Waite's three-part pi/2 to y0 + y1,
 # |y0| <= pi/4, then the kernels' minimax polynomials, each result within 1 ulp, as glibc's
-# (tests/test_c_source.py checks it against 40-digit mpmath). Inline, it costs about half of a
-# call of glibc's sincos (which takes a more exact path, and whose call spills the live
-# registers): 40 chained four-bars 25.0k -> 22.4k instructions a pose, a four-bar 1.39k ->
-# 1.23k, Jansen's leg 3.8k -> 3.4k (360 poses); compiling takes longer (gcc -O3, CPU: a
-# four-bar's kernel 0.23 -> 0.27 s, 40 chained four-bars' 1.3 -> 2.3 s; a call that is not
-# inlined: 0.24 s and 1.8 s, but a third of the gain). Beyond |x| = 2^20 pi/2, infinities and NaNs:
-# libm's. Used in kernels of INLINE_TRIG_UNKNOWNS unknowns or more (kincas/core/kernel.py;
-# the others are built with c_library.Library's `libm`). The virtual machine keeps casadi's
-# sin and cos (libm's), so compiled and virtual machine sweeps agree to rounding, not bit for bit; KINCAS_LIBM_TRIG=1 (`libm_trig`) compiles
-# libm's instead, which the tests that hold the C loop to the virtual machine bit for bit use.
+# (tests/test_c_source.py checks it against 40-digit mpmath). glibc's sincos takes a more
+# exact path and sets and restores the rounding mode at every call: alone, in a loop, 19 ns a
+# call against fdlibm's 8 (inline or a call alike). Inline (Library's trig "inline"): 40
+# chained four-bars 25.0k -> 22.4k instructions a pose; compiling takes longer (gcc -O3, CPU:
+# 40 chained four-bars' 1.3 -> 2.3 s, Jansen's leg 0.63 -> 0.78 s). As one function that each
+# use calls (KINCAS_TRIG_CALL, trig "call"): compiling costs what libm's calls cost (Jansen's
+# leg 0.67 s, a four-bar 0.40 s as with libm), and a warm 360-pose sweep's compiled pass
+# takes 60 us instead of 69 on a four-bar, 143 instead of 167 on Jansen's leg (inline: 62,
+# 141). Beyond |x| = 2^20 pi/2, infinities and NaNs: libm's. The virtual machine keeps
+# casadi's sin and cos (libm's), so compiled and virtual machine sweeps agree to rounding, not
+# bit for bit; KINCAS_LIBM_TRIG=1 (`libm_trig`, trig "libm") compiles libm's instead, which
+# the tests that hold the C loop to the virtual machine bit for bit use.
 SINCOS_C = """#ifdef __GLIBC__
 #define kincas_libm_sincos(x, s, c) sincos(x, s, c)
 #else
@@ -45,7 +47,9 @@ SINCOS_C = """#ifdef __GLIBC__
 #define kincas_sin(x) sin(x)
 #define kincas_cos(x) cos(x)
 #else
-#if defined(__GNUC__) || defined(__clang__)
+#if defined(KINCAS_TRIG_CALL) && (defined(__GNUC__) || defined(__clang__))
+#define KINCAS_INLINE static __attribute__((noinline))
+#elif defined(__GNUC__) || defined(__clang__)
 #define KINCAS_INLINE static inline __attribute__((always_inline))
 #else
 #define KINCAS_INLINE static inline

@@ -227,7 +227,7 @@ class DesignsLoop:
                        {**sw.sweep_macros(), "NP": self.np, "NG": self.ng, "NS": sw.state_size,
                         "HALVINGS": HALVINGS, "SUB": 2 ** HALVINGS},
                        {"kincas_sweep": SWEEP_SIG, "kincas_designs_full": _FULL_SIG,
-                        "kincas_designs": _DESIGNS_SIG}, trusted=True, libm=sw.libm)
+                        "kincas_designs": _DESIGNS_SIG}, trusted=True, trig=sw.trig)
 
     def lib(self, n: int):
         """The loaded library for n poses in all, or None (see the class's text)."""

@@ -162,14 +162,15 @@ class FastSweeper(VirtualMachineSweep):
 
     def _library(self) -> Library:
         return Library("kincas_sweep", self.compiled_functions, SWEEP_C, self.sweep_macros(),
-                       {"kincas_sweep": SWEEP_SIG}, trusted=True, libm=self.libm)
+                       {"kincas_sweep": SWEEP_SIG}, trusted=True, trig=self.trig)
 
     @property
-    def libm(self) -> bool:
-        """Whether the compiled kernel takes libm's sines and cosines (the virtual machine's,
-        bit for bit) rather than fdlibm's inline (kincas/core/c_source.py): below
-        INLINE_TRIG_UNKNOWNS unknowns, where compiling time rules a user's first sweeps."""
-        return self.nq < INLINE_TRIG_UNKNOWNS
+    def trig(self) -> str:
+        """How the compiled kernel computes sines and cosines (c_library.Library's `trig`):
+        fdlibm's algorithm inline from INLINE_TRIG_UNKNOWNS unknowns on, below it as one
+        function each use calls, whose compiling costs what libm's calls cost (a small
+        kernel's compile is what a user's first sweeps wait for)."""
+        return "call" if self.nq < INLINE_TRIG_UNKNOWNS else "inline"
 
     def sweep_macros(self) -> dict:
         """The sizes SWEEP_C is compiled with (kincas/core/kernel.py)."""

@@ -63,10 +63,12 @@ GROUP_RUN = 4  # consecutive groups per function written group by group (measure
 QUINTIC_UNKNOWNS = 16
 # From this many unknowns on, the compiled kernel computes sines and cosines by fdlibm's
 # algorithm inline (kincas/core/c_source.py SINCOS_C: 40 chained four-bars 25.0k -> 22.4k
-# instructions a pose); below, by libm's calls, as the virtual machine: inline, they double
-# gcc's time on Jansen's leg (0.45 -> 0.8 s of CPU), and a small mechanism's first sweeps run
-# in the virtual machine until its library is built (issue [15]: 1,000 first calls of
-# Jansen's leg went from 0.73x to 1.33x pylinkage's time).
+# instructions a pose); below, by the same algorithm as one function each use calls: inline,
+# it doubles gcc's time on Jansen's leg (0.45 -> 0.8 s of CPU), and a small mechanism's first
+# sweeps run in the virtual machine until its library is built (issue [15]: 1,000 first calls
+# of Jansen's leg went from 0.73x to 1.33x pylinkage's time); called, it compiles as fast as
+# libm's calls and keeps most of the inline speed (a four-bar's 360-pose compiled pass 69 ->
+# 60 us, libm's -> fdlibm's called).
 INLINE_TRIG_UNKNOWNS = 16
 
 
