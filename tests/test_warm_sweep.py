@@ -419,3 +419,94 @@ def test_threads_reading_a_field_made_later_at_once_get_one_object():
         assert all(g[i] is got[0][i] for g in got for i in range(3))
         assert got[0][0].tolist() == ["ok"] * 40 and got[0][1] == [None] * 40
         assert got[0][2].dtype.kind == "i" and (got[0][2] >= 0).all()
+
+
+def _measures_summary_lib(m):
+    """The compiled library of a mechanism's fast sweep, as `kincas.sweep` builds it."""
+    from kincas.core.c_library import compiling_disabled
+    from kincas.core.fast import FastSweeper
+    if compiling_disabled():
+        pytest.skip("compiling disabled")
+    fast = FastSweeper(kincas.model_of(m), ["C.x"] if "C" in m.moving_points else [], compile=True)
+    return fast, fast.backend.compiled(1)
+
+
+@pytest.mark.parametrize("units", [0, 3])
+def test_the_compiled_loops_summary_of_the_measures_agrees_with_the_general_test(units):
+    """`kincas_measures_summary` (C: modes unlike the first pose's counted, the smallest sigma)
+    read by `nothing_met_summary` answers as `nothing_met` on tables built to sit on every
+    edge (a mode changing once, a mode 0 or NaN, a sigma at, just above and just below the
+    bound, NaN, one pose), with one Assur group (a four-bar) and three (chained four-bars)."""
+    import ctypes
+    from kincas.analysis.events import _SIGMA_BOUND, nothing_met, nothing_met_summary
+    from test_group_kernel import chain
+    fast, lib = _measures_summary_lib(fourbar() if units == 0 else chain(units))
+    g = len(fast.blocks)
+    assert g == (1 if units == 0 else units)
+    rng = np.random.default_rng(5)
+    edges = [_SIGMA_BOUND, np.nextafter(_SIGMA_BOUND, 1), np.nextafter(_SIGMA_BOUND, 0), np.nan, 0.3, 1.0]
+    tried = {True: 0, False: 0}
+    for trial in range(300):
+        n = int(rng.choice([1, 2, 7, 40]))
+        signs = np.tile(rng.choice([-1.0, 1.0], g), (n, 1))
+        sigma = rng.uniform(0.01, 1.0, n)
+        kind = trial % 5
+        if kind == 1:
+            signs[rng.integers(n), rng.integers(g)] *= -1
+        elif kind == 2:
+            signs[rng.integers(n), rng.integers(g)] = rng.choice([0.0, np.nan])
+        elif kind == 3:
+            sigma[rng.integers(n)] = rng.choice(edges)
+        M = np.empty((n, g + 1))
+        M[:, :g], M[:, g] = signs, sigma
+        out = np.full(2, -1.0)
+        lib.kincas_measures_summary(n, M.ctypes.data_as(ctypes.c_void_p), out.ctypes.data_as(ctypes.c_void_p))
+        want = nothing_met(np.ones(n, dtype=bool), signs, sigma, True)
+        assert nothing_met_summary(out) == want, (signs, sigma, out)
+        assert out[0] == np.count_nonzero(~(signs == signs[0]))  # (NaN: unlike everything)
+        tried[want] += 1
+    assert min(tried.values()) > 40
+
+
+@pytest.mark.parametrize("b", [3.5, 2.0 + 1e-9, 2.001])
+@pytest.mark.parametrize("how", ["from the guess", "careful first pose", "in blocks", "virtual machine"])
+def test_a_sweeps_summary_is_its_measures(b, how):
+    """Whatever road a sweep took (the kernel from the first pose, the careful path first, a
+    progress callback's blocks, the virtual machine), the summary it hands `kincas.sweep`,
+    where it has one, is that of its whole table of measures; and the sweep meets a
+    near-singular pose (b = 2 + 1e-9: the coupler and rocker next to collinear at crank
+    angle pi, g_q's smallest singular value 1.7e-5 of its size) as it met it before."""
+    import kincas.core.fast_run as fast_run
+    from kincas.analysis.events import nothing_met_measures, nothing_met_summary
+    th = np.linspace(0, 2 * np.pi, 361)
+    m = fourbar(b)  # (its guess (3.6, 2.9) is too far for the kernel: the careful path places C)
+    if how != "careful first pose":  # the kernel takes the first pose from a guess next to it
+        m = m.with_guess(C=tuple(closed_C(th[:1], b)[:, 0] + 1e-3))
+    seen = []
+    real = fast_run.FastRun.summary
+
+    def spy(run):
+        s = real(run)
+        seen.append((s, nothing_met_measures(run.measures_by_pose()[0])))
+        return s
+    kw = {"progress": lambda a, b: None} if how == "in blocks" else {}
+    careful, record = [], fast_run.FastRun.record
+
+    def recording(run, k, sol):
+        careful.append(k)
+        return record(run, k, sol)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(fast_run.FastRun, "summary", spy)
+        mp.setattr(fast_run.FastRun, "record", recording)
+        mp.setattr("kincas.core.fast.BLOCK", 100)
+        sw = kincas.sweep(m, {"crank.angle": th}, report=["C.x"], compile=how != "virtual machine", **kw)
+    assert sw.ok.all() and len(seen) == 1
+    (summary, want), = seen
+    if how == "virtual machine":
+        assert summary is None and sw.info["fast pass"] == "virtual machine"
+    else:
+        assert summary is not None and nothing_met_summary(summary) == want
+        assert (0 in careful) == (how == "careful first pose")
+    assert want == (b != 2.0 + 1e-9)
+    C = closed_C(th, b)
+    assert np.abs(sw["C.x"] - C[0]).max() < 1e-9  # (next to collinear the closed form's own rounding grows)

@@ -213,6 +213,14 @@ def nothing_met_measures(M, flat=None) -> bool:
     # takes NaN for the least; a third of a ufunc's reduction, which .min() goes through)
 
 
+def nothing_met_summary(summary) -> bool:
+    """`nothing_met` for a sweep with every pose solved by one call of the compiled loop, from
+    its summary of the measures (`FastRun.summary`: how many modes differ from the first
+    pose's, NaN counting as different, and the smallest sigma, NaN if any is)."""
+    other, low = summary
+    return bool(other == 0 and low > _SIGMA_BOUND)  # (NaN: not)
+
+
 _dot = np.dot
 _SIGMA_BOUND = max(NEAR_SINGULAR, 1e3 * FLAG_SIGMA)  # sigma above it everywhere: nothing near singular
 _ONES: dict = {}  # N -> N ones, read only

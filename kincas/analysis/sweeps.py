@@ -29,7 +29,7 @@ from ..core.symbolic import needs_jerk
 from ..model.names import default_report
 from .choice import choose_assembly
 from .resume import unlabelled_resumes
-from .events import nothing_met, nothing_met_measures, null_derivatives, sweep_events
+from .events import nothing_met, nothing_met_measures, nothing_met_summary, null_derivatives, sweep_events
 from ..core.joints import check_first_pose
 from .inputs import derivative_table, input_table as _input_table
 from .prepared import model_and_prepared
@@ -145,7 +145,9 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     if not every:  # after gaps the fast pass crossed (none where every pose is solved)
         events += unlabelled_resumes(model, U, p, L, Q, ok, events)
     crossed = getattr(run, "crossed", ())
-    if every and not len(crossed) and (nothing_met_measures(run.measures_by_pose()[0]) if type(run) is FastRun
+    summary = run.summary() if type(run) is FastRun else None  # (the compiled loop's, where one call did all)
+    if every and not len(crossed) and (nothing_met_summary(summary) if summary is not None
+                                       else nothing_met_measures(run.measures_by_pose()[0]) if type(run) is FastRun
                                        else nothing_met(ok, run.signs, run.sigma, every)):
         at = None  # the usual sweep: no singular position met, no gap (nothing to search)
     else:

@@ -46,7 +46,7 @@ import numpy as np
 
 from .blocks import diagonal_size, numeric_signs
 from .compiled import CHUNK, Backend, Library, QuantityEvaluator  # noqa: F401 (CHUNK: its old home)
-from .fast_run import INFO, FastRun, _moved_within, _rows, _take, _ticks  # noqa: F401 (INFO, _rows: their old home)
+from .fast_run import INFO, WHOLE_C, WHOLE_SIGS, FastRun, _moved_within, _rows, _take, _ticks  # noqa: F401 (INFO, _rows: their old home)
 from .fast_vm import VM_CHUNKS, VM_FLAT, VM_SKIP, VirtualMachineSweep, _Buffered  # noqa: F401
 from .group_kernel import kernel_sizes
 from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, KERNEL_NEAR, QUINTIC_ON, QUINTIC_TRY, RESIDUAL,  # noqa: F401
@@ -161,8 +161,8 @@ class FastSweeper(VirtualMachineSweep):
         return [kN, kF, kL, kW]
 
     def _library(self) -> Library:
-        return Library("kincas_sweep", self.compiled_functions, SWEEP_C, self.sweep_macros(),
-                       {"kincas_sweep": SWEEP_SIG}, trusted=True, trig=self.trig)
+        return Library("kincas_sweep", self.compiled_functions, SWEEP_C + WHOLE_C, self.sweep_macros(),
+                       {"kincas_sweep": SWEEP_SIG, **WHOLE_SIGS}, trusted=True, trig=self.trig)
 
     @property
     def trig(self) -> str:
@@ -343,7 +343,7 @@ class FastSweeper(VirtualMachineSweep):
         if bad > k and r.modes_at(k) == before and _moved_within(r.Q[k], q0s, inv_qs, self._groups_few,
                                                                    self._group_of, len(self.blocks)):
             return bad
-        r._s = None  # nothing of this attempt is kept: the careful path starts afresh
+        r._s, r.summarised = None, False  # nothing of this attempt is kept: the careful path starts afresh
         r.Q[k:bad + 1] = r.values[:, k:bad + 1] = r.measures[:, k:bad + 1] = np.nan
         r.accepted[k:bad + 1] = r.solved[k:bad + 1] = False
         return k

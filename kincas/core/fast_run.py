@@ -26,6 +26,39 @@ if TYPE_CHECKING:
     from .fast import FastSweeper
 
 INFO = ("residual", "step", "jac_change", "correction", "steps")
+# A run's whole sweep in one call (`FastRun.advance` from pose 0 to the end): the addresses of
+# the block's parts as byte offsets from its start, one array per layout (`_Layout.at`), so
+# that ctypes converts six arguments instead of sixteen (~1.6 us a call). Whenever a call
+# reaches the last pose, over every pose's measures (those the call wrote and those written
+# before it), what `kincas.sweep` asks of them first (`kincas_measures_summary`):
+# how many (pose, group) modes differ from the first pose's (NaN differs from everything),
+# and the smallest sigma (NaN if any is), so that Python reads two numbers instead of the
+# table (kincas/analysis/events.py `nothing_met_summary`).
+WHOLE_C = """
+void kincas_measures_summary(casadi_int n, const casadi_real* meas, casadi_real* out) {
+  casadi_int i, j, other = 0;
+  casadi_real low = INFINITY;
+  int nan = 0;
+  for (i = 0; i < n; ++i) {
+    const casadi_real* m = meas + i*NM;
+    for (j = 0; j < NM - 1; ++j) other += !(m[j] == meas[j]);
+    if (m[NM - 1] != m[NM - 1]) nan = 1;
+    else if (m[NM - 1] < low) low = m[NM - 1];
+  }
+  out[0] = (casadi_real) other; out[1] = nan ? NAN : low;
+}
+int kincas_sweep_whole(casadi_int n, char* b, const casadi_int* at, casadi_int max_evals, casadi_int sud,
+                       casadi_int sudd) {
+  int k = kincas_sweep(n, (const casadi_real*) (b + at[0]), (const casadi_real*) (b + at[1]),
+                       (const casadi_real*) b, (const casadi_real*) (b + 8), max_evals, (casadi_real*) (b + at[2]),
+                       (casadi_real*) (b + at[3]), (casadi_real*) (b + at[4]), n, (const casadi_real*) (b + at[5]), sud,
+                       (const casadi_real*) (b + at[6]), sudd, (casadi_real*) (b + at[7]), (casadi_real*) (b + at[8]));
+  kincas_measures_summary(k, (const casadi_real*) (b + at[8]), (casadi_real*) (b + at[9]));
+  return k;
+}
+"""
+_I, _V = ctypes.c_longlong, ctypes.c_void_p
+WHOLE_SIGS = {"kincas_sweep_whole": [_I, _V, _V, _I, _I, _I], "kincas_measures_summary": [_I, _V, _V]}
 _HEAD = np.array([np.nan, RESIDUAL, STEP, JAC_CHANGE, CORRECTION, KERNEL_NEAR])  # L, then thresholds
 _F8 = np.dtype(np.float64)
 # (numpy's names each run calls, looked up once: `np.name` is a module look-up a call)
@@ -39,10 +72,13 @@ class _Layout:
     reads it, the shapes of the views, and `whole`, the byte offsets of the addresses that
     `advance` hands the C loop for a call over every pose (start 0, stop N)."""
 
-    __slots__ = ("off", "q_shape", "info_shape", "values_shape", "whole")
+    __slots__ = ("off", "q_shape", "info_shape", "values_shape", "whole", "at", "at_address")
 
     def __init__(self, off, q_shape, info_shape, values_shape, whole):
         self.off, self.q_shape, self.info_shape, self.values_shape, self.whole = off, q_shape, info_shape, values_shape, whole
+        # (`whole` and the summary's place, as kincas_sweep_whole reads them: kept with the layout)
+        self.at = np.array([*whole, 8 * off[11]], dtype=np.int64)
+        self.at_address = self.at.ctypes.data
 
 
 def _layout(sweeper, key) -> _Layout:
@@ -60,8 +96,9 @@ def _layout(sweeper, key) -> _Layout:
     at_values = at_info + 5 * n
     at_m = at_values + no * n
     # (the order `advance` and the views read them in: state, Q, info, values, measures,
-    # U, rates, accelerations, parameters, then the ends of the parameters and measures)
-    o = (0, at_s, at_q, at_info, at_values, at_m, 6, at_ud, at_udd, at_p, at_s, at_m + nm * n)
+    # U, rates, accelerations, parameters, then the ends of the parameters and measures, then
+    # the end of the measures' summary, two numbers: the block's size)
+    o = (0, at_s, at_q, at_info, at_values, at_m, 6, at_ud, at_udd, at_p, at_s, at_m + nm * n, at_m + nm * n + 2)
     # the C loop's addresses at start 0, in bytes from the block's: U, p, state, Q, info,
     # rates, accelerations, values, measures
     whole = tuple(8 * o[i] for i in (6, 9, 1, 2, 3, 7, 8, 4, 5))
@@ -91,7 +128,7 @@ class FastRun:
     # it more; `__dict__` stays for what callers add, such as `crossed`)
     __slots__ = ("sweeper", "n", "_off", "_block", "Q", "info", "values", "_ok", "solved", "_accepted",
                  "_measures", "_state_view", "_sud", "_sudd", "_U", "_Ud", "_Udd", "_p", "first_bad", "_s", "_lay",
-                 "_addr", "recorded", "attempted", "backend", "__dict__")
+                 "_addr", "recorded", "attempted", "backend", "summarised", "__dict__")
 
     crossed = ()  # steps across a gap the careful path found (kincas/analysis/continuation.py
     # sets a list of its own where it finds one; read by `kincas.sweep` without a getattr
@@ -118,7 +155,7 @@ class FastRun:
         if lay is None:
             lay = _layout(sweeper, key)
         o = self._off = lay.off
-        block = self._block = _empty(o[11])
+        block = self._block = _empty(o[12])
         # (a slice assigned each: a quarter less than one np.concatenate of the five)
         block[:6] = _HEAD  # the thresholds, then L in its place
         block[0] = L
@@ -136,6 +173,7 @@ class FastRun:
         self.first_bad, self._s, self._addr, self.recorded = 0, None, None, 0
         self.attempted = False  # True once every pose was attempted (`FastSweeper.sweep`)
         self.backend = None  # "compiled" or "virtual machine": what `advance` ran last
+        self.summarised = False  # the block's summary is of every pose (`summary`)
 
     @property
     def accepted(self) -> np.ndarray:
@@ -208,6 +246,15 @@ class FastRun:
         flat = self._block[self._off[5]:self._off[11]]
         return flat.reshape(self.n, len(self.sweeper.blocks) + 1), flat
 
+    def summary(self) -> tuple | None:
+        """(modes that differ from the first pose's, the smallest sigma, NaN if any is) over
+        every pose's measures, as the compiled loop summed them when its last call reached
+        the last pose; None otherwise (the measures are then read from the table)."""
+        if not self.summarised:
+            return None
+        at = self._off[11]
+        return self._block[at], self._block[at + 1]
+
     def modes_at(self, k: int) -> list:
         """Each group's mode at pose k (the sign of det of its block of g_q), as numbers."""
         nm = len(self.sweeper.blocks) + 1
@@ -234,11 +281,10 @@ class FastRun:
             if a is None:  # the address of the run's block (inputs included): a ctypes view
                 # of the (writable, contiguous) block costs a third of `ptr`'s
                 a = self._addr = ctypes.addressof(ctypes.c_char.from_buffer(self._block))
-            if start == 0 and stop == self.n:  # (the usual warm sweep: its addresses from
-                # byte offsets worked out once per layout, `_Layout.whole`)
-                b = self._lay.whole
-                k = lib.kincas_sweep(stop, a + b[0], a + b[1], a, a + 8, sw.max_evals, a + b[2], a + b[3],
-                                     a + b[4], stop, a + b[5], self._sud, a + b[6], self._sudd, a + b[7], a + b[8])
+            if start == 0 and stop == self.n:  # (the usual warm sweep: its addresses as byte
+                # offsets worked out once per layout, `_Layout.at`; the measures summarised)
+                k = lib.kincas_sweep_whole(stop, a, self._lay.at_address, sw.max_evals, self._sud, self._sudd)
+                self.summarised = k == stop > 0
             else:
                 o, sud, sudd, nq, nu = self._off, self._sud, self._sudd, sw.nq, sw.nu
                 k = start + lib.kincas_sweep(
@@ -246,7 +292,11 @@ class FastRun:
                     a + 8 * (o[2] + start * nq), a + 8 * (o[3] + start), self.n, a + 8 * (o[7] + start * sud), sud,
                     a + 8 * (o[8] + start * sudd), sudd, a + 8 * (o[4] + start),
                     a + 8 * (o[5] + start * (len(sw.blocks) + 1)))
+                self.summarised = k == self.n > 0  # the last stretch: every pose's measures summarised
+                if self.summarised:  # (those before `start` as `record` or an earlier call wrote them)
+                    lib.kincas_measures_summary(self.n, a + 8 * o[5], a + 8 * o[11])
         else:
+            self.summarised = False
             k = sw._vm_advance(self, start, stop, s)
         if start == 0 and k == self.n:  # (the usual warm sweep: every pose at once)
             self._ok.fill(True)  # accepted and solved
@@ -260,6 +310,7 @@ class FastRun:
     def record(self, k: int, sol) -> None:
         """Store a carefully solved pose (an object with q, residual, iterations, ok, J)."""
         self.recorded += 1
+        self.summarised = False
         self.solved[k] = bool(sol.ok)
         self.Q[k], self.values[:, k] = (sol.q if sol.ok else np.nan), np.nan  # values: see sweep
         self.measures[:, k] = self.sweeper.measures(sol, self.U[k], self.p, self.L[0]) if sol.ok else np.nan
