@@ -510,3 +510,15 @@ def test_a_sweeps_summary_is_its_measures(b, how):
     assert want == (b != 2.0 + 1e-9)
     C = closed_C(th, b)
     assert np.abs(sw["C.x"] - C[0]).max() < 1e-9  # (next to collinear the closed form's own rounding grows)
+
+
+def test_a_run_from_a_later_pose_has_no_summary():
+    """`FastSweeper.run` from pose 1 (pose 0's measures never written by the loop, then NaN):
+    no summary, though its one call reached the last pose."""
+    from kincas.core.fast import FastSweeper
+    from test_fast import first_pose
+    m = fourbar()
+    U = np.linspace(0.2, 1.2, 50)[:, None]
+    model, p, L, q0 = first_pose(m, U)
+    run = FastSweeper(model, ["C.x"], compile=True).run(U, p, L, q0, U[0], start=1)
+    assert run.first_bad == len(U) and run.summary() is None

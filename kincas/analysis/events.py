@@ -214,9 +214,9 @@ def nothing_met_measures(M, flat=None) -> bool:
 
 
 def nothing_met_summary(summary) -> bool:
-    """`nothing_met` for a sweep with every pose solved by one call of the compiled loop, from
-    its summary of the measures (`FastRun.summary`: how many modes differ from the first
-    pose's, NaN counting as different, and the smallest sigma, NaN if any is)."""
+    """`nothing_met` for a sweep with every pose solved, from the compiled loop's summary of
+    every pose's measures (`FastRun.summary`: how many modes differ from the first pose's,
+    NaN counting as different, and the smallest sigma, NaN if any is)."""
     other, low = summary
     return bool(other == 0 and low > _SIGMA_BOUND)  # (NaN: not)
 

@@ -145,7 +145,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     if not every:  # after gaps the fast pass crossed (none where every pose is solved)
         events += unlabelled_resumes(model, U, p, L, Q, ok, events)
     crossed = getattr(run, "crossed", ())
-    summary = run.summary() if type(run) is FastRun else None  # (the compiled loop's, where one call did all)
+    summary = run.summary() if type(run) is FastRun else None  # (the compiled loop's, if its last call ended the sweep)
     if every and not len(crossed) and (nothing_met_summary(summary) if summary is not None
                                        else nothing_met_measures(run.measures_by_pose()[0]) if type(run) is FastRun
                                        else nothing_met(ok, run.signs, run.sigma, every)):

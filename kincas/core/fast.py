@@ -246,6 +246,7 @@ class FastSweeper(VirtualMachineSweep):
         k = r.advance(start, q_start, u_start)
         for a in (r.Q, r.info.T, r.values.T, r.measures.T):  # not reached
             a[:start], a[k + 1:] = np.nan, np.nan
+        r.summarised = False  # (the measures before `start` were not the loop's)
         return r
 
     def sweep(self, U, p, L, careful, Ud=None, Udd=None, progress=None, first=None) -> FastRun:

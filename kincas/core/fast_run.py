@@ -35,7 +35,7 @@ INFO = ("residual", "step", "jac_change", "correction", "steps")
 # and the smallest sigma (NaN if any is), so that Python reads two numbers instead of the
 # table (kincas/analysis/events.py `nothing_met_summary`).
 WHOLE_C = """
-void kincas_measures_summary(casadi_int n, const casadi_real* meas, casadi_real* out) {
+int kincas_measures_summary(casadi_int n, const casadi_real* meas, casadi_real* out) {
   casadi_int i, j, other = 0;
   casadi_real low = INFINITY;
   int nan = 0;
@@ -46,6 +46,7 @@ void kincas_measures_summary(casadi_int n, const casadi_real* meas, casadi_real*
     else if (m[NM - 1] < low) low = m[NM - 1];
   }
   out[0] = (casadi_real) other; out[1] = nan ? NAN : low;
+  return 0;
 }
 int kincas_sweep_whole(casadi_int n, char* b, const casadi_int* at, casadi_int max_evals, casadi_int sud,
                        casadi_int sudd) {
