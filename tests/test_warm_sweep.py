@@ -238,17 +238,15 @@ def test_status_flags_and_iterations_made_when_read_are_the_sweeps_own():
     check(c, th, 3.5, 1.0)
 
 
-def test_nothing_met_from_the_kernels_measures_agrees_with_the_general_test():
-    """`nothing_met_measures` (modes summed, one comparison) answers as `nothing_met` on
-    tables of modes and sigmas built to sit on every edge: a mode changing once, a mode 0
-    or NaN, a sigma at, just above and just below the bound, NaN, one pose, two groups, and
-    more groups than are checked in Python."""
-    from kincas.analysis.events import _SIGMA_BOUND, nothing_met, nothing_met_measures
-    rng = np.random.default_rng(7)
+def edge_tables(rng, trials, groups):
+    """(signs, sigma, M) tables of the kernel's measures (M: each pose's modes, then sigma)
+    built to sit on every edge of `nothing_met`: in turn as they are, a mode flipped at one
+    pose, a mode 0 or NaN, a sigma at, just above or just below the bound, or NaN; 1 to 40
+    poses, groups() groups."""
+    from kincas.analysis.events import _SIGMA_BOUND
     edges = [_SIGMA_BOUND, np.nextafter(_SIGMA_BOUND, 1), np.nextafter(_SIGMA_BOUND, 0), np.nan, 0.3, 1.0]
-    tried = {True: 0, False: 0}
-    for trial in range(400):
-        n, g = int(rng.choice([1, 2, 7, 40])), int(rng.choice([1, 2, 3, 12, 41]))  # (beyond 8: numpy's sums)
+    for trial in range(trials):
+        n, g = int(rng.choice([1, 2, 7, 40])), groups()
         signs = np.tile(rng.choice([-1.0, 1.0], g), (n, 1))
         sigma = rng.uniform(0.01, 1.0, n)
         kind = trial % 5
@@ -260,7 +258,19 @@ def test_nothing_met_from_the_kernels_measures_agrees_with_the_general_test():
             sigma[rng.integers(n)] = rng.choice(edges)
         M = np.empty((n, g + 1))
         M[:, :g], M[:, g] = signs, sigma
-        want = nothing_met(np.ones(n, dtype=bool), signs, sigma, True)
+        yield signs, sigma, M
+
+
+def test_nothing_met_from_the_kernels_measures_agrees_with_the_general_test():
+    """`nothing_met_measures` (modes summed, one comparison) answers as `nothing_met` on
+    tables of modes and sigmas built to sit on every edge: a mode changing once, a mode 0
+    or NaN, a sigma at, just above and just below the bound, NaN, one pose, two groups, and
+    more groups than are checked in Python."""
+    from kincas.analysis.events import nothing_met, nothing_met_measures
+    tried = {True: 0, False: 0}
+    rng = np.random.default_rng(7)
+    for signs, sigma, M in edge_tables(rng, 400, lambda: int(rng.choice([1, 2, 3, 12, 41]))):  # (beyond 8: numpy's sums)
+        want = nothing_met(np.ones(len(M), dtype=bool), signs, sigma, True)
         assert nothing_met_measures(M, M.ravel()) == want, (signs, sigma)
         tried[want] += 1
     assert min(tried.values()) > 50  # both answers were met often
@@ -438,30 +448,16 @@ def test_the_compiled_loops_summary_of_the_measures_agrees_with_the_general_test
     edge (a mode changing once, a mode 0 or NaN, a sigma at, just above and just below the
     bound, NaN, one pose), with one Assur group (a four-bar) and three (chained four-bars)."""
     import ctypes
-    from kincas.analysis.events import _SIGMA_BOUND, nothing_met, nothing_met_summary
+    from kincas.analysis.events import nothing_met, nothing_met_summary
     from test_group_kernel import chain
     fast, lib = _measures_summary_lib(fourbar() if units == 0 else chain(units))
     g = len(fast.blocks)
     assert g == (1 if units == 0 else units)
-    rng = np.random.default_rng(5)
-    edges = [_SIGMA_BOUND, np.nextafter(_SIGMA_BOUND, 1), np.nextafter(_SIGMA_BOUND, 0), np.nan, 0.3, 1.0]
     tried = {True: 0, False: 0}
-    for trial in range(300):
-        n = int(rng.choice([1, 2, 7, 40]))
-        signs = np.tile(rng.choice([-1.0, 1.0], g), (n, 1))
-        sigma = rng.uniform(0.01, 1.0, n)
-        kind = trial % 5
-        if kind == 1:
-            signs[rng.integers(n), rng.integers(g)] *= -1
-        elif kind == 2:
-            signs[rng.integers(n), rng.integers(g)] = rng.choice([0.0, np.nan])
-        elif kind == 3:
-            sigma[rng.integers(n)] = rng.choice(edges)
-        M = np.empty((n, g + 1))
-        M[:, :g], M[:, g] = signs, sigma
+    for signs, sigma, M in edge_tables(np.random.default_rng(5), 300, lambda: g):
         out = np.full(2, -1.0)
-        lib.kincas_measures_summary(n, M.ctypes.data_as(ctypes.c_void_p), out.ctypes.data_as(ctypes.c_void_p))
-        want = nothing_met(np.ones(n, dtype=bool), signs, sigma, True)
+        lib.kincas_measures_summary(len(M), M.ctypes.data_as(ctypes.c_void_p), out.ctypes.data_as(ctypes.c_void_p))
+        want = nothing_met(np.ones(len(M), dtype=bool), signs, sigma, True)
         assert nothing_met_summary(out) == want, (signs, sigma, out)
         assert out[0] == np.count_nonzero(~(signs == signs[0]))  # (NaN: unlike everything)
         tried[want] += 1
