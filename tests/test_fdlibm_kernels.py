@@ -22,7 +22,7 @@ pytestmark = pytest.mark.skipif(compiling_disabled(), reason="compiling disabled
 def fdlibm(request, monkeypatch, tmp_path):
     monkeypatch.delenv("KINCAS_LIBM_TRIG", raising=False)
     # (a four-bar's kernel calls fdlibm's by default, below INLINE_TRIG_UNKNOWNS; inline, forced)
-    monkeypatch.setattr("kincas.core.fast.INLINE_TRIG_UNKNOWNS", 1 if request.param == "inline" else 10 ** 6)
+    monkeypatch.setattr("kincas.core.c_library.INLINE_TRIG_UNKNOWNS", 1 if request.param == "inline" else 10 ** 6)
     monkeypatch.setenv("KINCAS_CACHE", str(tmp_path))
     monkeypatch.delenv("KINCAS_NO_COMPILE", raising=False)
 
@@ -33,7 +33,7 @@ def _runs(m, report, U, Ud):
     a = fast.run(U, p, L, q0, U[0], start=1, Ud=Ud)
     src = fast.backend.library.source
     assert "#define KINCAS_LIBM_TRIG" not in src  # fdlibm's, as users get it
-    assert ("#define KINCAS_TRIG_CALL" in src) == (fast.nq < kincas.core.fast.INLINE_TRIG_UNKNOWNS)
+    assert ("#define KINCAS_TRIG_CALL" in src) == (fast.nq < kincas.core.c_library.INLINE_TRIG_UNKNOWNS)
     b = FastSweeper(model, report, compile=False).run(U, p, L, q0, U[0], start=1, Ud=Ud)
     assert a.first_bad == b.first_bad == len(U)
     return model, p, L, a, b
@@ -90,12 +90,16 @@ def test_long_chain_written_group_by_group_is_its_closed_form():
 
 
 def test_small_kernels_call_fdlibms_sines_and_large_ones_have_them_inline(monkeypatch):
-    monkeypatch.setattr("kincas.core.fast.INLINE_TRIG_UNKNOWNS", 16)
+    monkeypatch.setattr("kincas.core.c_library.INLINE_TRIG_UNKNOWNS", 16)
     small = FastSweeper(kincas.model_of(fourbar()), ["C.x"], compile=True)
     large = FastSweeper(kincas.model_of(chain(8)), ["T8.x"], compile=True)
     assert small.nq < 16 <= large.nq
     assert small._library().source.startswith("#define KINCAS_TRIG_CALL 1\n")
     assert not large._library().source.startswith("#define KINCAS_")
+    # the quantities' library of a long sweep's careful poses by the same rule
+    from kincas.core.fast import evaluator_for
+    assert evaluator_for(small.model, ["C.x"])._library().source.startswith("#define KINCAS_TRIG_CALL 1\n")
+    assert not evaluator_for(large.model, ["T8.x"])._library().source.startswith("#define KINCAS_")
     monkeypatch.setenv("KINCAS_LIBM_TRIG", "1")  # libm's, whatever the size
     assert small._library().source.startswith("#define KINCAS_LIBM_TRIG 1\n")
     assert large._library().source.startswith("#define KINCAS_LIBM_TRIG 1\n")

@@ -66,6 +66,24 @@ def cache_dir() -> Path:
 
 # the line each choice of `Library`'s trig puts before the prelude (c_source.py SINCOS_C)
 TRIG = {"inline": "", "call": "#define KINCAS_TRIG_CALL 1\n", "libm": "#define KINCAS_LIBM_TRIG 1\n"}
+# From this many unknowns on, a kernel's library has fdlibm's sines and cosines inline
+# (kincas/core/c_source.py SINCOS_C: 40 chained four-bars 25.0k -> 22.4k instructions a pose);
+# below, as one function each use calls: inline, they double gcc's time on Jansen's leg (0.45
+# -> 0.8 s of CPU) while a small mechanism's first sweeps wait in the virtual machine for its
+# library (issue [15]: 1,000 first calls of Jansen's leg 0.73x -> 1.33x pylinkage's time);
+# called, they compile as fast as libm's and keep most of the speed (four-bar, 360-pose
+# compiled pass: libm's 69 us, fdlibm's called 60, inline 62).
+INLINE_TRIG_UNKNOWNS = 16
+
+
+def trig_for(unknowns: int) -> str:
+    """`Library`'s trig for the library of a kernel of this many unknowns: "inline" from
+    INLINE_TRIG_UNKNOWNS on, else "call" (one rule for the sweep, designs and quantity loops).
+
+    >>> trig_for(2), trig_for(80)
+    ('call', 'inline')
+    """
+    return "call" if unknowns < INLINE_TRIG_UNKNOWNS else "inline"
 
 
 def libm_trig() -> bool:

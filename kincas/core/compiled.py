@@ -21,7 +21,7 @@ import threading
 import warnings
 
 from .c_library import (MAX_CACHED, _LIBS, Library, cache_dir, compiling_disabled,  # noqa: F401 (their old home)
-                        exiting, pair_sincos)
+                        exiting, pair_sincos, trig_for)
 from .cancel import held
 
 import casadi as ca
@@ -195,7 +195,8 @@ class QuantityEvaluator:
 
     def _library(self) -> Library:
         return Library("kincas_quantities", [self.f], _QUANT_C, {"NQ": self.nq, "NO": self.no},
-                       {"kincas_quantities": [_I, _V, _V, _I, _V, _V, _I, _V, _I, _V, _I]}, trusted=True)
+                       {"kincas_quantities": [_I, _V, _V, _I, _V, _V, _I, _V, _I, _V, _I]}, trusted=True,
+                       trig=trig_for(self.nq))
 
     def evaluate(self, Q, U, p, Ud=None, Udd=None, ok=None) -> np.ndarray:
         """(len(names), N) values at the poses (Q (N, nq), U (N, nu) tables; rates Ud and

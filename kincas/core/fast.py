@@ -46,11 +46,11 @@ import numpy as np
 
 from .blocks import diagonal_size, numeric_signs
 from .compiled import CHUNK, Backend, Library, QuantityEvaluator  # noqa: F401 (CHUNK: its old home)
+from .c_library import trig_for
 from .fast_run import INFO, WHOLE_C, WHOLE_SIGS, FastRun, _moved_within, _rows, _take, _ticks  # noqa: F401 (INFO, _rows: their old home)
 from .fast_vm import VM_CHUNKS, VM_FLAT, VM_SKIP, VirtualMachineSweep, _Buffered  # noqa: F401
 from .group_kernel import kernel_sizes
 from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, KERNEL_NEAR, QUINTIC_ON, QUINTIC_TRY, RESIDUAL,  # noqa: F401
-                     INLINE_TRIG_UNKNOWNS,
                      STEP, SWEEP_C,
                      kernel_functions, state_function)
 
@@ -166,11 +166,9 @@ class FastSweeper(VirtualMachineSweep):
 
     @property
     def trig(self) -> str:
-        """How the compiled kernel computes sines and cosines (c_library.Library's `trig`):
-        fdlibm's algorithm inline from INLINE_TRIG_UNKNOWNS unknowns on, below it as one
-        function each use calls, whose compiling costs what libm's calls cost (a small
-        kernel's compile is what a user's first sweeps wait for)."""
-        return "call" if self.nq < INLINE_TRIG_UNKNOWNS else "inline"
+        """How the compiled kernel computes sines and cosines (c_library.Library's `trig`,
+        by `trig_for` its number of unknowns)."""
+        return trig_for(self.nq)
 
     def sweep_macros(self) -> dict:
         """The sizes SWEEP_C is compiled with (kincas/core/kernel.py)."""

@@ -61,14 +61,6 @@ GROUP_RUN = 4  # consecutive groups per function written group by group (measure
 # (its cubic, ~30); written as casadi code the quintic also cost compiling (gcc 0.27 -> 0.37
 # s of CPU for a four-bar's kernel, which a user's first sweeps wait for).
 QUINTIC_UNKNOWNS = 16
-# From this many unknowns on, the compiled kernel has fdlibm's sines and cosines inline
-# (kincas/core/c_source.py SINCOS_C: 40 chained four-bars 25.0k -> 22.4k instructions a pose);
-# below, as one function each use calls: inline, they double gcc's time on Jansen's leg (0.45
-# -> 0.8 s of CPU) while a small mechanism's first sweeps wait in the virtual machine for its
-# library (issue [15]: 1,000 first calls of Jansen's leg 0.73x -> 1.33x pylinkage's time);
-# called, they compile as fast as libm's and keep most of the speed (four-bar, 360-pose
-# compiled pass: libm's 69 us, fdlibm's called 60, inline 62).
-INLINE_TRIG_UNKNOWNS = 16
 
 
 # --- the casadi functions ---
