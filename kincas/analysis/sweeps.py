@@ -145,10 +145,7 @@ def sweep(m: Mechanism, inputs=None, *, rates=None, accelerations=None, report=N
     if not every:  # after gaps the fast pass crossed (none where every pose is solved)
         events += unlabelled_resumes(model, U, p, L, Q, ok, events)
     crossed = getattr(run, "crossed", ())
-    summary = run.summary() if type(run) is FastRun else None  # (the compiled loop's, if its last call ended the sweep)
-    if every and not len(crossed) and (nothing_met_summary(summary) if summary is not None
-                                       else nothing_met_measures(run.measures_by_pose()[0]) if type(run) is FastRun
-                                       else nothing_met(ok, run.signs, run.sigma, every)):
+    if every and not len(crossed) and _nothing_met(run, ok):
         at = None  # the usual sweep: no singular position met, no gap (nothing to search)
     else:
         flags = [None] * n
@@ -194,6 +191,16 @@ def _with_jerks(model, report, values, Q, U, p, Ud, Udd, Uddd, ok):
         values = np.array(values, dtype=float)
         values[np.ix_(third, np.flatnonzero(ok))] = got
     return values
+
+
+def _nothing_met(run, ok) -> bool:
+    """Whether a sweep with every pose solved met no singular position (`nothing_met`): from
+    the compiled loop's summary where its last call ended the sweep, else from the fast
+    kernel's table of measures, else (the careful path alone) from the signs and sigmas."""
+    if type(run) is FastRun:
+        summary = run.summary()
+        return nothing_met_summary(summary) if summary is not None else nothing_met_measures(run.measures_by_pose()[0])
+    return nothing_met(ok, run.signs, run.sigma, True)
 
 
 def _sort_events(events, U, keys) -> None:

@@ -70,15 +70,14 @@ LAYOUTS_KEPT = 64  # layouts remembered per sweeper (sweeps of many lengths: kep
 class _Layout:
     """Where each part of a run's block starts (`FastRun`), for one sweeper and one set of
     sizes (poses, the strides of rates and accelerations, parameters): `off` as `FastRun._off`
-    reads it, the shapes of the views, and `whole`, the byte offsets of the addresses that
-    `advance` hands the C loop for a call over every pose (start 0, stop N)."""
+    reads it, the shapes of the views, and `at`, the byte offsets of the parts that
+    kincas_sweep_whole reads for a call over every pose (start 0, stop N), at `at_address`."""
 
-    __slots__ = ("off", "q_shape", "info_shape", "values_shape", "whole", "at", "at_address")
+    __slots__ = ("off", "q_shape", "info_shape", "values_shape", "at", "at_address")
 
-    def __init__(self, off, q_shape, info_shape, values_shape, whole):
-        self.off, self.q_shape, self.info_shape, self.values_shape, self.whole = off, q_shape, info_shape, values_shape, whole
-        # (`whole` and the summary's place, as kincas_sweep_whole reads them: kept with the layout)
-        self.at = np.array([*whole, 8 * off[11]], dtype=np.int64)
+    def __init__(self, off, q_shape, info_shape, values_shape, at):
+        self.off, self.q_shape, self.info_shape, self.values_shape = off, q_shape, info_shape, values_shape
+        self.at = np.array(at, dtype=np.int64)  # (kept with the layout: the C loop reads it)
         self.at_address = self.at.ctypes.data
 
 
@@ -101,9 +100,8 @@ def _layout(sweeper, key) -> _Layout:
     # the end of the measures' summary, two numbers: the block's size)
     o = (0, at_s, at_q, at_info, at_values, at_m, 6, at_ud, at_udd, at_p, at_s, at_m + nm * n, at_m + nm * n + 2)
     # the C loop's addresses at start 0, in bytes from the block's: U, p, state, Q, info,
-    # rates, accelerations, values, measures
-    whole = tuple(8 * o[i] for i in (6, 9, 1, 2, 3, 7, 8, 4, 5))
-    lay = _Layout(o, (n, nq), (5, n), (no, n), whole)
+    # rates, accelerations, values, measures, then the measures' summary
+    lay = _Layout(o, (n, nq), (5, n), (no, n), [8 * o[i] for i in (6, 9, 1, 2, 3, 7, 8, 4, 5, 11)])
     kept = sweeper._layouts
     if len(kept) >= LAYOUTS_KEPT:
         kept.clear()

@@ -112,10 +112,10 @@ def quintic_weights(u0, u, u1, u2):
     w1 = A * (2 * s3 - 3 * s2) + B * (6 * s - 6 * s2)  # f1 - f0
     wd0 = A * (s3 - 2 * s2 + s) + B * (4 * s - 3 * s2 - 1)
     wd1 = A * (s3 - s2) + B * (2 * s - 3 * s2)
-    return use, w1, A, wd0 * dup, wd1 * dup, B * dup
     # (at even steps the correction is 4 (f1 - f0) + 10 (f2 - f0) + 5 d0 + 16 d1 + 3 d2: these
     # weights amplify the rounding of the solved q's about four times more than the cubic's,
     # which is why the quintic runs only where the cubic misses by more than that: QUINTIC_ON)
+    return use, w1, A, wd0 * dup, wd1 * dup, B * dup
 
 
 def cubic(q0, T0, u0, u, T1, u1, q1):
