@@ -49,3 +49,12 @@ def test_compiled_max_and_min_follow_c99():
         want = np.r_[np.fmax(a, b), np.fmin(a, b), np.fmax.reduce(a), np.fmin.reduce(b)]
         np.testing.assert_array_equal(out, want)  # NaN where both are NaN, else the number
         assert np.array_equal(out, np.asarray(f(a, b)).ravel(), equal_nan=True)  # casadi's VM alike
+    # every pair of special and ordinary values, each in both places (the C form is one
+    # condition, `(y != y || x > y) ? x : y`: a NaN on either side must give the other)
+    special = [nan, -np.inf, -1.5, -0.0, 0.0, 1e-300, 2.0, np.inf]
+    for x in special:
+        for y in special:
+            a, b, out = np.array([x, y, x]), np.array([y, x, nan]), np.empty(8)
+            assert lib.kincas_minmax(a.ctypes.data, b.ctypes.data, out.ctypes.data) == 0
+            want = np.r_[np.fmax(a, b), np.fmin(a, b), np.fmax.reduce(a), np.fmin.reduce(b)]
+            np.testing.assert_array_equal(out, want, err_msg=f"max/min of {x!r}, {y!r}")
