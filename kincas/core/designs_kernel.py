@@ -45,7 +45,8 @@ import numpy as np
 from .blocks import block_measures, block_solve, diagonal_blocks
 from .compiled import Backend, Library, ptr, rows
 from .fast import COMPILE_MAX, SWEEP_SIG, sweeper_for
-from .kernel import KERNEL_NEAR, SWEEP_C
+from .kernel import KERNEL_NEAR
+from .sweep_loop import SWEEP_C
 from .tolerances import ACCEPT, PARAM_STEP as STEP  # largest parameter change per step, over the size
 MAX_STEPS = 64  # continuation steps per design at most
 NEWTON = 8  # Newton steps per continuation step at most

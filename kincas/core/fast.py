@@ -51,8 +51,8 @@ from .fast_run import INFO, WHOLE_C, WHOLE_SIGS, FastRun, _moved_within, _rows, 
 from .fast_vm import VM_CHUNKS, VM_FLAT, VM_SKIP, VirtualMachineSweep, _Buffered  # noqa: F401
 from .group_kernel import kernel_sizes
 from .kernel import (CORRECTION, JAC_CHANGE, MAX_EVALS, KERNEL_NEAR, QUINTIC_ON, QUINTIC_TRY, RESIDUAL,  # noqa: F401
-                     STEP, SWEEP_C,
-                     kernel_functions, state_function)
+                     STEP, kernel_functions, state_function)
+from .sweep_loop import SWEEP_C, loop_trig
 
 # Kernel size, in casadi instructions, beyond which compiling costs more than it saves: gcc
 # -O3 took 1.7 s at 11k instructions, 13 s at 39k and 200 s (3.5 GB) at 150k.
@@ -161,7 +161,9 @@ class FastSweeper(VirtualMachineSweep):
         return [kN, kF, kL, kW]
 
     def _library(self) -> Library:
-        return Library("kincas_sweep", self.compiled_functions, SWEEP_C + WHOLE_C, self.sweep_macros(),
+        kN, kF, kL, kW = self.compiled_functions
+        kN, kF, trig = loop_trig(kN, kF)  # (a flat kernel's sines and cosines from the loop)
+        return Library("kincas_sweep", [kN, kF, kL, kW], SWEEP_C + WHOLE_C, {**self.sweep_macros(), **trig},
                        {"kincas_sweep": SWEEP_SIG, **WHOLE_SIGS}, trusted=True, trig=self.trig)
 
     @property
@@ -171,7 +173,7 @@ class FastSweeper(VirtualMachineSweep):
         return trig_for(self.nq)
 
     def sweep_macros(self) -> dict:
-        """The sizes SWEEP_C is compiled with (kincas/core/kernel.py)."""
+        """The sizes SWEEP_C is compiled with (kincas/core/sweep_loop.py)."""
         return {"NQ": self.nq, "NU": self.nu, "NO": len(self.report), "NM": len(self.blocks) + 1,
                 "NJ": self.nj, "QUINTIC_ON": repr(float(QUINTIC_ON)),
                 "QUINTIC_TRY": repr(float(QUINTIC_TRY)), "HAVE_KP5": int(self.functions[4] is not None),

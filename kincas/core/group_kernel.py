@@ -38,6 +38,7 @@ import casadi as ca
 import numpy as np
 
 from .blocks import block_change, block_measures, block_solve, diagonal_blocks, diagonal_size, reciprocal
+from .lifting import lift_constants, lift_trig
 from .structure import Block
 
 OPTS = {"cse": True}  # one sin and cos per angle within a group's function
@@ -81,8 +82,8 @@ class _Group:
         new = [ca.vertcat(*qv) if qv else ca.SX(0, 1), u, ca.vertcat(*pv) if pv else ca.SX(0, 1)]
         keep = [k for k, v in enumerate(old) if v.numel()]
         g = ca.substitute([gB], [old[k] for k in keep], [new[k] for k in keep])[0]
-        trig, self.trig = _lift_trig(ca.Function("g", [x, z, u, p], [g]), 1)
-        shape, self.values = _lift_constants(trig)
+        trig, self.trig = lift_trig(ca.Function("g", [x, z, u, p], [g]), 1)
+        shape, self.values = lift_constants(trig)
         self.is_length = sym.is_length[self.cols]
         layout = tuple((len(b.rows), len(b.cols)) for b in blks)
         self.key = (shape.serialize(), tuple(self.is_length), layout)
@@ -293,75 +294,3 @@ def _max_rows(parts):
         return ca.MX.zeros(2)
     M = ca.horzcat(*parts)
     return ca.vertcat(ca.mmax(M[0, :]) + 0 * ca.sum2(M[0, :]), ca.mmax(M[1, :]) + 0 * ca.sum2(M[1, :]))
-
-
-def _lift_constants(f: ca.Function):
-    """(g, c): g(*f's inputs, c) == f(*f's inputs), every constant of f's instructions an
-    entry of the new last input c; the same operations in the same order, so g computes
-    f's numbers exactly."""
-    g, keys = _lift(f, lambda i, op, src: i if op == ca.OP_CONST else None)
-    return g, np.array([f.instruction_constant(i) for i in keys], dtype=float)
-
-
-def _lift_trig(f: ca.Function, which: int):
-    """(g, ks): the sines and cosines of entries of f's input `which` (a run's hanging
-    unknowns z) lifted into a new last input t = [sin z_k, cos z_k for k in ks]: the run that
-    solved z_k has computed them already and passes them on (40 chained four-bars: 10 of 90
-    sines and cosines a pose fewer). Both of each pair, as d sin z / dz = cos z."""
-    srcs = _sources(f)
-    ks = sorted({src[1] for i, src in enumerate(srcs)
-                 if f.instruction_id(i) in (ca.OP_SIN, ca.OP_COS) and src and src[0] == which})
-    at = {(k, op): 2 * n + (op == ca.OP_COS) for n, k in enumerate(ks) for op in (ca.OP_SIN, ca.OP_COS)}
-    g, _ = _lift(f, lambda i, op, src: at[src[1], op] if op in (ca.OP_SIN, ca.OP_COS) and src
-                 and src[0] == which else None, slots=2 * len(ks))
-    return g, ks
-
-
-def _sources(f):
-    """Per instruction of f: (input, entry) where it is unary and its argument an input's
-    entry, else None."""
-    srcs, slot = [], {}
-    for j in range(f.n_instructions()):
-        op, o, ii = f.instruction_id(j), f.instruction_output(j), f.instruction_input(j)
-        srcs.append(slot.get(ii[0]) if len(ii) == 1 and op not in (ca.OP_INPUT, ca.OP_OUTPUT) else None)
-        if op == ca.OP_INPUT:
-            slot[o[0]] = (ii[0], ii[1])
-        elif op != ca.OP_OUTPUT:
-            slot.pop(o[0], None)
-    return srcs
-
-
-def _lift(f: ca.Function, key, slots=None):
-    """(g, keys): g(*f's inputs, t) == f(*f's inputs) where every instruction i for which
-    key(i, op, source) is not None gives (instead of its own result) the entry t[key] of a
-    new last input t (`slots` entries, or one per such instruction in their order, `keys`
-    holding their keys); every other instruction the same operation in the same order."""
-    ins, srcs = f.sx_in(), _sources(f)
-    lifted, keys, work, outs = {}, [], {}, [[None] * f.nnz_out(k) for k in range(f.n_out())]
-    t = ca.SX.sym("t", slots) if slots is not None else None
-    nz = [ca.vertsplit(ca.vec(a), 1) if a.numel() else [] for a in ins]
-    for i in range(f.n_instructions()):
-        op, o, ii = f.instruction_id(i), f.instruction_output(i), f.instruction_input(i)
-        k = key(i, op, srcs[i]) if op not in (ca.OP_INPUT, ca.OP_OUTPUT) else None
-        if k is not None:
-            if slots is None:
-                lifted[k] = ca.SX.sym(f"c{len(keys)}")
-                keys.append(k)
-            work[o[0]] = t[k] if slots is not None else lifted[k]
-        elif op == ca.OP_CONST:
-            work[o[0]] = ca.SX(f.instruction_constant(i))
-        elif op == ca.OP_INPUT:
-            work[o[0]] = nz[ii[0]][ii[1]]
-        elif op == ca.OP_OUTPUT:
-            outs[o[0]][o[1]] = work[ii[0]]
-        elif len(ii) == 1:
-            work[o[0]] = ca.SX.unary(op, work[ii[0]])
-        else:
-            work[o[0]] = ca.SX.binary(op, work[ii[0]], work[ii[1]])
-    res = []
-    for k, col in enumerate(outs):
-        sp = f.sparsity_out(k)
-        res.append(ca.SX(sp, ca.vertcat(*[ca.SX(0) if v is None else v for v in col]) if col else ca.SX(0, 1)))
-    if slots is None:
-        t = ca.vertcat(*[lifted[k] for k in keys]) if keys else ca.SX(0, 1)
-    return ca.Function("g", [*ins, t], res), keys

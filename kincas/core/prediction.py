@@ -68,7 +68,7 @@ def _along(u0, u, u1):
 
 def _times(T, v):
     """T v (T an nq x nu matrix, v an nu-vector) summed in the order the C loop sums it
-    (kincas/core/kernel.py SWEEP_C): T[:, 0] v[0] + T[:, 1] v[1] + ..., so that both give the
+    (kincas/core/sweep_loop.py SWEEP_C): T[:, 0] v[0] + T[:, 1] v[1] + ..., so that both give the
     same numbers."""
     t = T[:, 0] * v[0]
     for j in range(1, v.numel()):
@@ -132,7 +132,7 @@ def quintic(q0, T0, u0, u, T1, u1, q1, T2, u2, q2, scale=1):
     (see the module text), and max |p5 - p3| / scale, the cubic's error as the quintic sees
     it (0 where it does not apply). `scale`: each unknown's (1 for an angle, its group's
     length for a length). Casadi expressions (SX or DM); each unknown's correction summed
-    in the C loop's order (kincas/core/kernel.py SWEEP_C)."""
+    in the C loop's order (kincas/core/sweep_loop.py SWEEP_C)."""
     p3 = cubic(q0, T0, u0, u, T1, u1, q1)
     use, w1, w2, e0, e1, e2 = quintic_weights(u0, u, u1, u2)
     corr = (((w1 * (q1 - q0) + w2 * (q2 - q0)) + _times(T0, e0)) + _times(T1, e1)) + _times(T2, e2)
