@@ -105,8 +105,9 @@ SINCOS_DRIVER = """
 int kincas_test_trig(casadi_int n, const double* x, double* out) {
   casadi_int k;
   for (k = 0; k < n; ++k) {
-    kincas_sincos(x[k], out + 4*k, out + 4*k + 1);
-    out[4*k + 2] = kincas_sin(x[k]); out[4*k + 3] = kincas_cos(x[k]);
+    kincas_sincos(x[k], out + 6*k, out + 6*k + 1);
+    out[6*k + 2] = kincas_sin(x[k]); out[6*k + 3] = kincas_cos(x[k]);
+    kincas_sincos_inline(x[k], out + 6*k + 4, out + 6*k + 5);  /* the compiled loop's form */
   }
   return 0;
 }
@@ -135,16 +136,17 @@ def test_compiled_sines_and_cosines_are_within_an_ulp(monkeypatch, trig):
                         halves, np.nextafter(halves, np.inf), np.nextafter(halves, -np.inf),
                         [np.pi / 4, np.nextafter(np.pi / 4, 1), 5e-324, 1e-310, 1.6e6, 1.7e6, 1e22, 3.0e300]])
     assert ("#define KINCAS_TRIG_CALL" in built.source) == (trig == "call")
-    out = np.empty((len(x), 4))
+    out = np.empty((len(x), 6))
     assert lib.kincas_test_trig(len(x), x.ctypes.data, out.ctypes.data) == 0
     assert np.array_equal(out[:, 0], out[:, 2]) and np.array_equal(out[:, 1], out[:, 3])  # one arithmetic
+    assert np.array_equal(out[:, 0], out[:, 4]) and np.array_equal(out[:, 1], out[:, 5])  # inline or called
     mpmath.mp.dps = 40
-    for xi, (s, c, _, _) in zip(x, out):
+    for xi, (s, c, *_) in zip(x, out):
         for got, ref in ((s, mpmath.sin(mpmath.mpf(float(xi)))), (c, mpmath.cos(mpmath.mpf(float(xi))))):
             ulp = np.spacing(abs(float(ref))) if float(ref) else 5e-324
             assert float(abs(mpmath.mpf(float(got)) - ref)) <= ulp, (xi, got)
     special = np.array([0.0, -0.0, np.inf, -np.inf, np.nan])
-    out = np.empty((len(special), 4))
+    out = np.empty((len(special), 6))
     lib.kincas_test_trig(len(special), special.ctypes.data, out.ctypes.data)
     assert np.signbit(out[1, 0]) and out[1, 1] == 1 and out[0, 0] == 0 and not np.signbit(out[0, 0])
     assert np.isnan(out[2:, :]).all()

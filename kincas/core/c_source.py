@@ -36,7 +36,9 @@ import re
 # 141). Beyond |x| = 2^20 pi/2, infinities and NaNs: libm's. The virtual machine keeps
 # casadi's sin and cos (libm's), so compiled and virtual machine sweeps agree to rounding, not
 # bit for bit; KINCAS_LIBM_TRIG=1 (`libm_trig`, trig "libm") compiles libm's instead, which
-# the tests that hold the C loop to the virtual machine bit for bit use.
+# the tests that hold the C loop to the virtual machine bit for bit use. The compiled sweep's
+# loop computes a flat kernel's sines and cosines itself, at two sites, by kincas_sincos_inline:
+# fdlibm's inline whatever the trig (kincas/core/sweep_loop.py TRIG_C).
 SINCOS_C = """#ifdef __GLIBC__
 #define kincas_libm_sincos(x, s, c) sincos(x, s, c)
 #else
@@ -44,6 +46,7 @@ SINCOS_C = """#ifdef __GLIBC__
 #endif
 #ifdef KINCAS_LIBM_TRIG
 #define kincas_sincos(x, s, c) kincas_libm_sincos(x, s, c)
+#define kincas_sincos_inline(x, s, c) kincas_libm_sincos(x, s, c)
 #define kincas_sin(x) sin(x)
 #define kincas_cos(x) cos(x)
 #else
@@ -53,6 +56,11 @@ SINCOS_C = """#ifdef __GLIBC__
 #define KINCAS_INLINE static inline __attribute__((always_inline))
 #else
 #define KINCAS_INLINE static inline
+#endif
+#if defined(__GNUC__) || defined(__clang__)
+#define KINCAS_ALWAYS_INLINE static inline __attribute__((always_inline))
+#else
+#define KINCAS_ALWAYS_INLINE static inline
 #endif
 /*
  * ====================================================
@@ -83,7 +91,7 @@ static inline double kincas_kcos(double x, double y) {
   return w + (((1.0 - w) - hz) + (z*r - x*y));
 }
 static inline uint32_t kincas_high(double x) { uint64_t b; memcpy(&b, &x, 8); return (uint32_t) (b >> 32); }
-KINCAS_INLINE void kincas_sincos(double x, double* s, double* c) {
+KINCAS_ALWAYS_INLINE void kincas_sincos_inline(double x, double* s, double* c) {
   const double invpio2 = 6.36619772367581382433e-01, pio2_1 = 1.57079632673412561417e+00,
     pio2_1t = 6.07710050650619224932e-11, pio2_2 = 6.07710050630396597660e-11,
     pio2_2t = 2.02226624879595063154e-21, pio2_3 = 2.02226624871116645580e-21,
@@ -114,6 +122,9 @@ KINCAS_INLINE void kincas_sincos(double x, double* s, double* c) {
     default: *s = -cs; *c = sn;
   }
 }
+/* each use of the kernel's own code calls this one (KINCAS_TRIG_CALL) or has it inline; the
+   compiled loop's few sites (kincas/core/sweep_loop.py) have kincas_sincos_inline either way */
+KINCAS_INLINE void kincas_sincos(double x, double* s, double* c) { kincas_sincos_inline(x, s, c); }
 static inline double kincas_sin(double x) { double s, c; kincas_sincos(x, &s, &c); return s; }
 static inline double kincas_cos(double x) { double s, c; kincas_sincos(x, &s, &c); return c; }
 #endif

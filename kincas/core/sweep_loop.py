@@ -55,7 +55,10 @@ TRIG_C = r"""
    each pair by d, s' = s + (s (cos d - 1) - c sin d), c' = c + (c (cos d - 1) + s sin d), with
    cos d - 1 and sin d by their Taylor series (for |d| <= KS_TURN the next terms, d^6/720 and
    d^7/5040, are below 1e-20): a few operations where a sine and cosine cost ~80 instructions,
-   right to rounding as the function itself is; a longer step takes them afresh. */
+   right to rounding as the function itself is; a longer step takes them afresh. At the
+   prediction they are on every pose's path: fdlibm's inline there whatever the kernel's trig
+   (`kincas_sincos_inline`, two sites: a four-bar's warm 360-pose call 114 -> 107 us, its
+   compile no longer); a long step's, rarer, the kernel's form (`kincas_sincos`). */
 #ifndef KS_NTQ
 #define KS_NTQ 0
 #define KS_NTU 0
@@ -73,11 +76,11 @@ static const int KS_TRIG_Q[KS_NTQ > 0 ? KS_NTQ : 1] = KS_TRIG_Q_AT;
 static const int KS_TRIG_U[KS_NTU > 0 ? KS_NTU : 1] = KS_TRIG_U_AT;
 static inline void ks_trig_q(const casadi_real* q, casadi_real* t) {
   int n;
-  for (n = 0; n < KS_NTQ; ++n) kincas_sincos(q[KS_TRIG_Q[n]], t + 2*n, t + 2*n + 1);
+  for (n = 0; n < KS_NTQ; ++n) kincas_sincos_inline(q[KS_TRIG_Q[n]], t + 2*n, t + 2*n + 1);
 }
 static inline void ks_trig_u(const casadi_real* u, casadi_real* t) {
   int n;
-  for (n = 0; n < KS_NTU; ++n) kincas_sincos(u[KS_TRIG_U[n]], t + 2*(KS_NTQ + n), t + 2*(KS_NTQ + n) + 1);
+  for (n = 0; n < KS_NTU; ++n) kincas_sincos_inline(u[KS_TRIG_U[n]], t + 2*(KS_NTQ + n), t + 2*(KS_NTQ + n) + 1);
 }
 /* q <- q - dq, and the unknowns' sines and cosines in t with it */
 static inline void ks_step(casadi_real* q, const casadi_real* dq, casadi_real* t) {
