@@ -57,8 +57,8 @@ TRIG_C = r"""
    d^7/5040, are below 1e-20): a few operations where a sine and cosine cost ~80 instructions,
    right to rounding as the function itself is; a longer step takes them afresh. At the
    prediction they are on every pose's path: fdlibm's inline there whatever the kernel's trig
-   (`kincas_sincos_inline`, two sites: a four-bar's warm 360-pose call 114 -> 107 us, its
-   compile no longer); a long step's, rarer, the kernel's form (`kincas_sincos`). */
+   (`kincas_sincos_inline`, one site: a four-bar's warm 360-pose call 114 -> 107 us); a long
+   step's, rarer, the kernel's form (`kincas_sincos`). */
 #ifndef KS_NTQ
 #define KS_NTQ 0
 #define KS_NTU 0
@@ -74,16 +74,18 @@ TRIG_C = r"""
 #endif
 static const int KS_TRIG_Q[KS_NTQ > 0 ? KS_NTQ : 1] = KS_TRIG_Q_AT;
 static const int KS_TRIG_U[KS_NTU > 0 ? KS_NTU : 1] = KS_TRIG_U_AT;
-static inline void ks_trig_q(const casadi_real* q, casadi_real* t) {
+/* the unknowns' at the prediction q and the inputs' at u, all at one site of the inline form */
+static inline void ks_trig(const casadi_real* q, const casadi_real* u, casadi_real* t) {
   int n;
-  for (n = 0; n < KS_NTQ; ++n) kincas_sincos_inline(q[KS_TRIG_Q[n]], t + 2*n, t + 2*n + 1);
+  for (n = 0; n < KS_NT; ++n)
+    kincas_sincos_inline(n < KS_NTQ ? q[KS_TRIG_Q[n]] : u[KS_TRIG_U[n - KS_NTQ]], t + 2*n, t + 2*n + 1);
 }
-static inline void ks_trig_u(const casadi_real* u, casadi_real* t) {
-  int n;
-  for (n = 0; n < KS_NTU; ++n) kincas_sincos_inline(u[KS_TRIG_U[n]], t + 2*(KS_NTQ + n), t + 2*(KS_NTQ + n) + 1);
-}
-/* q <- q - dq, and the unknowns' sines and cosines in t with it */
-static inline void ks_step(casadi_real* q, const casadi_real* dq, casadi_real* t) {
+/* q <- q - dq, and the unknowns' sines and cosines in t with it (a function of its own: its
+   three uses inline made gcc's time for Jansen's leg's loop grow by a tenth) */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((noinline))
+#endif
+static void ks_step(casadi_real* q, const casadi_real* dq, casadi_real* t) {
   int n, i;
   for (n = 0; n < KS_NTQ; ++n) {
     const int j = KS_TRIG_Q[n];
@@ -151,7 +153,6 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
   for (k = 0; k < n; ++k) {
     const casadi_real* u = U + k*NU;
     int conv = 0;
-    ks_trig_u(u, tq);  /* the inputs' sines and cosines: once a pose */
     /* the prediction (kincas/core/prediction.py `cubic`, `quintic`): its scalars by kW, then
        each unknown by the same operations in the same order as kP and kP5 */
     arg[0] = P0 + NQ + NQ*NU; arg[1] = u; arg[2] = P1 + NQ + NQ*NU; arg[3] = P2 + NQ + NQ*NU; res[0] = W;
@@ -189,7 +190,7 @@ int kincas_sweep(casadi_int n, const casadi_real* U, const casadi_real* p, const
       }
     }
     for (i = 0; i < NQ; ++i) q[i] = qp[i];
-    ks_trig_q(q, tq);  /* the unknowns' at the prediction; moved with each step below */
+    ks_trig(q, u, tq);  /* the sines and cosines at the prediction; moved with each step below */
     if (near) {  /* kF at the prediction first: where its (next) step is negligible, no kN */
       arg[0] = q; arg[1] = u; arg[2] = p; arg[3] = L; arg[4] = Ud + k*sud; arg[5] = Udd + k*sudd;
       arg[6] = J0; arg[7] = qp; arg[8] = Lb; KS_ARG_T(9);
