@@ -37,7 +37,7 @@ import re
 # casadi's sin and cos (libm's), so compiled and virtual machine sweeps agree to rounding, not
 # bit for bit; KINCAS_LIBM_TRIG=1 (`libm_trig`, trig "libm") compiles libm's instead, which
 # the tests that hold the C loop to the virtual machine bit for bit use. The compiled sweep's
-# loop computes a flat kernel's sines and cosines itself, at two sites, by kincas_sincos_inline:
+# loop computes a flat kernel's sines and cosines itself, at one site, by kincas_sincos_inline:
 # fdlibm's inline whatever the trig (kincas/core/sweep_loop.py TRIG_C).
 SINCOS_C = """#ifdef __GLIBC__
 #define kincas_libm_sincos(x, s, c) sincos(x, s, c)

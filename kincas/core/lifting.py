@@ -41,13 +41,8 @@ def lift_trig(f: ca.Function, which: int):
     unknowns z) lifted into a new last input t = [sin z_k, cos z_k for k in ks]: the run that
     solved z_k has computed them already and passes them on (40 chained four-bars: 10 of 90
     sines and cosines a pose fewer). Both of each pair, as d sin z / dz = cos z."""
-    srcs = _sources(f)
-    ks = sorted({src[1] for i, src in enumerate(srcs)
-                 if f.instruction_id(i) in (ca.OP_SIN, ca.OP_COS) and src and src[0] == which})
-    at = {(k, op): 2 * n + (op == ca.OP_COS) for n, k in enumerate(ks) for op in (ca.OP_SIN, ca.OP_COS)}
-    g, _ = _lift(f, lambda i, op, src: at[src[1], op] if op in (ca.OP_SIN, ca.OP_COS) and src
-                 and src[0] == which else None, slots=2 * len(ks))
-    return g, ks
+    pairs = trig_pairs([f], (which,))
+    return lift_trig_pairs(f, pairs, "g"), [k for _, k in pairs]
 
 
 def trig_pairs(functions, inputs) -> list[tuple[int, int]]:
